@@ -1,0 +1,264 @@
+//! Scenes: meshes placed by instances with roles, lit by rectangular lights.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat3, Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Camera;
+use crate::error::{Result, SceneError};
+use crate::light::RectLight;
+use crate::mesh::Mesh;
+
+/// What an instance does for shadows.
+///
+/// Techniques that split the scene (Atty et al. render separate occluder and
+/// receiver maps) read this; the others and the ground truth treat every
+/// triangle as both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    /// Casts shadows but is not shaded by techniques that split roles.
+    Occluder,
+    /// Receives shadows but casts none in techniques that split roles.
+    Receiver,
+    /// Casts and receives.
+    #[default]
+    Both,
+}
+
+impl Role {
+    /// True for `Occluder` and `Both`.
+    #[must_use]
+    pub fn casts(self) -> bool {
+        matches!(self, Self::Occluder | Self::Both)
+    }
+
+    /// True for `Receiver` and `Both`.
+    #[must_use]
+    pub fn receives(self) -> bool {
+        matches!(self, Self::Receiver | Self::Both)
+    }
+}
+
+/// One placement of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instance {
+    /// A name for messages and role overrides (the glTF node name, or the mesh name).
+    pub name: String,
+    /// Index into [`Scene::meshes`].
+    pub mesh: usize,
+    /// Object-to-world transform; finite and invertible.
+    pub transform: Mat4,
+    /// Shadow role.
+    pub role: Role,
+}
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box: extending it by a point gives that point.
+    pub const EMPTY: Self = Self {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    /// Grows the box to contain `p`.
+    pub fn extend(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    /// True when no point was ever added.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+
+    /// Centre of the box.
+    #[must_use]
+    pub fn centre(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Edge lengths.
+    #[must_use]
+    pub fn size(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// The eight corners.
+    #[must_use]
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+}
+
+/// A complete, validated scene.
+///
+/// Build one with [`Scene::builtin`], [`Scene::load`] or by hand followed by
+/// [`Scene::validate`]; the GPU side assumes the invariants `validate` checks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Where the scene came from, for messages: a file, or `builtin:<name>`.
+    pub origin: PathBuf,
+    /// Meshes in object space.
+    pub meshes: Vec<Mesh>,
+    /// Placements of the meshes.
+    pub instances: Vec<Instance>,
+    /// Area lights; at least one.
+    pub lights: Vec<RectLight>,
+    /// The viewing camera.
+    pub camera: Camera,
+}
+
+/// One world-space triangle with the role of the instance it came from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldTriangle {
+    /// Corners, counter-clockwise seen from the front.
+    pub corners: [Vec3; 3],
+    /// Corner normals, world space, unit length.
+    pub normals: [Vec3; 3],
+    /// Role of the source instance.
+    pub role: Role,
+}
+
+impl Scene {
+    /// Checks every invariant: meshes, instances, lights, camera, and that there is something to draw.
+    ///
+    /// # Errors
+    /// The first problem found, naming [`Scene::origin`] and the element.
+    pub fn validate(&self) -> Result<()> {
+        let file = self.origin.as_path();
+        for mesh in &self.meshes {
+            mesh.validate(file)?;
+        }
+        for instance in &self.instances {
+            validate_instance(file, instance, self.meshes.len())?;
+        }
+        if self.triangle_count() == 0 {
+            return Err(SceneError::EmptyScene {
+                file: file.into(),
+                what: "no triangles",
+            });
+        }
+        if self.lights.is_empty() {
+            return Err(SceneError::EmptyScene {
+                file: file.into(),
+                what: "no lights",
+            });
+        }
+        for (index, light) in self.lights.iter().enumerate() {
+            light.validate(file, index)?;
+        }
+        self.camera.validate(file)?;
+        if !self.bounds().size().is_finite() {
+            return Err(SceneError::EmptyScene {
+                file: file.into(),
+                what: "geometry transforms to non-finite world coordinates",
+            });
+        }
+        Ok(())
+    }
+
+    /// Number of triangles over all instances.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .filter_map(|i| self.meshes.get(i.mesh))
+            .map(Mesh::triangle_count)
+            .sum()
+    }
+
+    /// World-space bounds of every instance.
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        self.bounds_where(|_| true)
+    }
+
+    /// World-space bounds of the instances whose role satisfies `keep`.
+    #[must_use]
+    pub fn bounds_where(&self, keep: impl Fn(Role) -> bool) -> Aabb {
+        let mut bounds = Aabb::EMPTY;
+        for instance in self.instances.iter().filter(|i| keep(i.role)) {
+            if let Some(mesh) = self.meshes.get(instance.mesh) {
+                for &p in &mesh.positions {
+                    bounds.extend(instance.transform.transform_point3(p));
+                }
+            }
+        }
+        bounds
+    }
+
+    /// Every triangle in world space, instance by instance.
+    pub fn world_triangles(&self) -> impl Iterator<Item = WorldTriangle> + '_ {
+        self.instances
+            .iter()
+            .filter_map(|i| self.meshes.get(i.mesh).map(|m| (i, m)))
+            .flat_map(|(instance, mesh)| {
+                let normal_matrix = normal_matrix(instance.transform);
+                mesh.triangles().map(move |t| {
+                    let corner = |k: usize| {
+                        instance
+                            .transform
+                            .transform_point3(mesh.positions[t[k] as usize])
+                    };
+                    let normal = |k: usize| {
+                        (normal_matrix * mesh.normals[t[k] as usize]).normalize_or(Vec3::Y)
+                    };
+                    WorldTriangle {
+                        corners: [corner(0), corner(1), corner(2)],
+                        normals: [normal(0), normal(1), normal(2)],
+                        role: instance.role,
+                    }
+                })
+            })
+    }
+}
+
+/// The matrix that carries normals of an object with this transform (inverse transpose).
+#[must_use]
+pub fn normal_matrix(transform: Mat4) -> Mat3 {
+    Mat3::from_mat4(transform).inverse().transpose()
+}
+
+fn validate_instance(file: &Path, instance: &Instance, mesh_count: usize) -> Result<()> {
+    if instance.mesh >= mesh_count {
+        return Err(SceneError::MissingMesh {
+            file: file.into(),
+            instance: instance.name.clone(),
+            mesh: instance.mesh,
+            count: mesh_count,
+        });
+    }
+    if !instance.transform.is_finite() {
+        return Err(SceneError::InvalidTransform {
+            file: file.into(),
+            instance: instance.name.clone(),
+            problem: "not finite",
+        });
+    }
+    let det = Mat3::from_mat4(instance.transform).determinant();
+    if !(det.abs() > 1e-12 && det.is_finite()) {
+        return Err(SceneError::InvalidTransform {
+            file: file.into(),
+            instance: instance.name.clone(),
+            problem: "singular",
+        });
+    }
+    Ok(())
+}
