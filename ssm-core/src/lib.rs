@@ -1,1 +1,49 @@
-//! wip
+//! The ssm framework: real-time soft-shadow techniques as plug-ins behind one
+//! trait, run on identical scenes, timed per pass, compared on the same pixels.
+//!
+//! - [`GpuContext`]: headless wgpu device with optional features negotiated.
+//! - [`ShadowTechnique`], [`Requirements`], [`TechniqueInfo`] and
+//!   [`register_technique!`]: the plug-in interface; [`Registry`] finds them.
+//! - [`ParamSpec`] / [`ParamValues`]: parameters settable from strings.
+//! - [`Renderer`]: uploads a [`Scene`](ssm_scene::Scene), builds the shared
+//!   inputs on demand ([`GBuffer`], [`LightFrame`]s, adjacency), runs a
+//!   technique into per-light screen-space visibility targets (`R32Float`,
+//!   1 = lit), times every pass ([`FrameTimings`]) and reads results back.
+//! - [`LightDepthMap`]: the light-space depth pass most techniques start from.
+//! - [`image_io`]: EXR and PNG output.
+
+mod composite;
+mod context;
+mod error;
+mod frame;
+mod gbuffer;
+mod gpu_scene;
+pub mod image_io;
+mod light_depth;
+mod light_frame;
+mod params;
+pub mod passes;
+pub mod readback;
+mod registry;
+mod renderer;
+pub mod shader;
+mod technique;
+mod timing;
+
+pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
+pub use error::{Error, Result};
+pub use frame::{Frame, SharedInputs};
+pub use gbuffer::GBuffer;
+pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SceneVertex};
+pub use light_depth::{LightDepthMap, LightDepthMapDesc, NO_SURFACE, ShadowMapSettings};
+pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT};
+pub use params::{ParamError, ParamKind, ParamSpec, ParamValue, ParamValues};
+pub use registry::Registry;
+pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
+pub use technique::{Requirements, ShadowTechnique, TechniqueInfo, TechniqueSetup};
+pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
+
+/// Re-exported so that technique crates can register without depending on it.
+pub use inventory;
+/// Re-exported so that technique crates use the same scene types.
+pub use ssm_scene;

@@ -56,7 +56,7 @@ impl Mesh {
     /// # Errors
     /// The first violated invariant, as a typed [`SceneError`].
     pub fn validate(&self, file: &Path) -> Result<()> {
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(SceneError::PartialTriangle {
                 file: file.into(),
                 mesh: self.name.clone(),

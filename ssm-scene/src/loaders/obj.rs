@@ -10,6 +10,8 @@ use crate::error::Result;
 use crate::mesh::{Mesh, check_indices, generate_normals};
 
 pub(super) fn load(path: &Path, bytes: &[u8]) -> Result<LoadedModel> {
+    // Other fields exist when tobj's `merging`/`reordering` features are on (another crate may enable them).
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

@@ -1,1 +1,151 @@
-//! wip
+//! Baseline: hard shadow mapping (Williams 1978, *Casting curved shadows on
+//! curved surfaces*), with a slope-scaled depth bias.
+//!
+//! One depth map from the light's centre over all geometry, then one
+//! comparison per pixel: visibility is 0 or 1. It is the fast end of every
+//! speed/accuracy plot and the limit every soft technique must reach as the
+//! light shrinks to a point.
+
+use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry};
+use ssm_core::shader::create_shader;
+use ssm_core::{
+    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result,
+    ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
+    register_technique,
+};
+
+/// The registered name.
+pub const NAME: &str = "hard";
+
+/// Parameters of [`HardShadowMapping`].
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "shadow_map_size",
+        kind: ParamKind::Int {
+            default: 2048,
+            min: 16,
+            max: 16384,
+        },
+        doc: "side of the square shadow map, texels",
+    },
+    ParamSpec {
+        name: "constant_bias",
+        kind: ParamKind::Float {
+            default: 1e-3,
+            min: 0.0,
+            max: 0.1,
+        },
+        doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
+    },
+    ParamSpec {
+        name: "slope_bias",
+        kind: ParamKind::Float {
+            default: 1.5,
+            min: 0.0,
+            max: 16.0,
+        },
+        doc: "slope-scaled bias: multiples of the depth change across one texel",
+    },
+];
+
+/// Hard shadow mapping.
+pub struct HardShadowMapping {
+    depth_map: LightDepthMap,
+    lookup_pipeline: wgpu::RenderPipeline,
+    gbuffer_bind_group: wgpu::BindGroup,
+    map_bind_group: wgpu::BindGroup,
+}
+
+impl HardShadowMapping {
+    /// Builds the depth map and the lookup pipeline.
+    ///
+    /// # Errors
+    /// A parameter or GPU error.
+    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
+        let settings = ShadowMapSettings::from_params(setup.params)?;
+        let device = &setup.gpu.device;
+        let gbuffer = setup.shared.gbuffer(NAME)?;
+        let depth_map = settings.depth_map(setup, "hard_shadow_map")?;
+        let map_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hard_map_layout"),
+            entries: &[texture_entry(0)],
+        });
+        let map_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("hard_map_bind_group"),
+            layout: &map_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+            }],
+        });
+        let module = create_shader(
+            setup.gpu,
+            "hard_lookup_shader",
+            include_str!("../../../shaders/hard/hard.wgsl"),
+        )?;
+        let lookup_pipeline = fullscreen_pipeline(
+            device,
+            "hard_lookup_pipeline",
+            &module,
+            "hard_lookup",
+            &[&setup.scene.uniform_layout, &gbuffer.layout, &map_layout],
+            VISIBILITY_FORMAT.into(),
+        );
+        Ok(Self {
+            depth_map,
+            lookup_pipeline,
+            gbuffer_bind_group: gbuffer.bind_group.clone(),
+            map_bind_group,
+        })
+    }
+}
+
+impl ShadowTechnique for HardShadowMapping {
+    fn render(
+        &mut self,
+        frame: &mut Frame<'_>,
+        light: usize,
+        output: &wgpu::TextureView,
+    ) -> Result<()> {
+        self.depth_map.encode(frame, light);
+        let light_frame = &frame.scene.light_bind_groups[light];
+        let mut pass = frame.render_pass("hard_lookup", &[color_attachment(output, None)], None);
+        pass.set_pipeline(&self.lookup_pipeline);
+        pass.set_bind_group(0, light_frame, &[]);
+        pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
+        pass.set_bind_group(2, &self.map_bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}
+
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    let settings = ShadowMapSettings::from_params(params)?;
+    Ok(Requirements {
+        gbuffer: true,
+        max_texture_size: settings.size,
+        ..Requirements::NONE
+    })
+}
+
+fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(HardShadowMapping::new(setup)?))
+}
+
+/// The registration.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: NAME,
+    summary: "hard shadow mapping from the light's centre, slope-scaled bias (baseline)",
+    paper: "Williams 1978, Casting curved shadows on curved surfaces",
+    params: PARAMS,
+    requirements,
+    create,
+};
+
+register_technique!(INFO);
+
+/// Call from a binary so that the linker keeps this crate, and with it the registration.
+#[inline(never)]
+pub fn link() -> &'static str {
+    NAME
+}

@@ -1,1 +1,206 @@
-//! wip
+//! Baseline: percentage-closer soft shadows (Fernando 2005, *Percentage-closer
+//! soft shadows*, SIGGRAPH sketch), with the regular n×n blocker-search and
+//! m×m filter grids used as the PCSS reference by Buades et al. (2015) and
+//! Shen et al. (2011).
+//!
+//! Per pixel: average the depths of the shadow-map texels nearer than the
+//! receiver inside the light's back-projection through the near plane, take
+//! the penumbra width from that average by similar triangles, and filter the
+//! shadow test over it. Cost grows with n² + m² per pixel: the reason
+//! separable and predicted variants exist.
+
+use bytemuck::{Pod, Zeroable};
+use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
+use ssm_core::shader::create_shader;
+use ssm_core::{
+    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result,
+    ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
+    register_technique,
+};
+use wgpu::util::DeviceExt;
+
+/// The registered name.
+pub const NAME: &str = "pcss";
+
+/// Parameters of [`Pcss`].
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "shadow_map_size",
+        kind: ParamKind::Int {
+            default: 1024,
+            min: 16,
+            max: 16384,
+        },
+        doc: "side of the square shadow map, texels",
+    },
+    ParamSpec {
+        name: "blocker_kernel",
+        kind: ParamKind::Int {
+            default: 7,
+            min: 1,
+            max: 64,
+        },
+        doc: "samples per axis of the blocker search (n; n² taps per pixel)",
+    },
+    ParamSpec {
+        name: "pcf_kernel",
+        kind: ParamKind::Int {
+            default: 15,
+            min: 1,
+            max: 128,
+        },
+        doc: "samples per axis of the PCF filter (m; m² taps per pixel)",
+    },
+    ParamSpec {
+        name: "constant_bias",
+        kind: ParamKind::Float {
+            default: 1e-3,
+            min: 0.0,
+            max: 0.1,
+        },
+        doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
+    },
+    ParamSpec {
+        name: "slope_bias",
+        kind: ParamKind::Float {
+            default: 1.5,
+            min: 0.0,
+            max: 16.0,
+        },
+        doc: "slope-scaled bias: multiples of the depth change across one texel",
+    },
+];
+
+/// The kernel sizes, as `shaders/pcss/pcss.wgsl` reads them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct PcssSettingsUniform {
+    blocker_kernel: u32,
+    pcf_kernel: u32,
+    padding: [u32; 2],
+}
+
+/// PCSS.
+pub struct Pcss {
+    depth_map: LightDepthMap,
+    filter_pipeline: wgpu::RenderPipeline,
+    gbuffer_bind_group: wgpu::BindGroup,
+    map_bind_group: wgpu::BindGroup,
+}
+
+impl Pcss {
+    /// Builds the depth map and the filter pipeline.
+    ///
+    /// # Errors
+    /// A parameter or GPU error.
+    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
+        let params = setup.params;
+        let map_settings = ShadowMapSettings::from_params(params)?;
+        let kernel = |name| params.int(name).map(|v| u32::try_from(v).unwrap_or(1));
+        let uniform = PcssSettingsUniform {
+            blocker_kernel: kernel("blocker_kernel")?,
+            pcf_kernel: kernel("pcf_kernel")?,
+            padding: [0; 2],
+        };
+        let device = &setup.gpu.device;
+        let gbuffer = setup.shared.gbuffer(NAME)?;
+        let depth_map = map_settings.depth_map(setup, "pcss_shadow_map")?;
+        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pcss_settings_uniform"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let map_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pcss_map_layout"),
+            entries: &[texture_entry(0), uniform_entry(1)],
+        });
+        let map_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pcss_map_bind_group"),
+            layout: &map_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: settings_buffer.as_entire_binding(),
+                },
+            ],
+        });
+        let module = create_shader(
+            setup.gpu,
+            "pcss_filter_shader",
+            include_str!("../../../shaders/pcss/pcss.wgsl"),
+        )?;
+        let filter_pipeline = fullscreen_pipeline(
+            device,
+            "pcss_filter_pipeline",
+            &module,
+            "pcss_filter",
+            &[&setup.scene.uniform_layout, &gbuffer.layout, &map_layout],
+            VISIBILITY_FORMAT.into(),
+        );
+        Ok(Self {
+            depth_map,
+            filter_pipeline,
+            gbuffer_bind_group: gbuffer.bind_group.clone(),
+            map_bind_group,
+        })
+    }
+}
+
+impl ShadowTechnique for Pcss {
+    fn render(
+        &mut self,
+        frame: &mut Frame<'_>,
+        light: usize,
+        output: &wgpu::TextureView,
+    ) -> Result<()> {
+        self.depth_map.encode(frame, light);
+        let light_frame = &frame.scene.light_bind_groups[light];
+        // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result for the same pixel.
+        let mut pass = frame.render_pass(
+            "pcss_blocker_search_and_filter",
+            &[color_attachment(output, None)],
+            None,
+        );
+        pass.set_pipeline(&self.filter_pipeline);
+        pass.set_bind_group(0, light_frame, &[]);
+        pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
+        pass.set_bind_group(2, &self.map_bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}
+
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    let settings = ShadowMapSettings::from_params(params)?;
+    Ok(Requirements {
+        gbuffer: true,
+        max_texture_size: settings.size,
+        ..Requirements::NONE
+    })
+}
+
+fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(Pcss::new(setup)?))
+}
+
+/// The registration.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: NAME,
+    summary: "percentage-closer soft shadows: n×n blocker search, m×m PCF sized by the penumbra estimate (baseline)",
+    paper: "Fernando 2005, Percentage-closer soft shadows (SIGGRAPH sketch)",
+    params: PARAMS,
+    requirements,
+    create,
+};
+
+register_technique!(INFO);
+
+/// Call from a binary so that the linker keeps this crate, and with it the registration.
+#[inline(never)]
+pub fn link() -> &'static str {
+    NAME
+}

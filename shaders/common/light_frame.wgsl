@@ -1,0 +1,52 @@
+// The shared light frame (ssm-core's LightFrame): a perspective view from the
+// light's centre, x along the rectangle's u axis, texture y along its v axis,
+// looking along its normal, fitted to the scene. Every technique sees the same
+// light geometry through it.
+
+struct LightFrame {
+    // World to clip space of the light's shadow-map frustum (depth in [0, 1]).
+    view_proj: mat4x4<f32>,
+    // World to light view space (right-handed: x = u, y = -v, z = -normal).
+    view: mat4x4<f32>,
+    // xyz: centre of the rectangle; w: intensity.
+    centre: vec4<f32>,
+    // xyz: unit u axis; w: half width along u.
+    u_axis: vec4<f32>,
+    // xyz: unit v axis; w: half height along v.
+    v_axis: vec4<f32>,
+    // xyz: unit normal (emission direction); w: area.
+    normal: vec4<f32>,
+    // x, y: tangents of the frustum's half angles along u and v; z: near; w: far.
+    projection: vec4<f32>,
+};
+
+// Distance of `world` in front of the light's plane (its linear light-space depth).
+fn light_depth(frame: LightFrame, world: vec3<f32>) -> f32 {
+    return dot(world - frame.centre.xyz, frame.normal.xyz);
+}
+
+// Shadow-map texture coordinates (u right, v down, both in [0, 1] inside the
+// frustum) and linear depth of a world point. Meaningless for depth <= 0.
+fn light_uv_depth(frame: LightFrame, world: vec3<f32>) -> vec3<f32> {
+    let offset = world - frame.centre.xyz;
+    let depth = dot(offset, frame.normal.xyz);
+    let x = dot(offset, frame.u_axis.xyz) / (depth * frame.projection.x);
+    let y = dot(offset, frame.v_axis.xyz) / (depth * frame.projection.y);
+    // Texture y grows along v (the frame's view y is -v).
+    return vec3<f32>(0.5 + 0.5 * x, 0.5 + 0.5 * y, depth);
+}
+
+// Half extent of the light rectangle, in shadow-map uv units, as seen through
+// a plane at linear depth `depth` from a point at `receiver_depth`: the
+// back-projection of the light through that plane (similar triangles).
+fn light_half_extent_uv(frame: LightFrame, depth: f32, receiver_depth: f32) -> vec2<f32> {
+    let half_size = vec2<f32>(frame.u_axis.w, frame.v_axis.w);
+    let scale = max(receiver_depth - depth, 0.0) / max(receiver_depth * depth, 1e-12);
+    return 0.5 * half_size * scale / frame.projection.xy;
+}
+
+// True when the point is in front of the light (a one-sided emitter lights
+// nothing behind its plane).
+fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
+    return light_depth(frame, world) > 0.0;
+}

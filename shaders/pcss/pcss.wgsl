@@ -1,0 +1,82 @@
+// Percentage-closer soft shadows (Fernando 2005), with the regular n×n blocker
+// search and m×m filter grids that Buades et al. (2015) and Shen et al. (2011)
+// compare against.
+//
+// 1. Blocker search: the region of the shadow map through which the receiver
+//    can see the light at the nearest possible blocker depth (the frame's near
+//    plane) is sampled on an n×n grid; texels nearer the light than the
+//    receiver are blockers, and their depths are averaged.
+// 2. Penumbra estimate: with parallel planes, the light seen from the
+//    receiver through the blocker plane at d_blocker spans
+//    w_light * (d_receiver - d_blocker) / (d_receiver * d_blocker) in the
+//    map's normalised units (Fernando's w_penumbra scaled to the map).
+// 3. PCF over that extent on an m×m grid.
+
+// #import common/fullscreen.wgsl
+// #import common/light_frame.wgsl
+// #import common/shadow_map.wgsl
+
+struct PcssSettings {
+    // Samples per axis of the blocker search (n).
+    blocker_kernel: u32,
+    // Samples per axis of the filter (m).
+    pcf_kernel: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(0) @binding(0) var<uniform> frame: LightFrame;
+@group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
+@group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
+@group(2) @binding(0) var shadow_map: texture_2d<f32>;
+@group(2) @binding(1) var<uniform> settings: PcssSettings;
+
+// Offset of sample `i` of `count` across [-1, 1], at the centres of equal cells.
+fn grid_offset(i: u32, count: u32) -> f32 {
+    return (f32(i) + 0.5) / f32(count) * 2.0 - 1.0;
+}
+
+@fragment
+fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
+    let position = textureLoad(gbuffer_position, vec2<i32>(in.clip.xy), 0);
+    if (position.w < 0.5) {
+        return 1.0;
+    }
+    if (!in_front_of_light(frame, position.xyz)) {
+        return 0.0;
+    }
+    let uvd = light_uv_depth(frame, position.xyz);
+    let receiver_depth = uvd.z;
+
+    // 1. Blocker search over the light's back-projection through the near plane.
+    let search = light_half_extent_uv(frame, frame.projection.z, receiver_depth);
+    let n = max(settings.blocker_kernel, 1u);
+    var blocker_sum = 0.0;
+    var blocker_count = 0u;
+    for (var j = 0u; j < n; j++) {
+        for (var i = 0u; i < n; i++) {
+            let offset = vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
+            let depth = shadow_map_depth(shadow_map, uvd.xy + offset);
+            if (depth < receiver_depth) {
+                blocker_sum += depth;
+                blocker_count += 1u;
+            }
+        }
+    }
+    if (blocker_count == 0u) {
+        return 1.0;
+    }
+    let blocker_depth = blocker_sum / f32(blocker_count);
+
+    // 2. Penumbra extent, 3. PCF over it.
+    let filter_extent = light_half_extent_uv(frame, blocker_depth, receiver_depth);
+    let m = max(settings.pcf_kernel, 1u);
+    var lit = 0.0;
+    for (var j = 0u; j < m; j++) {
+        for (var i = 0u; i < m; i++) {
+            let offset = vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
+            lit += select(0.0, 1.0, receiver_depth <= shadow_map_depth(shadow_map, uvd.xy + offset));
+        }
+    }
+    return lit / f32(m * m);
+}

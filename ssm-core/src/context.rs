@@ -1,0 +1,159 @@
+//! The GPU context: instance, adapter, device and queue, with the optional
+//! features this adapter offers negotiated once.
+
+use std::sync::{Arc, Mutex};
+
+/// Optional device features ssm asks for when the adapter has them.
+///
+/// Techniques declare the ones they cannot do without in their
+/// [`Requirements`](crate::Requirements); the rest are used when present
+/// (timestamps for per-pass timing, for instance).
+pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::FLOAT32_BLENDABLE
+    .union(wgpu::Features::FLOAT32_FILTERABLE)
+    .union(wgpu::Features::TIMESTAMP_QUERY)
+    .union(wgpu::Features::SHADER_F16)
+    .union(wgpu::Features::CONSERVATIVE_RASTERIZATION)
+    .union(wgpu::Features::DEPTH32FLOAT_STENCIL8)
+    .union(wgpu::Features::DEPTH_CLIP_CONTROL)
+    .union(wgpu::Features::POLYGON_MODE_LINE);
+
+/// Why no GPU context could be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ContextError {
+    /// No adapter at all: neither a GPU nor a software rasteriser.
+    #[error(
+        "no graphics adapter found ({detail}). ssm needs Vulkan: on a machine without a GPU install Mesa's software driver \
+         with `sudo apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), then check with `vulkaninfo --summary`"
+    )]
+    NoAdapter {
+        /// What wgpu said.
+        detail: String,
+    },
+    /// The adapter refused to make a device.
+    #[error("the adapter `{adapter}` could not create a device: {detail}")]
+    NoDevice {
+        /// Adapter name.
+        adapter: String,
+        /// What wgpu said.
+        detail: String,
+    },
+}
+
+/// The instance, adapter, device and queue every pass is recorded with.
+///
+/// wgpu reports validation errors asynchronously; this context captures them
+/// instead of letting wgpu panic, and [`GpuContext::take_errors`] hands them
+/// to the caller, which turns them into typed errors.
+#[derive(Clone, Debug)]
+pub struct GpuContext {
+    /// The wgpu instance.
+    pub instance: wgpu::Instance,
+    /// The adapter in use.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// The adapter's description.
+    pub info: wgpu::AdapterInfo,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// A headless context on the best adapter: a hardware one when present,
+    /// otherwise the software one (lavapipe). `WGPU_BACKEND` and `WGPU_ADAPTER_NAME`
+    /// select another, as in wgpu's own tools.
+    ///
+    /// # Errors
+    /// [`ContextError::NoAdapter`] with the command that installs Mesa's software
+    /// driver; [`ContextError::NoDevice`] if the adapter refuses.
+    pub fn new() -> Result<Self, ContextError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
+            &instance, None,
+        ))
+        .map_err(|e| ContextError::NoAdapter {
+            detail: e.to_string(),
+        })?;
+        let info = adapter.get_info();
+        let features = adapter.features() & OPTIONAL_FEATURES;
+        let descriptor = wgpu::DeviceDescriptor {
+            label: Some("ssm_device"),
+            required_features: features,
+            // Take whatever the adapter allows: shadow maps of 8192² and large storage buffers are normal here.
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&descriptor)).map_err(|e| {
+                ContextError::NoDevice {
+                    adapter: info.name.clone(),
+                    detail: e.to_string(),
+                }
+            })?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&errors);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            if let Ok(mut list) = sink.lock() {
+                list.push(error.to_string());
+            }
+        }));
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            info,
+            errors,
+        })
+    }
+
+    /// The features the device was created with.
+    #[must_use]
+    pub fn features(&self) -> wgpu::Features {
+        self.device.features()
+    }
+
+    /// True when passes can be timed on the GPU.
+    #[must_use]
+    pub fn has_timestamps(&self) -> bool {
+        self.features().contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// One line naming the adapter, its driver and backend, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) [Vulkan Cpu, Mesa 22.3.6]`.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let i = &self.info;
+        format!(
+            "{} [{:?} {:?}, {} {}]",
+            i.name, i.backend, i.device_type, i.driver, i.driver_info
+        )
+    }
+
+    /// Errors wgpu reported since the last call, oldest first.
+    #[must_use]
+    pub fn take_errors(&self) -> Vec<String> {
+        self.errors
+            .lock()
+            .map(|mut list| std::mem::take(&mut *list))
+            .unwrap_or_default()
+    }
+
+    /// Blocks until the GPU has finished everything submitted so far.
+    ///
+    /// # Errors
+    /// The poll error as text (device lost, timeout).
+    pub fn wait_idle(&self) -> Result<(), String> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: None,
+            })
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }
+}

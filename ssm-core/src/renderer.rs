@@ -1,0 +1,305 @@
+//! The frame driver: uploads a scene, builds the shared inputs that the
+//! techniques in use declared, runs a technique per light into the
+//! visibility targets, times it, and reads results back.
+
+use std::time::Instant;
+
+use ssm_scene::{Adjacency, Mesh, Scene};
+
+use crate::composite::Composite;
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::frame::{Frame, SharedInputs};
+use crate::gbuffer::GBuffer;
+use crate::gpu_scene::GpuScene;
+use crate::params::ParamValues;
+use crate::passes::{color_attachment, render_texture};
+use crate::readback::read_texture;
+use crate::technique::{Requirements, ShadowTechnique, TechniqueInfo, create_checked};
+use crate::timing::{FrameTimings, PassTimer, PassTiming};
+
+/// Format of the visibility targets.
+pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// Largest error tolerated when checking that visibility lies in `[0, 1]`
+/// (floating-point accumulation may overshoot by a few ulps).
+pub const VISIBILITY_RANGE_TOLERANCE: f32 = 1e-4;
+
+/// Drives frames of one scene at one size.
+pub struct Renderer {
+    /// The GPU.
+    pub gpu: GpuContext,
+    /// The uploaded scene.
+    pub scene: GpuScene,
+    /// The shared inputs built for the techniques in use.
+    pub shared: SharedInputs,
+    visibility: Vec<(wgpu::Texture, wgpu::TextureView)>,
+    composite: Option<Composite>,
+    timer: PassTimer,
+    /// Times of the shared passes (the G-buffer), measured once when built.
+    pub shared_timings: Vec<PassTiming>,
+}
+
+impl Renderer {
+    /// Uploads `scene` for `width` × `height` images and builds the shared
+    /// inputs `needs` asks for (the union of the techniques' requirements, plus
+    /// the G-buffer when shaded images or positions will be read).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for an invalid scene, [`Error::InvalidSize`], or a GPU error.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        needs: &Requirements,
+    ) -> Result<Self> {
+        scene.validate()?;
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::InvalidSize {
+                width,
+                height,
+                problem: format!("each side must be in [1, {max}] on this adapter"),
+            });
+        }
+        let gpu = gpu.clone();
+        let gpu_scene = GpuScene::new(&gpu, scene, width, height);
+        let mut timer = PassTimer::new(&gpu);
+        let mut shared = SharedInputs::default();
+        let mut shared_timings = Vec::new();
+        if needs.gbuffer {
+            let gbuffer = GBuffer::new(&gpu, &gpu_scene)?;
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("gbuffer_encoder"),
+                });
+            encoder.push_debug_group("gbuffer");
+            gbuffer.encode(&mut encoder, &gpu_scene, &mut timer);
+            encoder.pop_debug_group();
+            timer.resolve(&mut encoder);
+            let start = Instant::now();
+            gpu.queue.submit([encoder.finish()]);
+            gpu.wait_idle().map_err(|e| Error::Gpu {
+                during: "rendering the G-buffer".into(),
+                messages: vec![e],
+            })?;
+            shared_timings = timer
+                .read(&gpu, start.elapsed().as_secs_f64() * 1e3)?
+                .passes;
+            timer.reset();
+            shared.gbuffer = Some(gbuffer);
+        }
+        if needs.adjacency {
+            shared.adjacency = Some(casting_adjacency(scene));
+        }
+        let visibility = (0..gpu_scene.light_count())
+            .map(|light| {
+                let texture = render_texture(
+                    &gpu.device,
+                    &format!("visibility_target_{light}"),
+                    width,
+                    height,
+                    VISIBILITY_FORMAT,
+                    wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
+                );
+                let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+                (texture, view)
+            })
+            .collect();
+        let renderer = Self {
+            gpu,
+            scene: gpu_scene,
+            shared,
+            visibility,
+            composite: None,
+            timer,
+            shared_timings,
+        };
+        renderer.check_gpu_errors("uploading the scene")?;
+        Ok(renderer)
+    }
+
+    fn check_gpu_errors(&self, during: &str) -> Result<()> {
+        let messages = self.gpu.take_errors();
+        if messages.is_empty() {
+            Ok(())
+        } else {
+            Err(Error::Gpu {
+                during: during.into(),
+                messages,
+            })
+        }
+    }
+
+    /// Creates a technique with `params`, after checking its requirements
+    /// against the device and the shared inputs built.
+    ///
+    /// # Errors
+    /// [`Error::MissingFeatures`], [`Error::LimitTooLow`], [`Error::UndeclaredRequirement`],
+    /// or whatever the technique's constructor reports.
+    pub fn create_technique(
+        &self,
+        info: &TechniqueInfo,
+        params: &ParamValues,
+    ) -> Result<Box<dyn ShadowTechnique>> {
+        create_checked(info, &self.gpu, &self.scene, &self.shared, params)
+    }
+
+    /// Renders one frame of `technique` (registered as `name`) for every
+    /// light, waits for the GPU, and returns its timings.
+    ///
+    /// # Errors
+    /// The technique's own errors, or [`Error::Gpu`] if wgpu reported any.
+    pub fn render(
+        &mut self,
+        technique: &mut dyn ShadowTechnique,
+        name: &str,
+    ) -> Result<FrameTimings> {
+        let start = Instant::now();
+        self.timer.reset();
+        let mut frame = Frame {
+            gpu: &self.gpu,
+            scene: &self.scene,
+            shared: &self.shared,
+            encoder: self
+                .gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some(&format!("{name}_frame_encoder")),
+                }),
+            timer: &mut self.timer,
+        };
+        for (light, (_, view)) in self.visibility.iter().enumerate() {
+            // The contract: the target starts fully lit.
+            drop(
+                frame
+                    .encoder
+                    .begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("visibility_clear"),
+                        color_attachments: &[color_attachment(view, Some(wgpu::Color::WHITE))],
+                        ..Default::default()
+                    }),
+            );
+            frame.timer.set_light(light);
+            frame.encoder.push_debug_group(name);
+            let result = technique.render(&mut frame, light, view);
+            frame.encoder.pop_debug_group();
+            result?;
+        }
+        let Frame { mut encoder, .. } = frame;
+        self.timer.resolve(&mut encoder);
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.wait_idle().map_err(|e| Error::Gpu {
+            during: format!("rendering `{name}`"),
+            messages: vec![e],
+        })?;
+        let cpu_wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.check_gpu_errors(&format!("rendering `{name}`"))?;
+        self.timer.read(&self.gpu, cpu_wall_ms)
+    }
+
+    /// Reads light `light`'s visibility, row-major from the top-left, after
+    /// checking that every value is finite and in `[0, 1]`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidOutput`] naming `technique` and the first bad pixel, or a readback error.
+    pub fn read_visibility(&self, light: usize, technique: &str) -> Result<Vec<f32>> {
+        let (texture, _) = self.visibility.get(light).ok_or_else(|| Error::Readback {
+            what: format!("visibility of light {light}"),
+            detail: "no such light".into(),
+        })?;
+        let bytes = read_texture(&self.gpu, texture, 4, "visibility")?;
+        let values: Vec<f32> = bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        let bad = |v: &f32| {
+            !(v.is_finite()
+                && *v >= -VISIBILITY_RANGE_TOLERANCE
+                && *v <= 1.0 + VISIBILITY_RANGE_TOLERANCE)
+        };
+        if let Some(first) = values.iter().position(bad) {
+            let width = self.scene.width as usize;
+            return Err(Error::InvalidOutput {
+                technique: technique.into(),
+                count: values.iter().filter(|v| bad(v)).count(),
+                x: (first % width) as u32,
+                y: (first / width) as u32,
+                value: values[first],
+            });
+        }
+        Ok(values.into_iter().map(|v| v.clamp(0.0, 1.0)).collect())
+    }
+
+    /// The G-buffer's world positions (`w` = coverage), row-major from the top-left.
+    ///
+    /// # Errors
+    /// [`Error::UndeclaredRequirement`] without a G-buffer, or a readback error.
+    pub fn read_positions(&self) -> Result<Vec<[f32; 4]>> {
+        let gbuffer = self.shared.gbuffer("renderer outputs")?;
+        let bytes = read_texture(&self.gpu, &gbuffer.position, 16, "G-buffer positions")?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Shades the current visibility (Lambert × visibility + ambient) and reads
+    /// the sRGB image back as RGBA8.
+    ///
+    /// # Errors
+    /// [`Error::UndeclaredRequirement`] without a G-buffer, or a GPU error.
+    pub fn shade(&mut self) -> Result<Vec<u8>> {
+        let gbuffer = self.shared.gbuffer("composite shading")?;
+        if self.composite.is_none() {
+            let views: Vec<wgpu::TextureView> = self
+                .visibility
+                .iter()
+                .map(|(_, view)| view.clone())
+                .collect();
+            self.composite = Some(Composite::new(&self.gpu, &self.scene, gbuffer, &views)?);
+        }
+        let Some(composite) = &self.composite else {
+            unreachable!("built above")
+        };
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("composite_encoder"),
+            });
+        composite.encode(&mut encoder, &self.scene, gbuffer);
+        self.gpu.queue.submit([encoder.finish()]);
+        let pixels = read_texture(&self.gpu, &composite.target, 4, "shaded image")?;
+        self.check_gpu_errors("composite shading")?;
+        Ok(pixels)
+    }
+
+    /// Output width.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.scene.width
+    }
+
+    /// Output height.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.scene.height
+    }
+}
+
+/// World-space adjacency of every triangle that casts shadows.
+fn casting_adjacency(scene: &Scene) -> Adjacency {
+    let mut positions = Vec::new();
+    for triangle in scene.world_triangles().filter(|t| t.role.casts()) {
+        positions.extend_from_slice(&triangle.corners);
+    }
+    let indices = (0..positions.len() as u32).collect();
+    // Normals are not used by adjacency; welding happens on positions.
+    let mesh = Mesh {
+        name: "casting geometry".into(),
+        normals: vec![glam::Vec3::Y; positions.len()],
+        positions,
+        indices,
+    };
+    Adjacency::of(&mesh)
+}

@@ -1,0 +1,243 @@
+//! The plug-in interface: [`ShadowTechnique`], what a technique needs
+//! ([`Requirements`]), and how it registers ([`TechniqueInfo`],
+//! [`register_technique!`](crate::register_technique)).
+
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::frame::{Frame, SharedInputs};
+use crate::gpu_scene::GpuScene;
+use crate::params::{ParamSpec, ParamValues};
+
+/// What a technique needs from the framework and the device. The framework
+/// builds only the shared inputs some technique in use asks for, and refuses
+/// with a typed error, before any rendering, when the device cannot meet them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Requirements {
+    /// The camera G-buffer (depth, world position, normal).
+    pub gbuffer: bool,
+    /// Occluder/receiver roles: the technique draws [`Geometry::Occluders`](crate::Geometry)
+    /// and [`Geometry::Receivers`](crate::Geometry) separately.
+    pub roles: bool,
+    /// Edge–face adjacency of the casting geometry (silhouettes).
+    pub adjacency: bool,
+    /// Device features it cannot run without.
+    pub features: wgpu::Features,
+    /// Largest 2D texture side it will allocate, in texels.
+    pub max_texture_size: u32,
+}
+
+impl Requirements {
+    /// Nothing at all.
+    pub const NONE: Self = Self {
+        gbuffer: false,
+        roles: false,
+        adjacency: false,
+        features: wgpu::Features::empty(),
+        max_texture_size: 0,
+    };
+
+    /// Everything either asks for.
+    #[must_use]
+    pub fn union(self, other: Self) -> Self {
+        Self {
+            gbuffer: self.gbuffer || other.gbuffer,
+            roles: self.roles || other.roles,
+            adjacency: self.adjacency || other.adjacency,
+            features: self.features | other.features,
+            max_texture_size: self.max_texture_size.max(other.max_texture_size),
+        }
+    }
+
+    /// Checks the device side: features and limits.
+    ///
+    /// # Errors
+    /// [`Error::MissingFeatures`] or [`Error::LimitTooLow`] naming `technique`.
+    pub fn check_device(&self, technique: &str, gpu: &GpuContext) -> Result<()> {
+        let missing = self.features - gpu.features();
+        if !missing.is_empty() {
+            return Err(Error::MissingFeatures {
+                technique: technique.into(),
+                features: missing,
+                adapter: gpu.describe(),
+            });
+        }
+        let allowed = gpu.device.limits().max_texture_dimension_2d;
+        if self.max_texture_size > allowed {
+            return Err(Error::LimitTooLow {
+                technique: technique.into(),
+                what: format!("{0}x{0} textures", self.max_texture_size),
+                allowed: format!("{allowed}x{allowed}"),
+            });
+        }
+        Ok(())
+    }
+
+    /// A short human description, e.g. `G-buffer, roles, FLOAT32_BLENDABLE`.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let mut parts = Vec::new();
+        if self.gbuffer {
+            parts.push("G-buffer".to_owned());
+        }
+        if self.roles {
+            parts.push("occluder/receiver roles".to_owned());
+        }
+        if self.adjacency {
+            parts.push("mesh adjacency".to_owned());
+        }
+        for (name, _) in self.features.iter_names() {
+            parts.push(name.to_owned());
+        }
+        if parts.is_empty() {
+            "nothing".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+}
+
+/// What a technique is given when it is created: the device, the uploaded
+/// scene (geometry, camera, light frames), the shared inputs it declared, and
+/// its parameter values. Pipelines and size-dependent resources are made here,
+/// once, never per frame.
+pub struct TechniqueSetup<'a> {
+    /// The GPU.
+    pub gpu: &'a GpuContext,
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// The shared inputs.
+    pub shared: &'a SharedInputs,
+    /// Parameter values, complete.
+    pub params: &'a ParamValues,
+}
+
+/// A soft-shadow technique.
+///
+/// Contract: `render` records the passes that compute, for every pixel of the
+/// camera's view, the fraction of light `light` visible from the surface
+/// seen there (1 = fully lit, 0 = fully occluded), into `output`, an
+/// `R32Float` texture of the view's size that the framework has cleared to 1.
+/// Values must be finite and in `[0, 1]`. Every pass goes through
+/// [`Frame::render_pass`] or [`Frame::compute_pass`] with a label prefixed by
+/// the technique's name, so it is labelled and timed; the framework wraps the
+/// whole in a debug group named after the technique.
+pub trait ShadowTechnique {
+    /// Records one frame's passes for `light` into `frame`, writing `output`.
+    ///
+    /// # Errors
+    /// Anything the technique cannot do with this scene or frame.
+    fn render(
+        &mut self,
+        frame: &mut Frame<'_>,
+        light: usize,
+        output: &wgpu::TextureView,
+    ) -> Result<()>;
+
+    /// Scalar diagnostics of the last frame, reported beside the error metrics
+    /// (SSSM's reuse share, PVSM's tile count...). Empty by default.
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
+}
+
+/// A technique's registration: name, documentation, parameters, requirements and constructor.
+///
+/// Submit one per technique crate with [`register_technique!`](crate::register_technique).
+pub struct TechniqueInfo {
+    /// Unique name (`hard`, `pcss`...), used on the command line.
+    pub name: &'static str,
+    /// One line: what it is.
+    pub summary: &'static str,
+    /// The paper it implements.
+    pub paper: &'static str,
+    /// Its parameters.
+    pub params: &'static [ParamSpec],
+    /// Its requirements, which may depend on the parameter values.
+    pub requirements: fn(&ParamValues) -> Result<Requirements>,
+    /// Builds the technique (pipelines, textures) for a scene and size.
+    pub create: fn(&TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>>,
+}
+
+impl TechniqueInfo {
+    /// Every parameter at its default.
+    #[must_use]
+    pub fn default_params(&self) -> ParamValues {
+        ParamValues::defaults(self.name, self.params)
+    }
+
+    /// Default parameters with `name=value` assignments applied.
+    ///
+    /// # Errors
+    /// [`Error::Param`] for an unknown name or bad value.
+    pub fn params_from<'s>(
+        &self,
+        assignments: impl IntoIterator<Item = (&'s str, &'s str)>,
+    ) -> Result<ParamValues> {
+        let mut values = self.default_params();
+        for (name, value) in assignments {
+            values.set(name, value)?;
+        }
+        Ok(values)
+    }
+}
+
+impl std::fmt::Debug for TechniqueInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TechniqueInfo")
+            .field("name", &self.name)
+            .field("summary", &self.summary)
+            .finish_non_exhaustive()
+    }
+}
+
+inventory::collect!(TechniqueInfo);
+
+/// Registers a technique: `ssm_core::register_technique!(TechniqueInfo { ... });`.
+///
+/// The crate that does this must be linked into the binary: reference any item
+/// of it (the `ssm` CLI calls each technique crate's `link()` for this reason).
+#[macro_export]
+macro_rules! register_technique {
+    ($info:expr $(,)?) => {
+        $crate::inventory::submit! { $info }
+    };
+}
+
+/// Builds and checks everything a technique declared, then creates it.
+pub(crate) fn create_checked(
+    info: &TechniqueInfo,
+    gpu: &GpuContext,
+    scene: &GpuScene,
+    shared: &SharedInputs,
+    params: &ParamValues,
+) -> Result<Box<dyn ShadowTechnique>> {
+    let requirements = (info.requirements)(params)?;
+    requirements.check_device(info.name, gpu)?;
+    if requirements.gbuffer && shared.gbuffer.is_none() {
+        return Err(Error::UndeclaredRequirement {
+            technique: info.name.into(),
+            input: "G-buffer (the renderer was built without it)",
+        });
+    }
+    if requirements.adjacency && shared.adjacency.is_none() {
+        return Err(Error::UndeclaredRequirement {
+            technique: info.name.into(),
+            input: "mesh adjacency (the renderer was built without it)",
+        });
+    }
+    let technique = (info.create)(&TechniqueSetup {
+        gpu,
+        scene,
+        shared,
+        params,
+    })?;
+    let messages = gpu.take_errors();
+    if messages.is_empty() {
+        Ok(technique)
+    } else {
+        Err(Error::Gpu {
+            during: format!("creating technique `{}`", info.name),
+            messages,
+        })
+    }
+}
