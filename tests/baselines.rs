@@ -1,6 +1,9 @@
 //! The baselines on every built-in scene, on the software adapter, with
 //! numerical assertions on the analytic `parallel-square`.
 
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use glam::Vec3;
 use ssm_integration_tests::{at, gpu, parallel_square_exact, pixel_of, render};
 use ssm_scene::{BUILTIN_SCENES, builtin};

@@ -1,1 +1,72 @@
+//! The plug-in test: a technique defined in a crate ssm-core does not know
+//! (`tests/plugin-technique`) is registered, listed, created and rendered
+//! through the same path as the built-in ones.
 
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::Path;
+
+use ssm_core::Registry;
+use ssm_integration_tests::{gpu, link_techniques, render};
+use ssm_scene::{Manifest, builtin};
+
+#[test]
+fn outside_technique_is_registered_and_listed_in_order() {
+    link_techniques();
+    let registry = Registry::global().unwrap();
+    let names = registry.names();
+    assert!(names.contains(&"front-of-light"), "{names:?}");
+    assert!(
+        names.contains(&"hard") && names.contains(&"pcss"),
+        "{names:?}"
+    );
+    let mut sorted = names.clone();
+    sorted.sort_unstable();
+    assert_eq!(names, sorted, "the listing is sorted by name");
+    assert!(registry.get("front-of-light").unwrap().params.is_empty());
+}
+
+#[test]
+fn outside_technique_renders() {
+    let gpu = gpu();
+    // Light facing down: the whole receiver is in front of it.
+    let scene = builtin("parallel-square").unwrap().build();
+    let rendered = render(&gpu, &scene, "front-of-light", &[], 64, 48).unwrap();
+    assert!(rendered.visibility.iter().all(|v| *v == 1.0));
+
+    // Light facing up from below the ground: every surface is behind it.
+    let text = r#"
+[camera]
+position = [0.0, 5.0, 6.0]
+target = [0.0, 0.0, 0.0]
+
+[[light]]
+centre = [0.0, -1.0, 0.0]
+normal = [0.0, -1.0, 0.0]
+size = [1.0, 1.0]
+
+[[object]]
+primitive = "plane"
+size = [8.0, 8.0]
+role = "receiver"
+"#;
+    let scene = Manifest::parse(text, Path::new("inline.toml"))
+        .unwrap()
+        .build(Path::new("inline.toml"), Path::new("."))
+        .unwrap();
+    let rendered = render(&gpu, &scene, "front-of-light", &[], 64, 48).unwrap();
+    let positions = rendered.renderer.read_positions().unwrap();
+    let covered: Vec<f32> = rendered
+        .visibility
+        .iter()
+        .zip(&positions)
+        .filter(|(_, p)| p[3] > 0.5)
+        .map(|(v, _)| *v)
+        .collect();
+    assert!(covered.len() > 500, "the plane covers the view");
+    assert!(
+        covered.iter().all(|v| *v == 0.0),
+        "everything is behind the light"
+    );
+}

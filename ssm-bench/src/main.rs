@@ -1,1 +1,239 @@
-fn main() {}
+//! `ssm`: render scenes with any registered soft-shadow technique.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use ssm_bench::{
+    median, output_requirements, registry, render_technique, support_on, write_positions,
+};
+use ssm_core::{GpuContext, Renderer, Requirements};
+use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
+
+#[derive(Parser)]
+#[command(
+    name = "ssm",
+    version,
+    about = "Soft-shadow techniques as plug-ins, compared on identical scenes"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the registered techniques with their parameters, requirements and whether this adapter runs them.
+    List,
+    /// List the built-in scenes.
+    Scenes,
+    /// Render a scene with one or more techniques and write images and timings.
+    Render(RenderArgs),
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// A built-in scene name, a scene manifest (.toml) or a model file (.gltf, .glb, .obj, .ply; staged with a ground and a light).
+    #[arg(long)]
+    scene: String,
+    /// Technique names, comma-separated (see `ssm list`).
+    #[arg(long, value_delimiter = ',', required = true)]
+    technique: Vec<String>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Parameter assignment `<technique>.<param>=<value>`; repeatable.
+    #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
+    settings: Vec<String>,
+    /// Frames timed after one warm-up frame; timings.json holds each and the median.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Output directory: <out>/<technique>/{visibility.exr,visibility.png,shaded.png,timings.json} and <out>/position.exr.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Writes a line to stdout, failing (rather than panicking like `println!`) when stdout is closed.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        writeln!(std::io::stdout().lock(), $($arg)*).context("writing to stdout")?
+    };
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::List => list(),
+        Command::Scenes => scenes(),
+        Command::Render(args) => render(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // A reader that stopped reading (`ssm list | head`) is not a failure.
+        Err(error)
+            if error.chain().any(|e| {
+                e.downcast_ref::<std::io::Error>()
+                    .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            }) =>
+        {
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            // One line: the error and its causes.
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn list() -> Result<()> {
+    let registry = registry()?;
+    let gpu = GpuContext::new();
+    match &gpu {
+        Ok(gpu) => say!("adapter: {}\n", gpu.describe()),
+        Err(e) => say!("adapter: none ({e})\n"),
+    }
+    for info in registry.iter() {
+        say!("{}: {}", info.name, info.summary);
+        say!("  paper: {}", info.paper);
+        let requirements = (info.requirements)(&info.default_params())?;
+        say!("  needs: {}", requirements.describe());
+        if let Ok(gpu) = &gpu {
+            say!("  runs here: {}", support_on(gpu, info));
+        }
+        for spec in info.params {
+            say!(
+                "  --set {}.{}={}  ({}; {})",
+                info.name,
+                spec.name,
+                spec.default_value(),
+                spec.range_text(),
+                spec.doc
+            );
+        }
+        say!("");
+    }
+    Ok(())
+}
+
+fn scenes() -> Result<()> {
+    for scene in BUILTIN_SCENES {
+        let built = scene.build();
+        say!(
+            "{:<16} {:>7} triangles  {}",
+            scene.name,
+            built.triangle_count(),
+            scene.summary
+        );
+    }
+    Ok(())
+}
+
+/// Splits `technique.param=value`.
+fn parse_setting(text: &str) -> Result<(&str, &str, &str)> {
+    let (key, value) = text
+        .split_once('=')
+        .with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
+    let (technique, param) = key
+        .split_once('.')
+        .with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
+    Ok((technique.trim(), param.trim(), value.trim()))
+}
+
+fn render(args: &RenderArgs) -> Result<()> {
+    let registry = registry()?;
+    let (scene, source) =
+        Scene::load(&args.scene).with_context(|| format!("loading scene `{}`", args.scene))?;
+    if let SceneSource::StagedModel(manifest) = &source {
+        say!(
+            "# staged scene for {} (save beside the model and edit):\n{}",
+            args.scene,
+            manifest.to_toml()
+        );
+    }
+    say!(
+        "scene: {} ({} triangles, {} instances, {} lights)",
+        args.scene,
+        scene.triangle_count(),
+        scene.instances.len(),
+        scene.lights.len()
+    );
+    let settings: Vec<(&str, &str, &str)> = args
+        .settings
+        .iter()
+        .map(|s| parse_setting(s))
+        .collect::<Result<_>>()?;
+    for (technique, _, _) in &settings {
+        if !args.technique.iter().any(|t| t == technique) {
+            bail!(
+                "--set names technique `{technique}`, which is not among --technique {}",
+                args.technique.join(",")
+            );
+        }
+    }
+    // Resolve every technique and its parameters before touching the GPU: a typo fails fast.
+    let mut runs = Vec::new();
+    let mut needs = output_requirements();
+    for name in &args.technique {
+        let info = registry.get(name)?;
+        let params = info.params_from(
+            settings
+                .iter()
+                .filter(|(t, _, _)| t == name)
+                .map(|(_, p, v)| (*p, *v)),
+        )?;
+        needs = needs.union((info.requirements)(&params)?);
+        runs.push((info, params));
+    }
+    let gpu = GpuContext::new()?;
+    let mut renderer = Renderer::new(
+        &gpu,
+        &scene,
+        args.width,
+        args.height,
+        &Requirements { ..needs },
+    )?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    write_positions(&renderer, &args.out.join("position.exr"))?;
+
+    let progress = ProgressBar::new(runs.len() as u64);
+    progress.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    for (info, params) in &runs {
+        progress.set_message(info.name);
+        let dir = args.out.join(info.name);
+        let run = render_technique(&mut renderer, info, params, args.frames, &dir)
+            .with_context(|| format!("technique `{}`", info.name))?;
+        let gpu_ms: Vec<f64> = run.frames.iter().filter_map(|t| t.gpu_ms).collect();
+        let cpu_ms: Vec<f64> = run.frames.iter().map(|t| t.cpu_wall_ms).collect();
+        let time = match median(&gpu_ms) {
+            Some(ms) => format!("{ms:.3} ms GPU"),
+            None => format!(
+                "{:.3} ms CPU wall (no timestamps)",
+                median(&cpu_ms).unwrap_or(f64::NAN)
+            ),
+        };
+        progress.suspend(|| -> Result<()> {
+            say!(
+                "{:<8} {time}  [{}]  -> {}",
+                info.name,
+                params,
+                dir.display()
+            );
+            Ok(())
+        })?;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    say!("adapter: {}", gpu.describe());
+    Ok(())
+}

@@ -185,7 +185,7 @@ impl Manifest {
     #[must_use]
     pub fn to_toml(&self) -> String {
         // Serialising plain structs of numbers, strings and maps cannot fail.
-        toml::to_string_pretty(self).unwrap_or_default()
+        toml::to_string(self).unwrap_or_default()
     }
 
     /// Builds and validates the scene; model paths are resolved against `base_dir`.
@@ -387,10 +387,12 @@ pub fn framing_camera(bounds: &Aabb, fov_y: f32) -> Camera {
 }
 
 /// Stages a bare model: the model as a `both` object, a receiver plane under
-/// it, a square light above it and a camera framing everything (chosen when
-/// the scene is built). Print it with [`Manifest::to_toml`] to save and edit.
+/// it, a square light above and to one side of it (so that the shadow falls
+/// beside the model, where the camera sees it) and a camera framing the model
+/// and the ground around it. Print it with [`Manifest::to_toml`] to save and edit.
 ///
-/// The model path is written as its file name: save the manifest beside the model.
+/// Assumes +Y is up, as in the Stanford scans and most glTF files. The model
+/// path is written as its file name: save the manifest beside the model.
 ///
 /// # Errors
 /// Any error loading the model.
@@ -408,43 +410,71 @@ pub fn stage_model(model: &Path) -> Result<Manifest> {
             what: "the model has no placed geometry",
         });
     }
-    let size = bounds.size();
-    let extent = size.max_element().max(1e-3);
+    let extent = bounds.size().max_element().max(1e-3);
     let centre = bounds.centre();
+    let light_centre = Vec3::new(
+        centre.x + 0.6 * extent,
+        bounds.max.y + 1.5 * extent,
+        centre.z + 0.4 * extent,
+    );
+    // The light faces the model's centre.
+    let light_normal = (centre - light_centre).normalize();
+    // Frame the model with half its size of ground on every side.
+    let mut view = bounds;
+    view.extend(Vec3::new(
+        bounds.min.x - 0.5 * extent,
+        bounds.min.y,
+        bounds.min.z - 0.5 * extent,
+    ));
+    view.extend(Vec3::new(
+        bounds.max.x + 0.5 * extent,
+        bounds.min.y,
+        bounds.max.z + 0.5 * extent,
+    ));
+    let camera = framing_camera(&view, 45f32.to_radians());
     let file_name = model
         .file_name()
         .map_or_else(|| model.to_path_buf(), PathBuf::from);
+    let object = |model: Option<PathBuf>,
+                  primitive: Option<String>,
+                  size: Vec<f32>,
+                  role: Role,
+                  translate: [f32; 3]| ObjectSpec {
+        model,
+        primitive,
+        size,
+        role,
+        roles: BTreeMap::new(),
+        translate,
+        rotate_degrees: [0.0; 3],
+        scale: Scale::default(),
+    };
     Ok(Manifest {
-        camera: None,
+        camera: Some(CameraSpec {
+            position: camera.position.to_array(),
+            target: camera.target.to_array(),
+            up: [0.0, 1.0, 0.0],
+            fov_y_degrees: 45.0,
+            near: Some(camera.near),
+            far: Some(camera.far),
+        }),
         lights: vec![LightSpec {
-            centre: [centre.x, bounds.max.y + 1.5 * extent, centre.z],
-            normal: [0.0, -1.0, 0.0],
+            centre: light_centre.to_array(),
+            normal: light_normal.to_array(),
             u_axis: Some([1.0, 0.0, 0.0]),
             size: [0.3 * extent; 2],
             intensity: 1.0,
         }],
         objects: vec![
-            ObjectSpec {
-                model: Some(file_name),
-                primitive: None,
-                size: Vec::new(),
-                role: Role::Both,
-                roles: BTreeMap::new(),
-                translate: [0.0; 3],
-                rotate_degrees: [0.0; 3],
-                scale: Scale::default(),
-            },
-            ObjectSpec {
-                model: None,
-                primitive: Some("plane".into()),
-                size: vec![3.0 * extent, 3.0 * extent],
-                role: Role::Receiver,
-                roles: BTreeMap::new(),
-                // Slightly below the model's lowest point, so that a model resting on the ground touches without z-fighting.
-                translate: [centre.x, bounds.min.y - 1e-4 * extent, centre.z],
-                rotate_degrees: [0.0; 3],
-                scale: Scale::default(),
-            },
+            object(Some(file_name), None, Vec::new(), Role::Both, [0.0; 3]),
+            // Slightly below the model's lowest point, so that a model resting on the ground touches it without z-fighting.
+            object(
+                None,
+                Some("plane".into()),
+                vec![3.0 * extent, 3.0 * extent],
+                Role::Receiver,
+                [centre.x, bounds.min.y - 1e-4 * extent, centre.z],
+            ),
         ],
     })
 }

@@ -24,7 +24,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// A mesh from positions and triangles, with area-weighted smooth normals.
+    /// A mesh from positions and triangles, with angle-weighted smooth normals.
     #[must_use]
     pub fn with_generated_normals(
         name: impl Into<String>,
@@ -112,19 +112,28 @@ pub(crate) fn check_indices(
     Ok(())
 }
 
-/// Area-weighted vertex normals; vertices on no (or only degenerate) triangles get +Y.
+/// Angle-weighted vertex normals (Thürmer and Wüthrich 1998): each face adds
+/// its unit normal times its corner angle, so the result does not depend on
+/// how polygons were split into triangles. Vertices on no (or only
+/// degenerate) triangles get +Y.
 ///
 /// Indices must already be in range.
 #[must_use]
 pub fn generate_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
-        // The cross product's length is twice the area: larger triangles weigh more.
-        let face = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
-        if face.is_finite() {
-            for v in [a, b, c] {
-                normals[v] += face;
+        let corners = [t[0] as usize, t[1] as usize, t[2] as usize];
+        let [a, b, c] = corners.map(|i| positions[i]);
+        let Some(face) = (b - a).cross(c - a).try_normalize() else {
+            continue;
+        };
+        for (k, &vertex) in corners.iter().enumerate() {
+            let here = positions[vertex];
+            let next = positions[corners[(k + 1) % 3]] - here;
+            let previous = positions[corners[(k + 2) % 3]] - here;
+            let angle = next.angle_between(previous);
+            if angle.is_finite() {
+                normals[vertex] += face * angle;
             }
         }
     }

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Every check CI runs, in order: dependencies, test models, formatting, lints,
+# then every test of the workspace (GPU tests run on lavapipe when there is no GPU).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+scripts/install-deps.sh
+scripts/fetch-models.sh
+# Mesa's loader looks for a Wayland socket; headless runs have none.
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+
+cargo fmt --all --check
+cargo clippy --workspace --all-targets --locked -- -D warnings
+cargo test --workspace --locked
