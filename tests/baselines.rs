@@ -95,3 +95,43 @@ fn every_builtin_scene_renders_with_both_baselines() {
         }
     }
 }
+
+#[test]
+fn pcss_receiver_plane_test_removes_self_shadowing_at_grazing_light() {
+    // A light 12 units to the side, 0.25 above a bare receiver: nothing occludes it.
+    let gpu = gpu();
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.instances.retain(|i| i.name == "ground");
+    scene.lights[0] = ssm_scene::RectLight::try_facing(
+        Vec3::new(-12.0, 0.25, 0.0),
+        Vec3::new(1.0, -0.02, 0.0),
+        Vec3::Z,
+        glam::Vec2::ONE,
+        1.0,
+    )
+    .unwrap();
+    let lit_share = |settings: &[(&str, &str)]| {
+        let rendered = render(&gpu, &scene, "pcss", settings, WIDTH, HEIGHT).unwrap();
+        let positions = rendered.renderer.read_positions().unwrap();
+        let covered: Vec<f32> = rendered
+            .visibility
+            .iter()
+            .zip(&positions)
+            .filter(|(_, p)| p[3] > 0.5)
+            .map(|(v, _)| *v)
+            .collect();
+        covered.iter().filter(|v| **v > 0.95).count() as f32 / covered.len() as f32
+    };
+    let with_plane = lit_share(&[]);
+    let without_plane = lit_share(&[("receiver_plane", "false")]);
+    assert!(
+        with_plane > 0.99,
+        "with the receiver plane, {:.1}% of the bare receiver reads lit",
+        with_plane * 100.0
+    );
+    assert!(
+        without_plane < 0.9,
+        "without it, the receiver shadows itself: {:.1}% lit",
+        without_plane * 100.0
+    );
+}

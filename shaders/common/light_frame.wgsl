@@ -50,3 +50,21 @@ fn light_half_extent_uv(frame: LightFrame, depth: f32, receiver_depth: f32) -> v
 fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
     return light_depth(frame, world) > 0.0;
 }
+
+// Linear depth, along the ray from the light's centre through shadow-map
+// coordinates `uv`, of the plane through `point` with normal `normal`: the
+// receiver's own tangent plane seen at another texel (an exact, perspective
+// form of the receiver-plane depth bias of Isidoro 2006). Returns
+// `fallback` where the ray misses the plane or runs along it.
+fn receiver_plane_depth(frame: LightFrame, point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, fallback: f32) -> f32 {
+    let ndc = uv * 2.0 - vec2<f32>(1.0);
+    // The ray's direction scaled so that its component along the light's normal is 1: its parameter is the linear depth.
+    let direction = frame.normal.xyz + ndc.x * frame.projection.x * frame.u_axis.xyz + ndc.y * frame.projection.y * frame.v_axis.xyz;
+    let denominator = dot(direction, normal);
+    let numerator = dot(point - frame.centre.xyz, normal);
+    let depth = numerator / denominator;
+    if (abs(denominator) < 1e-6 || depth <= 0.0) {
+        return fallback;
+    }
+    return depth;
+}

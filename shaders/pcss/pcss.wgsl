@@ -11,6 +11,11 @@
 //    w_light * (d_receiver - d_blocker) / (d_receiver * d_blocker) in the
 //    map's normalised units (Fernando's w_penumbra scaled to the map).
 // 3. PCF over that extent on an m×m grid.
+//
+// With `receiver_plane` on, each tap compares against the depth of the
+// receiver's tangent plane along that tap's ray rather than the receiver's
+// own depth, so that a wide kernel on a surface tilted to the light does not
+// find the surface itself (Isidoro 2006). Off, this is Fernando's sketch.
 
 // #import common/fullscreen.wgsl
 // #import common/light_frame.wgsl
@@ -21,8 +26,9 @@ struct PcssSettings {
     blocker_kernel: u32,
     // Samples per axis of the filter (m).
     pcf_kernel: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // 1: compare taps with the receiver's tangent plane; 0: with its depth.
+    receiver_plane: u32,
+    _pad: u32,
 };
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
@@ -31,6 +37,14 @@ struct PcssSettings {
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
 
+// The depth a tap at `uv` is compared with.
+fn tap_receiver_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
+    if (settings.receiver_plane == 0u) {
+        return receiver_depth;
+    }
+    return receiver_plane_depth(frame, position, normal, uv, receiver_depth);
+}
+
 // Offset of sample `i` of `count` across [-1, 1], at the centres of equal cells.
 fn grid_offset(i: u32, count: u32) -> f32 {
     return (f32(i) + 0.5) / f32(count) * 2.0 - 1.0;
@@ -38,13 +52,15 @@ fn grid_offset(i: u32, count: u32) -> f32 {
 
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
-    let position = textureLoad(gbuffer_position, vec2<i32>(in.clip.xy), 0);
+    let texel = vec2<i32>(in.clip.xy);
+    let position = textureLoad(gbuffer_position, texel, 0);
     if (position.w < 0.5) {
         return 1.0;
     }
     if (!in_front_of_light(frame, position.xyz)) {
         return 0.0;
     }
+    let normal = textureLoad(gbuffer_normal, texel, 0).xyz;
     let uvd = light_uv_depth(frame, position.xyz);
     let receiver_depth = uvd.z;
 
@@ -55,9 +71,9 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     var blocker_count = 0u;
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
-            let offset = vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
-            let depth = shadow_map_depth(shadow_map, uvd.xy + offset);
-            if (depth < receiver_depth) {
+            let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
+            let depth = shadow_map_depth(shadow_map, uv);
+            if (depth < tap_receiver_depth(position.xyz, normal, uv, receiver_depth)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
             }
@@ -74,8 +90,8 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     var lit = 0.0;
     for (var j = 0u; j < m; j++) {
         for (var i = 0u; i < m; i++) {
-            let offset = vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
-            lit += select(0.0, 1.0, receiver_depth <= shadow_map_depth(shadow_map, uvd.xy + offset));
+            let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
+            lit += select(0.0, 1.0, tap_receiver_depth(position.xyz, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
         }
     }
     return lit / f32(m * m);

@@ -4,7 +4,9 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::{color_attachment, fullscreen_pipeline, render_texture, texture_entry};
+use crate::passes::{
+    color_attachment, fullscreen_pipeline, labelled_view, render_texture, texture_entry,
+};
 use crate::shader::create_shader;
 
 /// The composite pass and its target.
@@ -41,7 +43,7 @@ impl Composite {
             Self::FORMAT,
             wgpu::TextureUsages::COPY_SRC,
         );
-        let target_view = target.create_view(&wgpu::TextureViewDescriptor::default());
+        let target_view = labelled_view(&target, "composite_target");
         let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite_visibility_layout"),
             entries: &[texture_entry(0)],

@@ -3,7 +3,7 @@
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gpu_scene::{Geometry, GpuScene, SceneVertex};
-use crate::passes::{color_attachment, render_texture, texture_entry};
+use crate::passes::{color_attachment, labelled_view, render_texture, texture_entry};
 use crate::shader::create_shader;
 use crate::timing::PassTimer;
 
@@ -68,9 +68,9 @@ impl GBuffer {
             Self::DEPTH_FORMAT,
             wgpu::TextureUsages::empty(),
         );
-        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        let (position_view, normal_view, depth_view) =
-            (view(&position), view(&normal), view(&depth));
+        let position_view = labelled_view(&position, "gbuffer_position");
+        let normal_view = labelled_view(&normal, "gbuffer_normal");
+        let depth_view = labelled_view(&depth, "gbuffer_depth");
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer_layout"),
             entries: &[texture_entry(0), texture_entry(1)],

@@ -9,7 +9,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::gpu_scene::{Geometry, GpuScene, SceneVertex};
-use crate::passes::{color_attachment, render_texture, uniform_entry};
+use crate::passes::{color_attachment, labelled_view, render_texture, uniform_entry};
 use crate::shader::create_shader;
 
 /// Linear depth written where no surface was drawn (cleared value).
@@ -143,11 +143,10 @@ impl LightDepthMap {
             multiview_mask: None,
             cache: None,
         });
-        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
         Ok(Self {
-            linear_depth_view: view(&linear_depth),
+            linear_depth_view: labelled_view(&linear_depth, &format!("{label}_linear_depth")),
             linear_depth,
-            depth_view: view(&depth),
+            depth_view: labelled_view(&depth, &format!("{label}_depth")),
             pipeline,
             bias_bind_group,
             label: label.to_owned(),

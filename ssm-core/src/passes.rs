@@ -59,6 +59,15 @@ pub fn render_texture(
     })
 }
 
+/// A view of the whole texture, labelled `<texture label>_view`.
+#[must_use]
+pub fn labelled_view(texture: &wgpu::Texture, label: &str) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(&format!("{label}_view")),
+        ..Default::default()
+    })
+}
+
 /// A full-screen pass pipeline: the shared full-screen triangle vertex stage
 /// (`common/fullscreen.wgsl`, imported by `module`) and the fragment entry
 /// point `fragment` writing one `target`.

@@ -13,7 +13,7 @@ use crate::frame::{Frame, SharedInputs};
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
 use crate::params::ParamValues;
-use crate::passes::{color_attachment, render_texture};
+use crate::passes::{color_attachment, labelled_view, render_texture};
 use crate::readback::read_texture;
 use crate::technique::{Requirements, ShadowTechnique, TechniqueInfo, create_checked};
 use crate::timing::{FrameTimings, PassTimer, PassTiming};
@@ -96,15 +96,16 @@ impl Renderer {
         }
         let visibility = (0..gpu_scene.light_count())
             .map(|light| {
+                let label = format!("visibility_target_{light}");
                 let texture = render_texture(
                     &gpu.device,
-                    &format!("visibility_target_{light}"),
+                    &label,
                     width,
                     height,
                     VISIBILITY_FORMAT,
                     wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
                 );
-                let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+                let view = labelled_view(&texture, &label);
                 (texture, view)
             })
             .collect();

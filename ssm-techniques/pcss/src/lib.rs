@@ -52,6 +52,11 @@ pub const PARAMS: &[ParamSpec] = &[
         doc: "samples per axis of the PCF filter (m; m² taps per pixel)",
     },
     ParamSpec {
+        name: "receiver_plane",
+        kind: ParamKind::Bool { default: true },
+        doc: "compare each tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch",
+    },
+    ParamSpec {
         name: "constant_bias",
         kind: ParamKind::Float {
             default: 1e-3,
@@ -77,7 +82,8 @@ pub const PARAMS: &[ParamSpec] = &[
 struct PcssSettingsUniform {
     blocker_kernel: u32,
     pcf_kernel: u32,
-    padding: [u32; 2],
+    receiver_plane: u32,
+    padding: u32,
 }
 
 /// PCSS.
@@ -100,7 +106,8 @@ impl Pcss {
         let uniform = PcssSettingsUniform {
             blocker_kernel: kernel("blocker_kernel")?,
             pcf_kernel: kernel("pcf_kernel")?,
-            padding: [0; 2],
+            receiver_plane: u32::from(params.bool("receiver_plane")?),
+            padding: 0,
         };
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
