@@ -89,3 +89,121 @@ pub fn parallel_square_exact(x: f32, z: f32) -> f32 {
     let overlap = |c: f32| ((1.0 - c).min(0.5) - (-1.0 - c).max(-0.5)).max(0.0);
     1.0 - overlap(x) * overlap(z)
 }
+
+/// Environment variable that (re)writes reference images instead of comparing.
+pub const BLESS_VARIABLE: &str = "SSM_BLESS";
+
+/// Tolerances of an image comparison.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageTolerance {
+    /// Largest mean absolute difference.
+    pub mean: f32,
+    /// A pixel differing by more than this counts as wrong...
+    pub pixel: f32,
+    /// ...and at most this share of pixels may be wrong (edges rasterise slightly differently across drivers).
+    pub wrong_share: f32,
+}
+
+/// The folder of the blessed reference images, `tests/reference/`.
+#[must_use]
+pub fn reference_directory() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference")
+}
+
+/// True when the run was asked to (re)write references (`SSM_BLESS=1`).
+#[must_use]
+pub fn bless_requested() -> bool {
+    std::env::var_os(BLESS_VARIABLE).is_some_and(|v| v == "1")
+}
+
+/// Compares single-channel `values` in [0, 1] (row-major, `width` × `height`) with
+/// the 16-bit PNG reference `<directory>/<name>.png`.
+///
+/// With `bless` the reference is written instead. A missing reference fails.
+/// On failure, `<name>-actual.png` and `<name>-diff.png` (red where the image
+/// is darker than the reference, blue where lighter) are written beside the
+/// reference, and the error says where.
+///
+/// # Errors
+/// A message describing the mismatch.
+pub fn compare_with_reference(
+    directory: &std::path::Path,
+    name: &str,
+    values: &[f32],
+    (width, height): (u32, u32),
+    tolerance: ImageTolerance,
+    bless: bool,
+) -> Result<(), String> {
+    let reference_path = directory.join(format!("{name}.png"));
+    let to_png = |values: &[f32]| {
+        let pixels: Vec<u16> = values
+            .iter()
+            .map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect();
+        image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
+    };
+    let Some(actual) = to_png(values) else {
+        return Err(format!(
+            "{name}: {} values for {width}x{height}",
+            values.len()
+        ));
+    };
+    if bless {
+        std::fs::create_dir_all(directory).map_err(|e| e.to_string())?;
+        return actual
+            .save(&reference_path)
+            .map_err(|e| format!("{}: {e}", reference_path.display()));
+    }
+    let reference = match image::open(&reference_path) {
+        Ok(image) => image.into_luma16(),
+        Err(e) => {
+            return Err(format!(
+                "{}: {e}; render it with {BLESS_VARIABLE}=1 and review it before committing",
+                reference_path.display()
+            ));
+        }
+    };
+    if reference.dimensions() != (width, height) {
+        return Err(format!(
+            "{name}: reference is {:?}, image is {width}x{height}",
+            reference.dimensions()
+        ));
+    }
+    let differences: Vec<f32> = actual
+        .pixels()
+        .zip(reference.pixels())
+        .map(|(a, r)| (f32::from(a.0[0]) - f32::from(r.0[0])) / 65535.0)
+        .collect();
+    let mean = differences.iter().map(|d| d.abs()).sum::<f32>() / differences.len() as f32;
+    let wrong_share = differences
+        .iter()
+        .filter(|d| d.abs() > tolerance.pixel)
+        .count() as f32
+        / differences.len() as f32;
+    if mean <= tolerance.mean && wrong_share <= tolerance.wrong_share {
+        return Ok(());
+    }
+    let actual_path = directory.join(format!("{name}-actual.png"));
+    let diff_path = directory.join(format!("{name}-diff.png"));
+    let _ = actual.save(&actual_path);
+    let diff = image::RgbImage::from_fn(width, height, |x, y| {
+        let d = differences[(y * width + x) as usize];
+        let strength = (d.abs() * 4.0).min(1.0) * 255.0;
+        // Red: darker than the reference (more shadow); blue: lighter.
+        if d < 0.0 {
+            image::Rgb([strength as u8, 0, 0])
+        } else {
+            image::Rgb([0, 0, strength as u8])
+        }
+    });
+    let _ = diff.save(&diff_path);
+    Err(format!(
+        "{name}: mean difference {mean:.5} (allowed {}), {:.3}% of pixels off by more than {} (allowed {:.3}%); wrote {} and {}",
+        tolerance.mean,
+        wrong_share * 100.0,
+        tolerance.pixel,
+        tolerance.wrong_share * 100.0,
+        actual_path.display(),
+        diff_path.display()
+    ))
+}

@@ -2,6 +2,8 @@
 // stored value is the distance along the light's normal of the nearest
 // surface, with bias already added; NO_SURFACE where nothing was drawn.
 
+// #import common/light_frame.wgsl
+
 const NO_SURFACE: f32 = 3.40282347e38;
 
 // Nearest-texel depth at shadow-map coordinates `uv`; NO_SURFACE outside the map.
@@ -11,4 +13,19 @@ fn shadow_map_depth(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     }
     let size = vec2<f32>(textureDimensions(map));
     return textureLoad(map, vec2<i32>(uv * size), 0).x;
+}
+
+// World-space side of one texel of `map` at linear depth `depth` (the larger of its two sides).
+fn shadow_texel_size(frame: LightFrame, map: texture_2d<f32>, depth: f32) -> f32 {
+    let size = vec2<f32>(textureDimensions(map));
+    return 2.0 * depth * max(frame.projection.x / size.x, frame.projection.y / size.y);
+}
+
+// Normal offset (Holbert 2011): the point to look up, moved `texels` texels
+// off the surface along its normal, on the side facing the light. Removes the
+// acne of surfaces at grazing angles to the light, which a depth bias alone
+// cannot, since their depth changes by many units across one texel.
+fn normal_offset_position(frame: LightFrame, map: texture_2d<f32>, position: vec3<f32>, normal: vec3<f32>, texels: f32) -> vec3<f32> {
+    let towards_light = select(-normal, normal, dot(normal, frame.centre.xyz - position) >= 0.0);
+    return position + towards_light * texels * shadow_texel_size(frame, map, light_depth(frame, position));
 }

@@ -10,15 +10,27 @@
 @group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 
+struct HardSettings {
+    // Normal offset of the lookup point, in shadow-map texels.
+    normal_offset: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+};
+@group(2) @binding(1) var<uniform> settings: HardSettings;
+
 @fragment
 fn hard_lookup(in: FullscreenVertex) -> @location(0) f32 {
-    let position = textureLoad(gbuffer_position, vec2<i32>(in.clip.xy), 0);
+    let texel = vec2<i32>(in.clip.xy);
+    let position = textureLoad(gbuffer_position, texel, 0);
     if (position.w < 0.5) {
         return 1.0;
     }
     if (!in_front_of_light(frame, position.xyz)) {
         return 0.0;
     }
-    let uvd = light_uv_depth(frame, position.xyz);
+    let normal = textureLoad(gbuffer_normal, texel, 0).xyz;
+    let lookup = normal_offset_position(frame, shadow_map, position.xyz, normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
 }

@@ -28,7 +28,8 @@ struct PcssSettings {
     pcf_kernel: u32,
     // 1: compare taps with the receiver's tangent plane; 0: with its depth.
     receiver_plane: u32,
-    _pad: u32,
+    // Normal offset of the lookup point, in shadow-map texels.
+    normal_offset: f32,
 };
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
@@ -61,7 +62,8 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         return 0.0;
     }
     let normal = textureLoad(gbuffer_normal, texel, 0).xyz;
-    let uvd = light_uv_depth(frame, position.xyz);
+    let lookup = normal_offset_position(frame, shadow_map, position.xyz, normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
     let receiver_depth = uvd.z;
 
     // 1. Blocker search over the light's back-projection through the near plane.
@@ -73,7 +75,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         for (var i = 0u; i < n; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
             let depth = shadow_map_depth(shadow_map, uv);
-            if (depth < tap_receiver_depth(position.xyz, normal, uv, receiver_depth)) {
+            if (depth < tap_receiver_depth(lookup, normal, uv, receiver_depth)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
             }
@@ -91,7 +93,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     for (var j = 0u; j < m; j++) {
         for (var i = 0u; i < m; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
-            lit += select(0.0, 1.0, tap_receiver_depth(position.xyz, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
+            lit += select(0.0, 1.0, tap_receiver_depth(lookup, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
         }
     }
     return lit / f32(m * m);

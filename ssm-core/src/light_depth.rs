@@ -9,6 +9,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::gpu_scene::{Geometry, GpuScene, SceneVertex};
+use crate::params::{ParamKind, ParamSpec};
 use crate::passes::{color_attachment, labelled_view, render_texture, uniform_entry};
 use crate::shader::create_shader;
 
@@ -185,8 +186,9 @@ impl LightDepthMap {
 }
 
 /// Size and bias of a square light depth map over all geometry, read from the
-/// parameters `shadow_map_size`, `constant_bias` and `slope_bias` that the
-/// shadow-map baselines share.
+/// parameters `shadow_map_size`, `constant_bias`, `slope_bias` and
+/// `normal_offset` that the shadow-map techniques share. Declare the last
+/// three with [`ShadowMapSettings::BIAS_PARAMS`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowMapSettings {
     /// Side of the square map, texels.
@@ -195,10 +197,44 @@ pub struct ShadowMapSettings {
     pub constant_bias: f32,
     /// Slope-scaled bias, multiples of the depth change per texel.
     pub slope_bias: f32,
+    /// Normal offset of the lookup point, shadow-map texels (used by the lookup shader).
+    pub normal_offset: f32,
 }
 
 impl ShadowMapSettings {
-    /// Reads `shadow_map_size`, `constant_bias` and `slope_bias`.
+    /// `constant_bias`, `slope_bias` and `normal_offset`, with their defaults
+    /// and ranges, for a technique's parameter list.
+    pub const BIAS_PARAMS: [ParamSpec; 3] = [
+        ParamSpec {
+            name: "constant_bias",
+            kind: ParamKind::Float {
+                default: 1e-3,
+                min: 0.0,
+                max: 0.1,
+            },
+            doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
+        },
+        ParamSpec {
+            name: "slope_bias",
+            kind: ParamKind::Float {
+                default: 1.5,
+                min: 0.0,
+                max: 16.0,
+            },
+            doc: "slope-scaled bias: multiples of the depth change across one texel",
+        },
+        ParamSpec {
+            name: "normal_offset",
+            kind: ParamKind::Float {
+                default: 1.0,
+                min: 0.0,
+                max: 8.0,
+            },
+            doc: "lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011)",
+        },
+    ];
+
+    /// Reads `shadow_map_size` and the [`ShadowMapSettings::BIAS_PARAMS`].
     ///
     /// # Errors
     /// A parameter error if one is missing or of another type.
@@ -207,6 +243,7 @@ impl ShadowMapSettings {
             size: u32::try_from(params.int("shadow_map_size")?).unwrap_or(u32::MAX),
             constant_bias: params.float("constant_bias")? as f32,
             slope_bias: params.float("slope_bias")? as f32,
+            normal_offset: params.float("normal_offset")? as f32,
         })
     }
 

@@ -6,13 +6,15 @@
 //! speed/accuracy plot and the limit every soft technique must reach as the
 //! light shrinks to a point.
 
-use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry};
+use bytemuck::{Pod, Zeroable};
+use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
     Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result,
     ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
     register_technique,
 };
+use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "hard";
@@ -28,25 +30,18 @@ pub const PARAMS: &[ParamSpec] = &[
         },
         doc: "side of the square shadow map, texels",
     },
-    ParamSpec {
-        name: "constant_bias",
-        kind: ParamKind::Float {
-            default: 1e-3,
-            min: 0.0,
-            max: 0.1,
-        },
-        doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
-    },
-    ParamSpec {
-        name: "slope_bias",
-        kind: ParamKind::Float {
-            default: 1.5,
-            min: 0.0,
-            max: 16.0,
-        },
-        doc: "slope-scaled bias: multiples of the depth change across one texel",
-    },
+    ShadowMapSettings::BIAS_PARAMS[0],
+    ShadowMapSettings::BIAS_PARAMS[1],
+    ShadowMapSettings::BIAS_PARAMS[2],
 ];
+
+/// The lookup settings, as `shaders/hard/hard.wgsl` reads them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct HardSettingsUniform {
+    normal_offset: f32,
+    padding: [f32; 3],
+}
 
 /// Hard shadow mapping.
 pub struct HardShadowMapping {
@@ -66,17 +61,32 @@ impl HardShadowMapping {
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let depth_map = settings.depth_map(setup, "hard_shadow_map")?;
+        let uniform = HardSettingsUniform {
+            normal_offset: settings.normal_offset,
+            padding: [0.0; 3],
+        };
+        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("hard_settings_uniform"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let map_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("hard_map_layout"),
-            entries: &[texture_entry(0)],
+            entries: &[texture_entry(0), uniform_entry(1)],
         });
         let map_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("hard_map_bind_group"),
             layout: &map_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: settings_buffer.as_entire_binding(),
+                },
+            ],
         });
         let module = create_shader(
             setup.gpu,

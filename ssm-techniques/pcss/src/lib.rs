@@ -56,24 +56,9 @@ pub const PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Bool { default: true },
         doc: "compare each tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch",
     },
-    ParamSpec {
-        name: "constant_bias",
-        kind: ParamKind::Float {
-            default: 1e-3,
-            min: 0.0,
-            max: 0.1,
-        },
-        doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
-    },
-    ParamSpec {
-        name: "slope_bias",
-        kind: ParamKind::Float {
-            default: 1.5,
-            min: 0.0,
-            max: 16.0,
-        },
-        doc: "slope-scaled bias: multiples of the depth change across one texel",
-    },
+    ShadowMapSettings::BIAS_PARAMS[0],
+    ShadowMapSettings::BIAS_PARAMS[1],
+    ShadowMapSettings::BIAS_PARAMS[2],
 ];
 
 /// The kernel sizes, as `shaders/pcss/pcss.wgsl` reads them.
@@ -83,7 +68,7 @@ struct PcssSettingsUniform {
     blocker_kernel: u32,
     pcf_kernel: u32,
     receiver_plane: u32,
-    padding: u32,
+    normal_offset: f32,
 }
 
 /// PCSS.
@@ -107,7 +92,7 @@ impl Pcss {
             blocker_kernel: kernel("blocker_kernel")?,
             pcf_kernel: kernel("pcf_kernel")?,
             receiver_plane: u32::from(params.bool("receiver_plane")?),
-            padding: 0,
+            normal_offset: map_settings.normal_offset,
         };
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
