@@ -17,8 +17,7 @@
 // own depth, so that a wide kernel on a surface tilted to the light does not
 // find the surface itself (Isidoro 2006). Off, this is Fernando's sketch.
 
-// #import common/fullscreen.wgsl
-// #import common/light_frame.wgsl
+// #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
 
 struct PcssSettings {
@@ -32,9 +31,6 @@ struct PcssSettings {
     normal_offset: f32,
 };
 
-@group(0) @binding(0) var<uniform> frame: LightFrame;
-@group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
-@group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
 
@@ -53,16 +49,13 @@ fn grid_offset(i: u32, count: u32) -> f32 {
 
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
-    let texel = vec2<i32>(in.clip.xy);
-    let position = textureLoad(gbuffer_position, texel, 0);
-    if (position.w < 0.5) {
-        return 1.0;
+    let point = screen_point(in);
+    let trivial = trivial_visibility(point);
+    if (trivial >= 0.0) {
+        return trivial;
     }
-    if (!in_front_of_light(frame, position.xyz)) {
-        return 0.0;
-    }
-    let normal = textureLoad(gbuffer_normal, texel, 0).xyz;
-    let lookup = normal_offset_position(frame, shadow_map, position.xyz, normal, settings.normal_offset);
+    let normal = point.normal;
+    let lookup = normal_offset_position(frame, shadow_map, point.position, normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let receiver_depth = uvd.z;
 

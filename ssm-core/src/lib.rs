@@ -9,7 +9,8 @@
 //!   inputs on demand ([`GBuffer`], [`LightFrame`]s, adjacency), runs a
 //!   technique into per-light screen-space visibility targets (`R32Float`,
 //!   1 = lit), times every pass ([`FrameTimings`]) and reads results back.
-//! - [`LightDepthMap`]: the light-space depth pass most techniques start from.
+//! - [`LightDepthMap`]: the light-space depth pass most techniques start from;
+//!   [`ScreenPass`]: a full-screen pass over the G-buffer for one light.
 //! - [`image_io`]: EXR and PNG output.
 
 mod composite;
@@ -26,6 +27,7 @@ pub mod passes;
 pub mod readback;
 mod registry;
 mod renderer;
+mod screen_pass;
 pub mod shader;
 mod technique;
 mod timing;
@@ -40,6 +42,7 @@ pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT};
 pub use params::{ParamError, ParamKind, ParamSpec, ParamValue, ParamValues};
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
+pub use screen_pass::ScreenPass;
 pub use technique::{Requirements, ShadowTechnique, TechniqueInfo, TechniqueSetup};
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 

@@ -7,28 +7,24 @@
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 
+/// `(import path, text)` of one file under `shaders/common/`.
+macro_rules! common_shader {
+    ($file:literal) => {
+        (
+            concat!("common/", $file),
+            include_str!(concat!("../../shaders/common/", $file)),
+        )
+    };
+}
+
 /// The shared WGSL files, by the path an import names.
 pub const COMMON_SHADERS: &[(&str, &str)] = &[
-    (
-        "common/fullscreen.wgsl",
-        include_str!("../../shaders/common/fullscreen.wgsl"),
-    ),
-    (
-        "common/camera.wgsl",
-        include_str!("../../shaders/common/camera.wgsl"),
-    ),
-    (
-        "common/scene.wgsl",
-        include_str!("../../shaders/common/scene.wgsl"),
-    ),
-    (
-        "common/light_frame.wgsl",
-        include_str!("../../shaders/common/light_frame.wgsl"),
-    ),
-    (
-        "common/shadow_map.wgsl",
-        include_str!("../../shaders/common/shadow_map.wgsl"),
-    ),
+    common_shader!("fullscreen.wgsl"),
+    common_shader!("camera.wgsl"),
+    common_shader!("scene.wgsl"),
+    common_shader!("light_frame.wgsl"),
+    common_shader!("shadow_map.wgsl"),
+    common_shader!("screen_pass.wgsl"),
 ];
 
 /// The prefix of an import line.

@@ -7,10 +7,10 @@
 //! light shrinks to a point.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
+use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result,
+    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
     ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
     register_technique,
 };
@@ -46,8 +46,7 @@ struct HardSettingsUniform {
 /// Hard shadow mapping.
 pub struct HardShadowMapping {
     depth_map: LightDepthMap,
-    lookup_pipeline: wgpu::RenderPipeline,
-    gbuffer_bind_group: wgpu::BindGroup,
+    lookup: ScreenPass,
     map_bind_group: wgpu::BindGroup,
 }
 
@@ -59,7 +58,6 @@ impl HardShadowMapping {
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = ShadowMapSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let gbuffer = setup.shared.gbuffer(NAME)?;
         let depth_map = settings.depth_map(setup, "hard_shadow_map")?;
         let uniform = HardSettingsUniform {
             normal_offset: settings.normal_offset,
@@ -93,18 +91,17 @@ impl HardShadowMapping {
             "hard_lookup_shader",
             include_str!("../../../shaders/hard/hard.wgsl"),
         )?;
-        let lookup_pipeline = fullscreen_pipeline(
-            device,
-            "hard_lookup_pipeline",
-            &module,
+        let lookup = ScreenPass::new(
+            setup,
+            NAME,
             "hard_lookup",
-            &[&setup.scene.uniform_layout, &gbuffer.layout, &map_layout],
+            (&module, "hard_lookup"),
+            Some(&map_layout),
             VISIBILITY_FORMAT.into(),
-        );
+        )?;
         Ok(Self {
             depth_map,
-            lookup_pipeline,
-            gbuffer_bind_group: gbuffer.bind_group.clone(),
+            lookup,
             map_bind_group,
         })
     }
@@ -118,13 +115,8 @@ impl ShadowTechnique for HardShadowMapping {
         output: &wgpu::TextureView,
     ) -> Result<()> {
         self.depth_map.encode(frame, light);
-        let light_frame = &frame.scene.light_bind_groups[light];
-        let mut pass = frame.render_pass("hard_lookup", &[color_attachment(output, None)], None);
-        pass.set_pipeline(&self.lookup_pipeline);
-        pass.set_bind_group(0, light_frame, &[]);
-        pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
-        pass.set_bind_group(2, &self.map_bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        self.lookup
+            .encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
     }
 }

@@ -10,10 +10,10 @@
 //! separable and predicted variants exist.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{color_attachment, fullscreen_pipeline, texture_entry, uniform_entry};
+use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result,
+    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
     ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
     register_technique,
 };
@@ -74,8 +74,7 @@ struct PcssSettingsUniform {
 /// PCSS.
 pub struct Pcss {
     depth_map: LightDepthMap,
-    filter_pipeline: wgpu::RenderPipeline,
-    gbuffer_bind_group: wgpu::BindGroup,
+    search_and_filter: ScreenPass,
     map_bind_group: wgpu::BindGroup,
 }
 
@@ -95,7 +94,6 @@ impl Pcss {
             normal_offset: map_settings.normal_offset,
         };
         let device = &setup.gpu.device;
-        let gbuffer = setup.shared.gbuffer(NAME)?;
         let depth_map = map_settings.depth_map(setup, "pcss_shadow_map")?;
         let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("pcss_settings_uniform"),
@@ -125,18 +123,18 @@ impl Pcss {
             "pcss_filter_shader",
             include_str!("../../../shaders/pcss/pcss.wgsl"),
         )?;
-        let filter_pipeline = fullscreen_pipeline(
-            device,
-            "pcss_filter_pipeline",
-            &module,
-            "pcss_filter",
-            &[&setup.scene.uniform_layout, &gbuffer.layout, &map_layout],
+        // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
+        let search_and_filter = ScreenPass::new(
+            setup,
+            NAME,
+            "pcss_blocker_search_and_filter",
+            (&module, "pcss_filter"),
+            Some(&map_layout),
             VISIBILITY_FORMAT.into(),
-        );
+        )?;
         Ok(Self {
             depth_map,
-            filter_pipeline,
-            gbuffer_bind_group: gbuffer.bind_group.clone(),
+            search_and_filter,
             map_bind_group,
         })
     }
@@ -150,18 +148,8 @@ impl ShadowTechnique for Pcss {
         output: &wgpu::TextureView,
     ) -> Result<()> {
         self.depth_map.encode(frame, light);
-        let light_frame = &frame.scene.light_bind_groups[light];
-        // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result for the same pixel.
-        let mut pass = frame.render_pass(
-            "pcss_blocker_search_and_filter",
-            &[color_attachment(output, None)],
-            None,
-        );
-        pass.set_pipeline(&self.filter_pipeline);
-        pass.set_bind_group(0, light_frame, &[]);
-        pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
-        pass.set_bind_group(2, &self.map_bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        self.search_and_filter
+            .encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
     }
 }

@@ -1,0 +1,43 @@
+// The binding convention of ssm-core's ScreenPass: a full-screen pass over the
+// G-buffer for one light. Group 0: the light frame; group 1: the G-buffer;
+// group 2: the technique's own resources.
+
+// #import common/fullscreen.wgsl
+// #import common/light_frame.wgsl
+
+@group(0) @binding(0) var<uniform> frame: LightFrame;
+@group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
+@group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
+
+// What the G-buffer holds at one pixel.
+struct ScreenPoint {
+    texel: vec2<i32>,
+    // World position.
+    position: vec3<f32>,
+    // Unit normal, turned towards the camera.
+    normal: vec3<f32>,
+    // Geometry covers the pixel.
+    covered: bool,
+    // The surface has the receiver role.
+    receives: bool,
+};
+
+fn screen_point(in: FullscreenVertex) -> ScreenPoint {
+    let texel = vec2<i32>(in.clip.xy);
+    let position = textureLoad(gbuffer_position, texel, 0);
+    let normal = textureLoad(gbuffer_normal, texel, 0);
+    return ScreenPoint(texel, position.xyz, normal.xyz, position.w > 0.5, normal.w > 0.5);
+}
+
+// The visibility of pixels no technique needs to compute: 1 where nothing
+// covers the pixel, 0 behind the light's plane (the emitter is one-sided);
+// -1 where the technique must compute it.
+fn trivial_visibility(point: ScreenPoint) -> f32 {
+    if (!point.covered) {
+        return 1.0;
+    }
+    if (!in_front_of_light(frame, point.position)) {
+        return 0.0;
+    }
+    return -1.0;
+}
