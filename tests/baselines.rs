@@ -112,14 +112,7 @@ fn pcss_receiver_plane_test_removes_self_shadowing_at_grazing_light() {
     .unwrap();
     let lit_share = |settings: &[(&str, &str)]| {
         let rendered = render(&gpu, &scene, "pcss", settings, WIDTH, HEIGHT).unwrap();
-        let positions = rendered.renderer.read_positions().unwrap();
-        let covered: Vec<f32> = rendered
-            .visibility
-            .iter()
-            .zip(&positions)
-            .filter(|(_, p)| p[3] > 0.5)
-            .map(|(v, _)| *v)
-            .collect();
+        let covered = rendered.covered_visibility();
         covered.iter().filter(|v| **v > 0.95).count() as f32 / covered.len() as f32
     };
     let with_plane = lit_share(&[]);

@@ -180,14 +180,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
 }
 
 fn check(technique: &str, scene_name: &str, expect: Expect, rendered: &Rendered) {
-    let positions = rendered.renderer.read_positions().unwrap();
-    let covered: Vec<f32> = rendered
-        .visibility
-        .iter()
-        .zip(&positions)
-        .filter(|(_, p)| p[3] > 0.5)
-        .map(|(v, _)| *v)
-        .collect();
+    let covered = rendered.covered_visibility();
     assert!(!covered.is_empty(), "{scene_name}: the camera sees nothing");
     let share = |keep: &dyn Fn(f32) -> bool| {
         covered.iter().filter(|v| keep(**v)).count() as f32 / covered.len() as f32

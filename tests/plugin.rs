@@ -56,14 +56,7 @@ role = "receiver"
         .build(Path::new("inline.toml"), Path::new("."))
         .unwrap();
     let rendered = render(&gpu, &scene, "front-of-light", &[], 64, 48).unwrap();
-    let positions = rendered.renderer.read_positions().unwrap();
-    let covered: Vec<f32> = rendered
-        .visibility
-        .iter()
-        .zip(&positions)
-        .filter(|(_, p)| p[3] > 0.5)
-        .map(|(v, _)| *v)
-        .collect();
+    let covered = rendered.covered_visibility();
     assert!(covered.len() > 500, "the plane covers the view");
     assert!(
         covered.iter().all(|v| *v == 0.0),

@@ -60,6 +60,26 @@ pub fn render(
     })
 }
 
+impl Rendered {
+    /// Light 0's visibility at the pixels that geometry covers (background left out).
+    ///
+    /// # Panics
+    /// If the positions cannot be read back.
+    #[must_use]
+    pub fn covered_visibility(&self) -> Vec<f32> {
+        let positions = self
+            .renderer
+            .read_positions()
+            .unwrap_or_else(|e| panic!("{e}"));
+        self.visibility
+            .iter()
+            .zip(&positions)
+            .filter(|(_, p)| p[3] > 0.5)
+            .map(|(v, _)| *v)
+            .collect()
+    }
+}
+
 /// The pixel (column, row) where the camera sees world point `world`.
 #[must_use]
 pub fn pixel_of(scene: &Scene, width: u32, height: u32, world: Vec3) -> (u32, u32) {

@@ -247,6 +247,20 @@ impl ShadowMapSettings {
         })
     }
 
+    /// The requirements of a technique made of this map and screen passes:
+    /// the G-buffer, and textures of `shadow_map_size`.
+    ///
+    /// # Errors
+    /// A parameter error.
+    pub fn screen_space_requirements(params: &crate::ParamValues) -> Result<crate::Requirements> {
+        let settings = Self::from_params(params)?;
+        Ok(crate::Requirements {
+            gbuffer: true,
+            max_texture_size: settings.size,
+            ..crate::Requirements::NONE
+        })
+    }
+
     /// Builds the depth map over all geometry, labelled `label`.
     ///
     /// # Errors

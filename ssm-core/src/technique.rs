@@ -192,14 +192,25 @@ impl std::fmt::Debug for TechniqueInfo {
 
 inventory::collect!(TechniqueInfo);
 
-/// Registers a technique: `ssm_core::register_technique!(TechniqueInfo { ... });`.
+/// Registers a technique and defines `pub fn link() -> &'static str` in the
+/// calling crate: `ssm_core::register_technique!(INFO);`.
 ///
-/// The crate that does this must be linked into the binary: reference any item
-/// of it (the `ssm` CLI calls each technique crate's `link()` for this reason).
+/// The crate must be linked into the binary for the registration to be
+/// present; binaries call its `link()` (the `ssm` tool does so for every
+/// technique crate in `ssm_bench::link_techniques`).
 #[macro_export]
 macro_rules! register_technique {
     ($info:expr $(,)?) => {
         $crate::inventory::submit! { $info }
+
+        /// Call from a binary so that the linker keeps this crate, and with it
+        /// its technique's registration. Returns the technique's name.
+        #[inline(never)]
+        pub fn link() -> &'static str {
+            // Named so that it cannot shadow a constant `$info` refers to.
+            const SSM_REGISTERED_TECHNIQUE_NAME: &str = $info.name;
+            SSM_REGISTERED_TECHNIQUE_NAME
+        }
     };
 }
 

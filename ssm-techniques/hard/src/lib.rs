@@ -10,9 +10,8 @@ use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
-    ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
-    register_technique,
+    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
+    ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -121,15 +120,6 @@ impl ShadowTechnique for HardShadowMapping {
     }
 }
 
-fn requirements(params: &ParamValues) -> Result<Requirements> {
-    let settings = ShadowMapSettings::from_params(params)?;
-    Ok(Requirements {
-        gbuffer: true,
-        max_texture_size: settings.size,
-        ..Requirements::NONE
-    })
-}
-
 fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(HardShadowMapping::new(setup)?))
 }
@@ -140,14 +130,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "hard shadow mapping from the light's centre, slope-scaled bias (baseline)",
     paper: "Williams 1978, Casting curved shadows on curved surfaces",
     params: PARAMS,
-    requirements,
+    requirements: ShadowMapSettings::screen_space_requirements,
     create,
 };
 
 register_technique!(INFO);
-
-/// Call from a binary so that the linker keeps this crate, and with it the registration.
-#[inline(never)]
-pub fn link() -> &'static str {
-    NAME
-}

@@ -13,9 +13,8 @@ use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
-    ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT,
-    register_technique,
+    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
+    ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -154,15 +153,6 @@ impl ShadowTechnique for Pcss {
     }
 }
 
-fn requirements(params: &ParamValues) -> Result<Requirements> {
-    let settings = ShadowMapSettings::from_params(params)?;
-    Ok(Requirements {
-        gbuffer: true,
-        max_texture_size: settings.size,
-        ..Requirements::NONE
-    })
-}
-
 fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(Pcss::new(setup)?))
 }
@@ -173,14 +163,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "percentage-closer soft shadows: n×n blocker search, m×m PCF sized by the penumbra estimate (baseline)",
     paper: "Fernando 2005, Percentage-closer soft shadows (SIGGRAPH sketch)",
     params: PARAMS,
-    requirements,
+    requirements: ShadowMapSettings::screen_space_requirements,
     create,
 };
 
 register_technique!(INFO);
-
-/// Call from a binary so that the linker keeps this crate, and with it the registration.
-#[inline(never)]
-pub fn link() -> &'static str {
-    NAME
-}

@@ -71,9 +71,3 @@ register_technique!(TechniqueInfo {
     }),
     create,
 });
-
-/// Call from a binary so that the linker keeps this crate, and with it the registration.
-#[inline(never)]
-pub fn link() -> &'static str {
-    NAME
-}
