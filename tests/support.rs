@@ -8,6 +8,7 @@ use ssm_scene::Scene;
 
 /// Keeps every technique crate linked into the test binaries, so that their registrations are present.
 pub fn link_techniques() {
+    ssm_core::reference::link();
     ssm_hard::link();
     ssm_pcss::link();
     ssm_plugin_technique::link();

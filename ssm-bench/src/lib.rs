@@ -12,8 +12,12 @@ use ssm_core::{
 /// Keeps every technique crate linked into the binary, so that their
 /// registrations reach the registry. A new technique crate adds one line here
 /// and one dependency in this crate's manifest.
-pub fn link_techniques() -> [&'static str; 2] {
-    [ssm_hard::link(), ssm_pcss::link()]
+pub fn link_techniques() -> [&'static str; 3] {
+    [
+        ssm_core::reference::link(),
+        ssm_hard::link(),
+        ssm_pcss::link(),
+    ]
 }
 
 /// The registry, with every technique crate linked.

@@ -88,7 +88,7 @@ impl Registry {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::technique::Requirements;
+    use crate::technique::{Requirements, TechniqueKind};
 
     fn no_create(_: &crate::TechniqueSetup<'_>) -> Result<Box<dyn crate::ShadowTechnique>> {
         Err(Error::Technique {
@@ -101,6 +101,7 @@ mod tests {
         name: "alpha",
         summary: "first",
         paper: "",
+        kind: TechniqueKind::Realtime,
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,
@@ -109,6 +110,7 @@ mod tests {
         name: "alpha",
         summary: "second",
         paper: "",
+        kind: TechniqueKind::Realtime,
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,
@@ -117,6 +119,7 @@ mod tests {
         name: "beta",
         summary: "b",
         paper: "",
+        kind: TechniqueKind::Realtime,
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,

@@ -31,6 +31,8 @@ pub struct Renderer {
     pub gpu: GpuContext,
     /// The uploaded scene.
     pub scene: GpuScene,
+    /// The scene on the CPU, shared with techniques that need it.
+    pub cpu_scene: std::sync::Arc<Scene>,
     /// The shared inputs built for the techniques in use.
     pub shared: SharedInputs,
     visibility: Vec<(wgpu::Texture, wgpu::TextureView)>,
@@ -112,6 +114,7 @@ impl Renderer {
         let renderer = Self {
             gpu,
             scene: gpu_scene,
+            cpu_scene: std::sync::Arc::new(scene.clone()),
             shared,
             visibility,
             composite: None,
@@ -145,7 +148,13 @@ impl Renderer {
         info: &TechniqueInfo,
         params: &ParamValues,
     ) -> Result<Box<dyn ShadowTechnique>> {
-        create_checked(info, &self.gpu, &self.scene, &self.shared, params)
+        create_checked(
+            info,
+            &self.gpu,
+            (&self.scene, &self.cpu_scene),
+            &self.shared,
+            params,
+        )
     }
 
     /// Renders one frame of `technique` (registered as `name`) for every
@@ -241,6 +250,16 @@ impl Renderer {
     pub fn read_positions(&self) -> Result<Vec<[f32; 4]>> {
         let gbuffer = self.shared.gbuffer("renderer outputs")?;
         let bytes = read_texture(&self.gpu, &gbuffer.position, 16, "G-buffer positions")?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// The G-buffer's normals (`w` = receiver flag), row-major from the top-left.
+    ///
+    /// # Errors
+    /// [`Error::UndeclaredRequirement`] without a G-buffer, or a readback error.
+    pub fn read_normals(&self) -> Result<Vec<[f32; 4]>> {
+        let gbuffer = self.shared.gbuffer("renderer outputs")?;
+        let bytes = read_texture(&self.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 

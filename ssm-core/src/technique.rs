@@ -103,8 +103,10 @@ impl Requirements {
 pub struct TechniqueSetup<'a> {
     /// The GPU.
     pub gpu: &'a GpuContext,
-    /// The scene.
+    /// The scene on the GPU.
     pub scene: &'a GpuScene,
+    /// The scene on the CPU, for work a paper puts on the CPU (and the ground truth).
+    pub cpu_scene: &'a ssm_scene::Scene,
     /// The shared inputs.
     pub shared: &'a SharedInputs,
     /// Parameter values, complete.
@@ -140,6 +142,15 @@ pub trait ShadowTechnique {
     }
 }
 
+/// What a registered technique is for the tools that compare them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TechniqueKind {
+    /// A real-time technique (or baseline): timed, compared and benchmarked.
+    Realtime,
+    /// The ground truth the others are measured against (`reference`).
+    GroundTruth,
+}
+
 /// A technique's registration: name, documentation, parameters, requirements and constructor.
 ///
 /// Submit one per technique crate with [`register_technique!`](crate::register_technique).
@@ -150,6 +161,8 @@ pub struct TechniqueInfo {
     pub summary: &'static str,
     /// The paper it implements.
     pub paper: &'static str,
+    /// Real-time technique or ground truth.
+    pub kind: TechniqueKind,
     /// Its parameters.
     pub params: &'static [ParamSpec],
     /// Its requirements, which may depend on the parameter values.
@@ -218,7 +231,7 @@ macro_rules! register_technique {
 pub(crate) fn create_checked(
     info: &TechniqueInfo,
     gpu: &GpuContext,
-    scene: &GpuScene,
+    (scene, cpu_scene): (&GpuScene, &ssm_scene::Scene),
     shared: &SharedInputs,
     params: &ParamValues,
 ) -> Result<Box<dyn ShadowTechnique>> {
@@ -239,6 +252,7 @@ pub(crate) fn create_checked(
     let technique = (info.create)(&TechniqueSetup {
         gpu,
         scene,
+        cpu_scene,
         shared,
         params,
     })?;

@@ -11,7 +11,8 @@ use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
     Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
-    ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT,
+    register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -129,6 +130,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "hard shadow mapping from the light's centre, slope-scaled bias (baseline)",
     paper: "Williams 1978, Casting curved shadows on curved surfaces",
+    kind: TechniqueKind::Realtime,
     params: PARAMS,
     requirements: ShadowMapSettings::screen_space_requirements,
     create,

@@ -14,7 +14,8 @@ use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
     Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
-    ShadowTechnique, TechniqueInfo, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT,
+    register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -162,6 +163,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "percentage-closer soft shadows: n×n blocker search, m×m PCF sized by the penumbra estimate (baseline)",
     paper: "Fernando 2005, Percentage-closer soft shadows (SIGGRAPH sketch)",
+    kind: TechniqueKind::Realtime,
     params: PARAMS,
     requirements: ShadowMapSettings::screen_space_requirements,
     create,

@@ -8,7 +8,7 @@
 use ssm_core::shader::create_shader;
 use ssm_core::{
     Frame, ParamSpec, Requirements, Result, ScreenPass, ShadowTechnique, TechniqueInfo,
-    TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 
 /// The registered name.
@@ -64,6 +64,7 @@ register_technique!(TechniqueInfo {
     name: NAME,
     summary: "test plug-in: lit in front of the light's plane, unlit behind; no occlusion",
     paper: "none (plug-in test)",
+    kind: TechniqueKind::Realtime,
     params: PARAMS,
     requirements: |_| Ok(Requirements {
         gbuffer: true,

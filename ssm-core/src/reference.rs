@@ -1,0 +1,678 @@
+//! The ground truth: for each pixel, the fraction of the rectangular light
+//! visible from the surface point seen there, by casting N×N stratified,
+//! jittered rays to the light against every triangle of the scene (roles do
+//! not matter: everything blocks light), on the CPU, with a CWBVH (`obvhs`)
+//! and all cores (`rayon`).
+//!
+//! Deterministic: each pixel's jitter comes from a fixed seed and the pixel's
+//! index, so the result does not depend on thread scheduling, and it is cached
+//! on disk under a hash of everything that changes it.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::ray::Ray;
+use obvhs::triangle::Triangle;
+use rayon::prelude::*;
+use ssm_scene::{RectLight, Scene};
+
+/// Version of the reference algorithm, part of every cache key: bump it when
+/// the results of the same inputs change.
+pub const REFERENCE_VERSION: u32 = 1;
+
+/// The scene's triangles in a BVH, ready for shadow rays.
+pub struct GroundTruth {
+    triangles: Vec<Triangle>,
+    bvh: CwBvh,
+    /// Offset of ray origins off the surface, world units (scaled to the scene).
+    surface_offset: f32,
+    /// Hash of the triangles, for cache keys.
+    geometry_hash: u64,
+}
+
+/// One pixel's surface point as the G-buffer records it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// World position.
+    pub position: Vec3,
+    /// Unit normal (either side; rays leave on the side facing each light sample).
+    pub normal: Vec3,
+}
+
+/// The result of tracing one image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceImage {
+    /// Visibility per pixel, row-major; 1 for pixels without a surface point.
+    pub visibility: Vec<f32>,
+    /// Shadow rays cast (0 when read from the cache).
+    pub rays: u64,
+    /// Wall time spent tracing.
+    pub elapsed: Duration,
+    /// True when the image came from the cache.
+    pub cached: bool,
+}
+
+impl ReferenceImage {
+    /// Shadow rays per second of wall time, when rays were traced.
+    #[must_use]
+    pub fn rays_per_second(&self) -> Option<f64> {
+        (self.rays > 0 && !self.elapsed.is_zero())
+            .then(|| self.rays as f64 / self.elapsed.as_secs_f64())
+    }
+}
+
+impl GroundTruth {
+    /// Builds the BVH over every triangle of `scene` (degenerate ones skipped).
+    #[must_use]
+    pub fn new(scene: &Scene) -> Self {
+        let mut hasher = Fnv64::new();
+        let triangles: Vec<Triangle> = scene
+            .world_triangles()
+            .filter(|t| {
+                (t.corners[1] - t.corners[0])
+                    .cross(t.corners[2] - t.corners[0])
+                    .length_squared()
+                    > 0.0
+            })
+            .map(|t| {
+                for corner in t.corners {
+                    hasher.write_f32s(&corner.to_array());
+                }
+                Triangle {
+                    v0: Vec3A::from(t.corners[0]),
+                    v1: Vec3A::from(t.corners[1]),
+                    v2: Vec3A::from(t.corners[2]),
+                }
+            })
+            .collect();
+        let bvh = build_cwbvh_from_tris(
+            &triangles,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let extent = scene.bounds().size().length().max(1e-6);
+        Self {
+            triangles,
+            bvh,
+            surface_offset: extent * 1e-5,
+            geometry_hash: hasher.finish(),
+        }
+    }
+
+    /// True when the segment from `origin` to `target` crosses no triangle.
+    fn unoccluded(&self, origin: Vec3, target: Vec3) -> bool {
+        let offset = target - origin;
+        let distance = offset.length();
+        if distance <= 0.0 {
+            return true;
+        }
+        // Stop just short of the light, so that geometry lying in the light's plane does not count twice.
+        let ray = Ray::new(
+            Vec3A::from(origin),
+            Vec3A::from(offset / distance),
+            0.0,
+            distance * (1.0 - 1e-6),
+        );
+        self.bvh.ray_traverse_miss(ray, |ray, id| {
+            self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray)
+        })
+    }
+
+    /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
+    /// samples jittered by `rng`. Points behind the light's plane see none of it.
+    #[must_use]
+    pub fn visibility(
+        &self,
+        light: &RectLight,
+        point: &SurfacePoint,
+        samples_per_axis: u32,
+        rng: &mut SplitMix64,
+    ) -> f32 {
+        if (point.position - light.centre).dot(light.normal()) <= 0.0 {
+            return 0.0;
+        }
+        let n = samples_per_axis.max(1);
+        let mut visible = 0u32;
+        for j in 0..n {
+            for i in 0..n {
+                let jitter = Vec2::new(rng.next_f32(), rng.next_f32());
+                let stratum = (Vec2::new(i as f32, j as f32) + jitter) / n as f32 * 2.0 - Vec2::ONE;
+                let sample = light.point(stratum.x, stratum.y);
+                // Leave the surface on the side facing this sample, so that it does not shadow itself.
+                let side = if point.normal.dot(sample - point.position) >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let origin = point.position + point.normal * (side * self.surface_offset);
+                if self.unoccluded(origin, sample) {
+                    visible += 1;
+                }
+            }
+        }
+        visible as f32 / (n * n) as f32
+    }
+
+    /// Traces every pixel (`None`: no surface, visibility 1) on all cores.
+    #[must_use]
+    pub fn trace(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+    ) -> ReferenceImage {
+        let start = Instant::now();
+        let visibility: Vec<f32> = points
+            .par_iter()
+            .enumerate()
+            .map(|(index, point)| match point {
+                Some(point) => self.visibility(
+                    light,
+                    point,
+                    samples_per_axis,
+                    &mut SplitMix64::for_pixel(seed, index as u64),
+                ),
+                None => 1.0,
+            })
+            .collect();
+        let traced = points.iter().filter(|p| p.is_some()).count() as u64;
+        let rays = traced * u64::from(samples_per_axis.max(1)).pow(2);
+        ReferenceImage {
+            visibility,
+            rays,
+            elapsed: start.elapsed(),
+            cached: false,
+        }
+    }
+
+    /// As [`GroundTruth::trace`], through a cache in `cache_dir` keyed by a hash
+    /// of the geometry, the light, the points, the sample count, the seed and
+    /// [`REFERENCE_VERSION`]. A cache that cannot be read or written is ignored.
+    #[must_use]
+    pub fn trace_cached(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+        cache_dir: &Path,
+    ) -> ReferenceImage {
+        let file = cache_dir.join(format!(
+            "{:016x}.f32",
+            self.cache_key(light, points, samples_per_axis, seed)
+        ));
+        if let Ok(bytes) = std::fs::read(&file)
+            && bytes.len() == points.len() * 4
+        {
+            let visibility = bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            return ReferenceImage {
+                visibility,
+                rays: 0,
+                elapsed: Duration::ZERO,
+                cached: true,
+            };
+        }
+        let image = self.trace(light, points, samples_per_axis, seed);
+        let bytes: Vec<u8> = image
+            .visibility
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        // Write then rename, so that a concurrent reader never sees half a file.
+        let partial = file.with_extension(format!("partial{}", std::process::id()));
+        if std::fs::create_dir_all(cache_dir).is_ok() && std::fs::write(&partial, bytes).is_ok() {
+            let _ = std::fs::rename(&partial, &file);
+        }
+        image
+    }
+
+    fn cache_key(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+    ) -> u64 {
+        let mut hasher = Fnv64::new();
+        hasher.write(&REFERENCE_VERSION.to_le_bytes());
+        hasher.write(&self.geometry_hash.to_le_bytes());
+        hasher.write_f32s(&[
+            light.centre.x,
+            light.centre.y,
+            light.centre.z,
+            light.u_axis.x,
+            light.u_axis.y,
+            light.u_axis.z,
+        ]);
+        hasher.write_f32s(&[
+            light.v_axis.x,
+            light.v_axis.y,
+            light.v_axis.z,
+            light.half_size.x,
+            light.half_size.y,
+        ]);
+        hasher.write(&samples_per_axis.to_le_bytes());
+        hasher.write(&seed.to_le_bytes());
+        hasher.write(&(points.len() as u64).to_le_bytes());
+        for point in points {
+            match point {
+                Some(p) => hasher.write_f32s(&[
+                    p.position.x,
+                    p.position.y,
+                    p.position.z,
+                    p.normal.x,
+                    p.normal.y,
+                    p.normal.z,
+                ]),
+                None => hasher.write(&[0xff]),
+            }
+        }
+        hasher.finish()
+    }
+
+    /// Number of triangles in the BVH.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+}
+
+/// The default cache folder: `$SSM_CACHE_DIR/reference`, else
+/// `$XDG_CACHE_HOME/ssm/reference`, else `~/.cache/ssm/reference`, else
+/// `ssm-cache/reference` under the working folder.
+#[must_use]
+pub fn default_cache_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("SSM_CACHE_DIR") {
+        return PathBuf::from(dir).join("reference");
+    }
+    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
+        return PathBuf::from(dir).join("ssm/reference");
+    }
+    if let Some(home) = std::env::var_os("HOME") {
+        return PathBuf::from(home).join(".cache/ssm/reference");
+    }
+    PathBuf::from("ssm-cache/reference")
+}
+
+/// Exact visibility of a rectangular light from `point` past one rectangular
+/// occluder parallel to the light and aligned with its axes: the occluder
+/// seen from the point projects onto the light's plane as a rectangle, and
+/// the hidden fraction is the product of the two clamped 1-D overlaps with
+/// the light (Atty et al., Sec. 4.2). `occluder_centre` is a point of the
+/// occluder; `occluder_half_size` its half extents along the light's u and v.
+/// Used to test the ray caster on `parallel-square`.
+#[must_use]
+pub fn parallel_rectangle_visibility(
+    light: &RectLight,
+    occluder_centre: Vec3,
+    occluder_half_size: Vec2,
+    point: Vec3,
+) -> f32 {
+    let normal = light.normal();
+    let local = |p: Vec3| {
+        let offset = p - light.centre;
+        (
+            Vec2::new(offset.dot(light.u_axis), offset.dot(light.v_axis)),
+            offset.dot(normal),
+        )
+    };
+    let (point_uv, point_depth) = local(point);
+    let (occluder_uv, occluder_depth) = local(occluder_centre);
+    if point_depth <= 0.0 {
+        return 0.0;
+    }
+    if !(occluder_depth > 0.0 && occluder_depth < point_depth) {
+        return 1.0;
+    }
+    // From the point, the occluder's plane maps onto the light's plane by this factor.
+    let scale = point_depth / (point_depth - occluder_depth);
+    if light.is_point() {
+        // One ray, to the centre: where does it cross the occluder's plane?
+        let crossing = point_uv - point_uv / scale;
+        return if (crossing - occluder_uv)
+            .abs()
+            .cmple(occluder_half_size)
+            .all()
+        {
+            0.0
+        } else {
+            1.0
+        };
+    }
+    let low = point_uv + (occluder_uv - occluder_half_size - point_uv) * scale;
+    let high = point_uv + (occluder_uv + occluder_half_size - point_uv) * scale;
+    let overlap = (high.min(light.half_size) - low.max(-light.half_size)).max(Vec2::ZERO);
+    1.0 - overlap.x * overlap.y / light.area()
+}
+
+/// SplitMix64 (Steele et al. 2014): a tiny, well-distributed generator; one
+/// per pixel, seeded from the run's seed and the pixel's index.
+#[derive(Clone, Debug)]
+pub struct SplitMix64 {
+    state: u64,
+}
+
+impl SplitMix64 {
+    /// A generator for pixel `index` of a run seeded with `seed`.
+    #[must_use]
+    pub fn for_pixel(seed: u64, index: u64) -> Self {
+        let mut mixer = Self {
+            state: seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15),
+        };
+        // Decorrelate neighbouring pixels before use.
+        mixer.next_u64();
+        mixer
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// A float uniform in `[0, 1)`.
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// FNV-1a, 64-bit: a stable hash (the same on every machine and Rust version) for cache keys.
+struct Fnv64(u64);
+
+impl Fnv64 {
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for byte in bytes {
+            self.0 ^= u64::from(*byte);
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn write_f32s(&mut self, values: &[f32]) {
+        for value in values {
+            self.write(&value.to_le_bytes());
+        }
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use ssm_scene::builtin;
+
+    use super::*;
+
+    #[test]
+    fn analytic_formula_matches_the_hand_computed_parallel_square() {
+        let scene = builtin("parallel-square").unwrap().build();
+        let light = &scene.lights[0];
+        let exact = |x: f32, z: f32| {
+            parallel_rectangle_visibility(
+                light,
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec2::splat(0.5),
+                Vec3::new(x, 0.0, z),
+            )
+        };
+        assert_eq!(exact(0.0, 0.0), 0.0);
+        assert_eq!(exact(2.0, 0.0), 1.0);
+        // Half-way through the penumbra along x, half the light is hidden.
+        assert!((exact(1.0, 0.0) - 0.5).abs() < 1e-6);
+        // At (1, 1) a quarter of the light is hidden.
+        assert!((exact(1.0, 1.0) - 0.75).abs() < 1e-6);
+    }
+
+    #[test]
+    fn generator_is_uniform_enough_and_repeatable() {
+        let mut a = SplitMix64::for_pixel(7, 3);
+        let mut b = SplitMix64::for_pixel(7, 3);
+        let samples: Vec<f32> = (0..10_000).map(|_| a.next_f32()).collect();
+        assert!(samples.iter().all(|s| (0.0..1.0).contains(s)));
+        let mean = samples.iter().sum::<f32>() / samples.len() as f32;
+        assert!((mean - 0.5).abs() < 0.01, "{mean}");
+        assert_eq!(samples[0], b.next_f32());
+        assert_ne!(
+            SplitMix64::for_pixel(7, 4).next_u64(),
+            SplitMix64::for_pixel(7, 3).next_u64()
+        );
+    }
+}
+
+/// The registered name of the ground truth.
+pub const NAME: &str = "reference";
+
+/// Parameters of the `reference` technique.
+pub const PARAMS: &[crate::ParamSpec] = &[
+    crate::ParamSpec {
+        name: "samples",
+        kind: crate::ParamKind::Int {
+            default: 16,
+            min: 1,
+            max: 256,
+        },
+        doc: "light samples per axis (N): N×N stratified, jittered shadow rays per pixel",
+    },
+    crate::ParamSpec {
+        name: "seed",
+        kind: crate::ParamKind::Int {
+            default: 1,
+            min: 0,
+            max: i64::MAX,
+        },
+        doc: "seed of the jitter",
+    },
+    crate::ParamSpec {
+        name: "cache",
+        kind: crate::ParamKind::Bool { default: true },
+        doc: "read and write the on-disk cache (SSM_CACHE_DIR, else ~/.cache/ssm)",
+    },
+];
+
+/// The ground truth as a technique: traces on the CPU, uploads, copies into the target.
+struct ReferenceTechnique {
+    truth: GroundTruth,
+    samples_per_axis: u32,
+    seed: u64,
+    cache_dir: Option<PathBuf>,
+    /// The G-buffer's points, read once: the scene and camera are static.
+    points: Option<Vec<Option<SurfacePoint>>>,
+    traced: wgpu::Texture,
+    traced_group: wgpu::BindGroup,
+    upload: crate::ScreenPass,
+    /// Each light's traced image, kept: the scene and camera are static, so later frames only upload it.
+    traced_per_light: Vec<Option<ReferenceImage>>,
+}
+
+impl ReferenceTechnique {
+    fn points(&mut self, frame: &crate::Frame<'_>) -> crate::Result<&[Option<SurfacePoint>]> {
+        if self.points.is_none() {
+            let gbuffer = frame.shared.gbuffer(NAME)?;
+            let positions = crate::readback::read_texture(
+                frame.gpu,
+                &gbuffer.position,
+                16,
+                "G-buffer positions",
+            )?;
+            let normals =
+                crate::readback::read_texture(frame.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
+            let positions: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&positions);
+            let normals: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&normals);
+            self.points = Some(
+                positions
+                    .iter()
+                    .zip(&normals)
+                    .map(|(p, n)| {
+                        (p[3] > 0.5).then(|| SurfacePoint {
+                            position: Vec3::new(p[0], p[1], p[2]),
+                            normal: Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y),
+                        })
+                    })
+                    .collect(),
+            );
+        }
+        Ok(self.points.as_deref().unwrap_or_default())
+    }
+}
+
+impl crate::ShadowTechnique for ReferenceTechnique {
+    fn render(
+        &mut self,
+        frame: &mut crate::Frame<'_>,
+        light: usize,
+        output: &wgpu::TextureView,
+    ) -> crate::Result<()> {
+        let rect = frame
+            .scene
+            .light_frames
+            .get(light)
+            .map(|f| f.light)
+            .ok_or_else(|| crate::Error::Technique {
+                technique: NAME.into(),
+                message: format!("no light {light}"),
+            })?;
+        if self.traced_per_light.len() <= light {
+            self.traced_per_light.resize(light + 1, None);
+        }
+        if self.traced_per_light[light].is_none() {
+            let (samples, seed) = (self.samples_per_axis, self.seed);
+            let cache_dir = self.cache_dir.clone();
+            let points = self.points(frame)?.to_vec();
+            let image = match &cache_dir {
+                Some(dir) => self.truth.trace_cached(&rect, &points, samples, seed, dir),
+                None => self.truth.trace(&rect, &points, samples, seed),
+            };
+            self.traced_per_light[light] = Some(image);
+        }
+        let Some(image) = &self.traced_per_light[light] else {
+            unreachable!("traced above")
+        };
+        let (width, height) = (self.traced.width(), self.traced.height());
+        frame.gpu.queue.write_texture(
+            self.traced.as_image_copy(),
+            bytemuck::cast_slice(&image.visibility),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width * 4),
+                rows_per_image: Some(height),
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        self.upload
+            .encode(frame, light, output, Some(&self.traced_group), None);
+        Ok(())
+    }
+
+    /// Totals over the lights traced so far: rays, trace time, rays per second, and how many came from the cache.
+    fn diagnostics(&self) -> Vec<(String, f64)> {
+        let images: Vec<&ReferenceImage> = self.traced_per_light.iter().flatten().collect();
+        if images.is_empty() {
+            return Vec::new();
+        }
+        let rays: u64 = images.iter().map(|i| i.rays).sum();
+        let seconds: f64 = images.iter().map(|i| i.elapsed.as_secs_f64()).sum();
+        let mut out = vec![
+            (
+                "reference_lights_from_cache".to_owned(),
+                images.iter().filter(|i| i.cached).count() as f64,
+            ),
+            ("reference_rays".to_owned(), rays as f64),
+            ("reference_trace_ms".to_owned(), seconds * 1e3),
+        ];
+        if rays > 0 && seconds > 0.0 {
+            out.push((
+                "reference_rays_per_second".to_owned(),
+                rays as f64 / seconds,
+            ));
+        }
+        out
+    }
+}
+
+fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::ShadowTechnique>> {
+    let params = setup.params;
+    let device = &setup.gpu.device;
+    let (width, height) = (setup.scene.width, setup.scene.height);
+    let traced = crate::passes::render_texture(
+        device,
+        "reference_traced",
+        width,
+        height,
+        crate::VISIBILITY_FORMAT,
+        wgpu::TextureUsages::COPY_DST,
+    );
+    let traced_view = crate::passes::labelled_view(&traced, "reference_traced");
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("reference_traced_layout"),
+        entries: &[crate::passes::texture_entry(0)],
+    });
+    let traced_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("reference_traced_bind_group"),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(&traced_view),
+        }],
+    });
+    let module = crate::shader::create_shader(
+        setup.gpu,
+        "reference_upload_shader",
+        include_str!("../../shaders/core/reference_upload.wgsl"),
+    )?;
+    let upload = crate::ScreenPass::new(
+        setup,
+        NAME,
+        "reference_upload",
+        (&module, "reference_upload"),
+        Some(&layout),
+        crate::VISIBILITY_FORMAT.into(),
+    )?;
+    Ok(Box::new(ReferenceTechnique {
+        truth: GroundTruth::new(setup.cpu_scene),
+        samples_per_axis: u32::try_from(params.int("samples")?).unwrap_or(16),
+        seed: u64::try_from(params.int("seed")?).unwrap_or(1),
+        cache_dir: params.bool("cache")?.then(default_cache_dir),
+        points: None,
+        traced,
+        traced_group,
+        upload,
+        traced_per_light: Vec::new(),
+    }))
+}
+
+/// The registration of the ground truth.
+pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
+    name: NAME,
+    summary: "ground truth: N×N stratified jittered shadow rays per pixel on the CPU (CWBVH, all cores), cached on disk",
+    paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling)",
+    kind: crate::TechniqueKind::GroundTruth,
+    params: PARAMS,
+    requirements: |_| {
+        Ok(crate::Requirements {
+            gbuffer: true,
+            ..crate::Requirements::NONE
+        })
+    },
+    create,
+};
+
+crate::register_technique!(INFO);

@@ -1,0 +1,138 @@
+//! The ground-truth ray caster against the exact answer of `parallel-square`,
+//! with tolerances derived from the sample count N.
+//!
+//! Seen from a receiver point, the occluder back-projects onto the light as an
+//! axis-aligned rectangle, so its edges cut at most 4N of the N×N strata; each
+//! cut stratum is off by at most 1/N², hence |error| ≤ 4/N at every pixel. The
+//! jitter makes each cut stratum's error zero-mean with variance ≤ 1/(4N⁴), so
+//! the error's standard deviation is at most √(4N)/(2N²) = N^-1.5: the mean
+//! absolute error over the penumbra stays below that.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use glam::{Vec2, Vec3};
+use ssm_core::reference::{GroundTruth, SurfacePoint, parallel_rectangle_visibility};
+use ssm_integration_tests::{gpu, render};
+use ssm_scene::builtin;
+
+const SIZE: (u32, u32) = (128, 96);
+
+/// (max error, mean error over penumbra pixels, penumbra pixel count) of the ray caster at N samples per axis.
+fn errors(samples: u32) -> (f32, f32, usize) {
+    let gpu = gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let settings = [
+        ("samples", samples.to_string()),
+        ("cache", "false".to_owned()),
+    ];
+    let settings: Vec<(&str, &str)> = settings.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    let rendered = render(&gpu, &scene, "reference", &settings, SIZE.0, SIZE.1).unwrap();
+    let positions = rendered.renderer.read_positions().unwrap();
+    let light = &scene.lights[0];
+    let (mut max, mut sum, mut count) = (0.0f32, 0.0f32, 0usize);
+    for (traced, p) in rendered.visibility.iter().zip(&positions) {
+        if p[3] < 0.5 {
+            continue;
+        }
+        let exact = parallel_rectangle_visibility(
+            light,
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec2::splat(0.5),
+            Vec3::new(p[0], p[1], p[2]),
+        );
+        let error = (traced - exact).abs();
+        max = max.max(error);
+        if exact > 0.0 && exact < 1.0 {
+            sum += error;
+            count += 1;
+        }
+    }
+    (max, sum / count.max(1) as f32, count)
+}
+
+#[test]
+fn ray_caster_matches_the_analytic_parallel_square_within_the_sampling_error() {
+    let mut means = Vec::new();
+    for n in [4u32, 8, 16, 32] {
+        let (max, mean, penumbra) = errors(n);
+        let n_f = n as f32;
+        println!(
+            "N = {n}: max error {max:.4} (bound {:.4}), mean penumbra error {mean:.5} (bound {:.5}) over {penumbra} pixels",
+            4.0 / n_f,
+            n_f.powf(-1.5)
+        );
+        assert!(
+            penumbra > 500,
+            "the penumbra covers too few pixels ({penumbra}) to measure"
+        );
+        assert!(
+            max <= 4.0 / n_f + 1e-4,
+            "N = {n}: max error {max} above 4/N"
+        );
+        assert!(
+            mean <= n_f.powf(-1.5),
+            "N = {n}: mean error {mean} above N^-1.5"
+        );
+        means.push(mean);
+    }
+    // The error falls with N (about as N^-1.5: 8x from N = 8 to 32; ask for 3x).
+    assert!(means[3] < means[1] / 3.0, "{means:?}");
+}
+
+#[test]
+fn cached_results_are_identical_and_keyed_by_their_inputs() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let truth = GroundTruth::new(&scene);
+    let points: Vec<Option<SurfacePoint>> = (0..64)
+        .map(|i| {
+            Some(SurfacePoint {
+                position: Vec3::new(i as f32 * 0.04, 0.0, 0.3),
+                normal: Vec3::Y,
+            })
+        })
+        .chain([None])
+        .collect();
+    let dir = std::env::temp_dir().join(format!("ssm-reference-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let light = &scene.lights[0];
+    let first = truth.trace_cached(light, &points, 8, 1, &dir);
+    assert!(!first.cached && first.rays == 64 * 64);
+    let again = truth.trace_cached(light, &points, 8, 1, &dir);
+    assert!(again.cached && again.rays == 0);
+    assert_eq!(first.visibility, again.visibility);
+    assert_eq!(
+        *first.visibility.last().unwrap(),
+        1.0,
+        "a pixel without a surface is lit"
+    );
+    // A different sample count or seed is a different entry.
+    assert!(!truth.trace_cached(light, &points, 4, 1, &dir).cached);
+    assert!(!truth.trace_cached(light, &points, 8, 2, &dir).cached);
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_point_behind_the_light_or_a_point_light_gives_exact_answers() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let truth = GroundTruth::new(&scene);
+    let mut light = scene.lights[0];
+    let mut rng = ssm_core::reference::SplitMix64::for_pixel(1, 0);
+    let behind = SurfacePoint {
+        position: Vec3::new(0.0, 5.0, 0.0),
+        normal: Vec3::Y,
+    };
+    assert_eq!(truth.visibility(&light, &behind, 8, &mut rng), 0.0);
+    light.half_size = Vec2::ZERO;
+    let under = SurfacePoint {
+        position: Vec3::new(0.9, 0.0, 0.0),
+        normal: Vec3::Y,
+    };
+    let beside = SurfacePoint {
+        position: Vec3::new(1.1, 0.0, 0.0),
+        normal: Vec3::Y,
+    };
+    assert_eq!(truth.visibility(&light, &under, 8, &mut rng), 0.0);
+    assert_eq!(truth.visibility(&light, &beside, 8, &mut rng), 1.0);
+}
