@@ -10,6 +10,7 @@ use ssm_scene::Scene;
 pub fn link_techniques() {
     ssm_core::reference::link();
     ssm_hard::link();
+    ssm_multi_sm::link();
     ssm_pcss::link();
     ssm_plugin_technique::link();
 }

@@ -23,7 +23,11 @@ struct ScreenPoint {
 };
 
 fn screen_point(in: FullscreenVertex) -> ScreenPoint {
-    let texel = vec2<i32>(in.clip.xy);
+    return screen_point_at(vec2<i32>(in.clip.xy));
+}
+
+// The same for a texel, from a compute shader.
+fn screen_point_at(texel: vec2<i32>) -> ScreenPoint {
     let position = textureLoad(gbuffer_position, texel, 0);
     let normal = textureLoad(gbuffer_normal, texel, 0);
     return ScreenPoint(texel, position.xyz, normal.xyz, position.w > 0.5, normal.w > 0.5);

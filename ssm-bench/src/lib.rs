@@ -12,10 +12,11 @@ use ssm_core::{
 /// Keeps every technique crate linked into the binary, so that their
 /// registrations reach the registry. A new technique crate adds one line here
 /// and one dependency in this crate's manifest.
-pub fn link_techniques() -> [&'static str; 3] {
+pub fn link_techniques() -> [&'static str; 4] {
     [
         ssm_core::reference::link(),
         ssm_hard::link(),
+        ssm_multi_sm::link(),
         ssm_pcss::link(),
     ]
 }

@@ -211,8 +211,8 @@ fn render(args: &RenderArgs) -> Result<()> {
     for (info, params) in &runs {
         progress.set_message(info.name);
         let dir = args.out.join(info.name);
-        let run = render_technique(&mut renderer, info, params, args.frames, &dir)
-            .with_context(|| format!("technique `{}`", info.name))?;
+        // Technique errors name the technique already.
+        let run = render_technique(&mut renderer, info, params, args.frames, &dir)?;
         let gpu_ms: Vec<f64> = run.frames.iter().filter_map(|t| t.gpu_ms).collect();
         let cpu_ms: Vec<f64> = run.frames.iter().map(|t| t.cpu_wall_ms).collect();
         let time = match median(&gpu_ms) {

@@ -22,6 +22,7 @@ mod gpu_scene;
 pub mod image_io;
 mod light_depth;
 mod light_frame;
+pub mod metrics;
 mod params;
 pub mod passes;
 pub mod readback;

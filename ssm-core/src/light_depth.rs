@@ -157,6 +157,15 @@ impl LightDepthMap {
 
     /// Records the pass for `light`, labelled and timed with the map's label.
     pub fn encode(&self, frame: &mut Frame<'_>, light: usize) {
+        let light_frame = &frame.scene.light_bind_groups[light];
+        self.encode_with(frame, light_frame);
+    }
+
+    /// Records the pass seen through another frame: a bind group of
+    /// [`GpuScene::uniform_layout`](crate::GpuScene) holding a
+    /// [`LightFrameUniform`](crate::LightFrameUniform) (a point on the light,
+    /// a tile of it...).
+    pub fn encode_with(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup) {
         let scene = frame.scene;
         let mut pass = frame.render_pass(
             &self.label,
@@ -179,7 +188,7 @@ impl LightDepthMap {
             }),
         );
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.light_bind_groups[light], &[]);
+        pass.set_bind_group(0, light_frame, &[]);
         pass.set_bind_group(1, &self.bias_bind_group, &[]);
         scene.draw(&mut pass, self.geometry);
     }

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::readback::read_buffer;
 
 /// Most timed passes in one frame; later passes run untimed (and are counted in [`FrameTimings::untimed_passes`]).
-pub const MAX_TIMED_PASSES: u32 = 256;
+pub const MAX_TIMED_PASSES: u32 = 2048;
 
 /// The time one pass took.
 #[derive(Clone, Debug, PartialEq, Serialize)]

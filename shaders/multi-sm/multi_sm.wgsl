@@ -1,0 +1,43 @@
+// The average of K hard shadow maps rendered from stratified points on the
+// light (the reference of Shen et al., Table 2, and of Buades et al., Fig. 13).
+// One dispatch per sample adds that sample's hard visibility, weighted 1/K,
+// to the visibility target; a clear to 0 precedes the first.
+
+// #import common/screen_pass.wgsl
+// #import common/shadow_map.wgsl
+
+struct MultiSmSettings {
+    // 1 / K.
+    weight: f32,
+    // Normal offset of the lookup point, in shadow-map texels.
+    normal_offset: f32,
+    _pad0: f32,
+    _pad1: f32,
+};
+
+// Group 0 (`frame`) holds this sample's frame: a point light at the sample, with the light's axes.
+@group(2) @binding(0) var shadow_map: texture_2d<f32>;
+@group(2) @binding(1) var<uniform> settings: MultiSmSettings;
+@group(2) @binding(2) var visibility: texture_storage_2d<r32float, read_write>;
+
+@compute @workgroup_size(8, 8)
+fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(visibility);
+    if (id.x >= size.x || id.y >= size.y) {
+        return;
+    }
+    let texel = vec2<i32>(id.xy);
+    let point = screen_point_at(texel);
+    var lit = 1.0;
+    if (point.covered) {
+        if (!in_front_of_light(frame, point.position)) {
+            lit = 0.0;
+        } else {
+            let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
+            let uvd = light_uv_depth(frame, lookup);
+            lit = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+        }
+    }
+    let sum = textureLoad(visibility, texel).x + settings.weight * lit;
+    textureStore(visibility, texel, vec4<f32>(sum, 0.0, 0.0, 0.0));
+}

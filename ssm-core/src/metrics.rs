@@ -1,0 +1,334 @@
+//! Error metrics of a visibility image against the ground truth, on the same
+//! pixels, and the error heat map.
+
+use serde::Serialize;
+
+/// Below this, a reference value counts as umbra; above `1 - UMBRA_EPSILON`, as lit.
+/// (The reference's values are multiples of 1/N², so exact 0 and 1 are reached.)
+pub const UMBRA_EPSILON: f32 = 1e-6;
+
+/// A pixel's class in the reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowClass {
+    /// No surface: not compared.
+    Background,
+    /// The whole light is visible.
+    Lit,
+    /// Part of the light is visible.
+    Penumbra,
+    /// None of the light is visible.
+    Umbra,
+}
+
+/// Classifies each pixel of a reference image; `covered[i]` says whether geometry covers pixel i.
+#[must_use]
+pub fn classify(reference: &[f32], covered: &[bool]) -> Vec<ShadowClass> {
+    reference
+        .iter()
+        .zip(covered)
+        .map(|(&r, &c)| match (c, r) {
+            (false, _) => ShadowClass::Background,
+            (true, r) if r >= 1.0 - UMBRA_EPSILON => ShadowClass::Lit,
+            (true, r) if r <= UMBRA_EPSILON => ShadowClass::Umbra,
+            _ => ShadowClass::Penumbra,
+        })
+        .collect()
+}
+
+/// The error numbers of one image against the reference.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ErrorMetrics {
+    /// Mean absolute error over the pixels in umbra or penumbra in the
+    /// reference (the metric of Atty et al., Sec. 5.2.1).
+    pub mae_penumbra: f64,
+    /// Root-mean-square error over covered pixels.
+    pub rmse: f64,
+    /// Largest absolute error.
+    pub max_abs: f64,
+    /// Peak signal-to-noise ratio, dB (peak 1; infinite when identical).
+    pub psnr: f64,
+    /// Mean structural similarity (Wang et al. 2004; 11×11 Gaussian window, σ = 1.5) over covered pixels.
+    pub ssim: f64,
+    /// Share of covered pixels off by more than 0.05.
+    pub frac_over_0_05: f64,
+    /// Mean signed error over covered pixels: negative when the technique over-shadows.
+    pub mean_signed: f64,
+    /// Covered pixels compared.
+    pub pixels: usize,
+    /// Pixels in penumbra in the reference.
+    pub penumbra_pixels: usize,
+    /// Pixels in umbra in the reference.
+    pub umbra_pixels: usize,
+}
+
+/// Compares `image` with `reference` (both `width` × `height`, row-major) over the covered pixels.
+///
+/// # Panics
+/// If the slices' lengths differ from `width * height`.
+#[must_use]
+pub fn compare(
+    reference: &[f32],
+    image: &[f32],
+    covered: &[bool],
+    width: usize,
+    height: usize,
+) -> ErrorMetrics {
+    assert!(
+        reference.len() == width * height
+            && image.len() == reference.len()
+            && covered.len() == reference.len(),
+        "image sizes differ"
+    );
+    let classes = classify(reference, covered);
+    let (mut count, mut squared, mut max_abs, mut over, mut signed) =
+        (0usize, 0.0f64, 0.0f64, 0usize, 0.0f64);
+    let (mut shadow_sum, mut shadow_count) = (0.0f64, 0usize);
+    for ((&r, &v), class) in reference.iter().zip(image).zip(&classes) {
+        if *class == ShadowClass::Background {
+            continue;
+        }
+        let error = f64::from(v) - f64::from(r);
+        count += 1;
+        squared += error * error;
+        signed += error;
+        max_abs = max_abs.max(error.abs());
+        over += usize::from(error.abs() > 0.05);
+        if matches!(class, ShadowClass::Penumbra | ShadowClass::Umbra) {
+            shadow_sum += error.abs();
+            shadow_count += 1;
+        }
+    }
+    let n = count.max(1) as f64;
+    let mse = squared / n;
+    ErrorMetrics {
+        mae_penumbra: if shadow_count == 0 {
+            0.0
+        } else {
+            shadow_sum / shadow_count as f64
+        },
+        rmse: mse.sqrt(),
+        max_abs,
+        psnr: if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            -10.0 * mse.log10()
+        },
+        ssim: ssim(reference, image, covered, width, height),
+        frac_over_0_05: over as f64 / n,
+        mean_signed: signed / n,
+        pixels: count,
+        penumbra_pixels: classes
+            .iter()
+            .filter(|c| **c == ShadowClass::Penumbra)
+            .count(),
+        umbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Umbra).count(),
+    }
+}
+
+/// Mean SSIM over covered pixels: local means, variances and covariance from
+/// an 11×11 Gaussian window (σ = 1.5, clamped at the borders), with
+/// C1 = (0.01)² and C2 = (0.03)² for a dynamic range of 1 (Wang et al. 2004).
+#[must_use]
+pub fn ssim(
+    reference: &[f32],
+    image: &[f32],
+    covered: &[bool],
+    width: usize,
+    height: usize,
+) -> f64 {
+    const RADIUS: i64 = 5;
+    const SIGMA: f64 = 1.5;
+    let weights: Vec<f64> = (-RADIUS..=RADIUS)
+        .map(|i| (-((i * i) as f64) / (2.0 * SIGMA * SIGMA)).exp())
+        .collect();
+    let total: f64 = weights.iter().sum();
+    let weights: Vec<f64> = weights.iter().map(|w| w / total).collect();
+    // Separable blur with clamped borders.
+    let blur = |values: &[f64]| -> Vec<f64> {
+        let clamp = |v: i64, max: usize| v.clamp(0, max as i64 - 1) as usize;
+        let mut horizontal = vec![0.0; values.len()];
+        for y in 0..height {
+            for x in 0..width {
+                horizontal[y * width + x] = (-RADIUS..=RADIUS)
+                    .map(|k| {
+                        weights[(k + RADIUS) as usize]
+                            * values[y * width + clamp(x as i64 + k, width)]
+                    })
+                    .sum();
+            }
+        }
+        let mut out = vec![0.0; values.len()];
+        for y in 0..height {
+            for x in 0..width {
+                out[y * width + x] = (-RADIUS..=RADIUS)
+                    .map(|k| {
+                        weights[(k + RADIUS) as usize]
+                            * horizontal[clamp(y as i64 + k, height) * width + x]
+                    })
+                    .sum();
+            }
+        }
+        out
+    };
+    let x: Vec<f64> = reference.iter().map(|v| f64::from(*v)).collect();
+    let y: Vec<f64> = image.iter().map(|v| f64::from(*v)).collect();
+    let product = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).collect::<Vec<f64>>();
+    let (mean_x, mean_y) = (blur(&x), blur(&y));
+    let (mean_xx, mean_yy, mean_xy) = (
+        blur(&product(&x, &x)),
+        blur(&product(&y, &y)),
+        blur(&product(&x, &y)),
+    );
+    let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
+    let (mut sum, mut count) = (0.0, 0usize);
+    for i in 0..x.len() {
+        if !covered[i] {
+            continue;
+        }
+        let (mx, my) = (mean_x[i], mean_y[i]);
+        let (vx, vy, cov) = (
+            mean_xx[i] - mx * mx,
+            mean_yy[i] - my * my,
+            mean_xy[i] - mx * my,
+        );
+        sum +=
+            ((2.0 * mx * my + c1) * (2.0 * cov + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+        count += 1;
+    }
+    if count == 0 { 1.0 } else { sum / count as f64 }
+}
+
+/// The signed error `image - reference` as an RGB heat map: white where
+/// equal, red where the technique is darker than the reference
+/// (over-shadowing), blue where it is lighter (under-shadowing), saturated at
+/// an error of `full_scale`; background pixels grey. Row-major RGB8.
+#[must_use]
+pub fn heat_map(reference: &[f32], image: &[f32], covered: &[bool], full_scale: f32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(reference.len() * 3);
+    for ((&r, &v), &c) in reference.iter().zip(image).zip(covered) {
+        if !c {
+            out.extend_from_slice(&[96, 96, 96]);
+            continue;
+        }
+        let t = ((v - r) / full_scale).clamp(-1.0, 1.0);
+        let fade = ((1.0 - t.abs()) * 255.0).round() as u8;
+        // Towards red (255, 0, 0) for t < 0, towards blue (0, 0, 255) for t > 0.
+        out.extend_from_slice(&if t < 0.0 {
+            [255, fade, fade]
+        } else {
+            [fade, fade, 255]
+        });
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(width: usize, height: usize) -> Vec<f32> {
+        (0..width * height)
+            .map(|i| (i % width) as f32 / (width - 1) as f32)
+            .collect()
+    }
+
+    #[test]
+    fn identical_images_are_perfect() {
+        let (w, h) = (24, 16);
+        let reference = ramp(w, h);
+        let m = compare(&reference, &reference, &vec![true; w * h], w, h);
+        assert_eq!(
+            (m.mae_penumbra, m.rmse, m.max_abs, m.frac_over_0_05),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+        assert!(m.psnr.is_infinite());
+        assert!((m.ssim - 1.0).abs() < 1e-12, "{}", m.ssim);
+    }
+
+    #[test]
+    fn a_constant_offset_gives_known_numbers() {
+        let (w, h) = (24, 16);
+        let reference: Vec<f32> = vec![0.5; w * h];
+        let image: Vec<f32> = vec![0.6; w * h];
+        let m = compare(&reference, &image, &vec![true; w * h], w, h);
+        assert!(
+            (m.rmse - 0.1).abs() < 1e-6
+                && (m.max_abs - 0.1).abs() < 1e-6
+                && (m.mae_penumbra - 0.1).abs() < 1e-6
+        );
+        assert!((m.mean_signed - 0.1).abs() < 1e-6);
+        assert!(
+            (m.psnr - 20.0).abs() < 1e-4,
+            "PSNR of a 0.1 offset is 20 dB, got {}",
+            m.psnr
+        );
+        assert_eq!(m.frac_over_0_05, 1.0);
+        // Flat images: variances are 0, so SSIM is the luminance term (2·0.5·0.6 + C1)/(0.25 + 0.36 + C1).
+        let expected = (2.0 * 0.5 * 0.6 + 1e-4) / (0.25 + 0.36 + 1e-4);
+        assert!((m.ssim - expected).abs() < 1e-5, "{} vs {expected}", m.ssim);
+    }
+
+    #[test]
+    fn a_single_wrong_pixel() {
+        let (w, h) = (30, 30);
+        let reference: Vec<f32> = vec![0.0; w * h];
+        let mut image = reference.clone();
+        image[15 * w + 15] = 1.0;
+        let m = compare(&reference, &image, &vec![true; w * h], w, h);
+        assert_eq!(m.max_abs, 1.0);
+        assert!(
+            (m.rmse - (1.0f64 / 900.0).sqrt()).abs() < 1e-9,
+            "{}",
+            m.rmse
+        );
+        assert!((m.mae_penumbra - 1.0 / 900.0).abs() < 1e-9);
+        assert!((m.frac_over_0_05 - 1.0 / 900.0).abs() < 1e-9);
+        assert!((m.psnr - 10.0 * 900f64.log10()).abs() < 1e-9);
+        assert_eq!(m.umbra_pixels, 900);
+        // Windows away from the pixel are perfect; those around it are not; a smaller error hurts less.
+        assert!(m.ssim < 1.0 && m.ssim > 0.5, "{}", m.ssim);
+        image[15 * w + 15] = 0.2;
+        assert!(compare(&reference, &image, &vec![true; w * h], w, h).ssim > m.ssim);
+    }
+
+    #[test]
+    fn background_is_ignored_and_lit_pixels_do_not_count_in_the_penumbra_mean() {
+        let reference = vec![1.0, 1.0, 0.5, 0.0];
+        let image = vec![0.0, 0.8, 0.4, 0.0];
+        let covered = vec![false, true, true, true];
+        let m = compare(&reference, &image, &covered, 4, 1);
+        assert_eq!(m.pixels, 3);
+        assert!(
+            (m.max_abs - 0.2).abs() < 1e-6,
+            "the background pixel's error of 1 is not counted"
+        );
+        assert!(
+            (m.mae_penumbra - 0.05).abs() < 1e-6,
+            "mean of 0.1 and 0.0 over the penumbra and umbra pixels"
+        );
+        assert_eq!(
+            classify(&reference, &covered),
+            vec![
+                ShadowClass::Background,
+                ShadowClass::Lit,
+                ShadowClass::Penumbra,
+                ShadowClass::Umbra
+            ]
+        );
+    }
+
+    #[test]
+    fn heat_map_colours_say_which_way() {
+        let map = heat_map(
+            &[0.5, 0.5, 0.5, 0.5],
+            &[0.5, 0.0, 1.0, 0.5],
+            &[true, true, true, false],
+            0.5,
+        );
+        assert_eq!(&map[0..3], &[255, 255, 255]);
+        assert_eq!(&map[3..6], &[255, 0, 0], "darker than the reference: red");
+        assert_eq!(&map[6..9], &[0, 0, 255], "lighter: blue");
+        assert_eq!(&map[9..12], &[96, 96, 96]);
+    }
+}
