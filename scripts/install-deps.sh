@@ -1,24 +1,34 @@
 #!/usr/bin/env bash
 # Installs what ssm needs beyond a Rust toolchain on a Debian or Ubuntu
-# machine: a Vulkan driver. Without a GPU that is Mesa's software rasteriser
-# lavapipe (package mesa-vulkan-drivers). Prints the exact command when it
-# cannot install (not root and no sudo).
+# machine: a Vulkan driver (without a GPU, Mesa's software rasteriser
+# lavapipe, package mesa-vulkan-drivers) and, with --for-tests, Chromium for
+# the report test. Prints the exact command when it cannot install (not root
+# and no sudo).
+#
+#   scripts/install-deps.sh              what `ssm` needs to run
+#   scripts/install-deps.sh --for-tests  and what the tests need
 set -euo pipefail
 
 die() { echo "install-deps: $*" >&2; exit 1; }
 
 command -v cargo >/dev/null 2>&1 || die "cargo is missing: install Rust with rustup (https://rustup.rs), then re-run"
 
+packages=()
 # Any Vulkan ICD will do (a GPU driver or lavapipe).
-if compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null || compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null; then
-    exit 0
+if ! compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null && ! compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null; then
+    packages+=(mesa-vulkan-drivers)
 fi
-command -v apt-get >/dev/null 2>&1 || die "no Vulkan driver found and this is not a Debian-like system: install Mesa's Vulkan drivers (lavapipe) or your GPU's driver"
+if [ "${1:-}" = "--for-tests" ] && ! command -v chromium >/dev/null 2>&1; then
+    packages+=(chromium)
+fi
+[ ${#packages[@]} -eq 0 ] && exit 0
+
+command -v apt-get >/dev/null 2>&1 || die "missing ${packages[*]} and this is not a Debian-like system: install Mesa's Vulkan drivers (or your GPU's) and Chromium"
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then
-    command -v sudo >/dev/null 2>&1 || die "no Vulkan driver found; run as root: apt-get update && apt-get install -y mesa-vulkan-drivers"
+    command -v sudo >/dev/null 2>&1 || die "run as root: apt-get update && apt-get install -y ${packages[*]}"
     as_root=(sudo)
 fi
-echo "install-deps: installing mesa-vulkan-drivers (software Vulkan)"
+echo "install-deps: installing ${packages[*]}"
 "${as_root[@]}" apt-get update -q
-DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -q mesa-vulkan-drivers
+DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -q "${packages[@]}"

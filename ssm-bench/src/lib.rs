@@ -1,13 +1,13 @@
 //! Support for the `ssm` command-line tool and the criterion benches: the
 //! list of linked technique crates and the rendering of one technique to files.
 
+pub mod report;
+
 use std::path::Path;
 
 use serde_json::json;
-use ssm_core::image_io::{write_exr_gray, write_exr_rgb, write_png_gray16, write_png_rgba8};
-use ssm_core::{
-    FrameTimings, GpuContext, ParamValues, Registry, Renderer, Requirements, TechniqueInfo,
-};
+use ssm_core::image_io::write_exr_rgb;
+use ssm_core::{GpuContext, ParamValues, Registry, Renderer, Requirements, TechniqueInfo};
 
 /// Keeps every technique crate linked into the binary, so that their
 /// registrations reach the registry. A new technique crate adds one line here
@@ -56,81 +56,46 @@ pub fn output_requirements() -> Requirements {
     }
 }
 
-/// What rendering one technique produced.
-#[derive(Debug)]
-pub struct TechniqueRun {
-    /// Timings of every measured frame.
-    pub frames: Vec<FrameTimings>,
-    /// Technique diagnostics after the last frame.
-    pub diagnostics: Vec<(String, f64)>,
-}
-
-/// Renders `info` with `params` for `warmup + frames` frames and writes, under
-/// `dir`, `visibility.exr`/`.png` (light 0; `visibility-light<k>.*` for the
-/// others), `shaded.png` and `timings.json`.
+/// Renders `info` with `params` for one warm-up and `frames` timed frames
+/// and writes, under `dir`, `visibility.exr`/`.png` (light 0;
+/// `visibility-light<k>.*` for the others), `shaded.png` and `timings.json`.
 ///
 /// # Errors
 /// Technique, GPU or file errors.
 pub fn render_technique(
     renderer: &mut Renderer,
-    info: &TechniqueInfo,
+    info: &'static TechniqueInfo,
     params: &ParamValues,
     frames: u32,
     dir: &Path,
-) -> ssm_core::Result<TechniqueRun> {
-    let write_error = |e: std::io::Error| ssm_core::Error::Write {
-        file: dir.into(),
-        message: e.to_string(),
-    };
-    std::fs::create_dir_all(dir).map_err(write_error)?;
-    let mut technique = renderer.create_technique(info, params)?;
-    // One warm-up frame: pipeline compilation and first-use allocation are not the technique's cost.
-    renderer.render(technique.as_mut(), info.name)?;
-    let mut timings = Vec::new();
-    for _ in 0..frames.max(1) {
-        timings.push(renderer.render(technique.as_mut(), info.name)?);
-    }
-    let (width, height) = (renderer.width(), renderer.height());
-    for light in 0..renderer.scene.light_count() {
-        let visibility = renderer.read_visibility(light, info.name)?;
-        let stem = if light == 0 {
-            "visibility".to_owned()
-        } else {
-            format!("visibility-light{light}")
-        };
-        write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, &visibility)?;
-        write_png_gray16(&dir.join(format!("{stem}.png")), width, height, &visibility)?;
-    }
-    let shaded = renderer.shade()?;
-    write_png_rgba8(&dir.join("shaded.png"), width, height, &shaded)?;
-    let diagnostics = technique.diagnostics();
-    let gpu_ms: Vec<f64> = timings.iter().filter_map(|t| t.gpu_ms).collect();
-    let cpu_ms: Vec<f64> = timings.iter().map(|t| t.cpu_wall_ms).collect();
+) -> ssm_core::Result<report::Measured> {
+    let measured = report::measure(renderer, info, params, frames)?;
+    report::write_images(dir, &measured, renderer.width(), renderer.height(), None)?;
     let report = json!({
         "technique": info.name,
         "params": params.to_string(),
         "adapter": renderer.gpu.describe(),
-        "width": width,
-        "height": height,
-        "frames": timings.len(),
-        "gpu_ms_median": median(&gpu_ms),
-        "cpu_wall_ms_median": median(&cpu_ms),
+        "width": renderer.width(),
+        "height": renderer.height(),
+        "frames": measured.frames.len(),
+        "gpu_ms_median": measured.gpu_ms_median(),
+        "gpu_ms_min": measured.gpu_ms_min(),
+        "cpu_wall_ms_median": measured.cpu_ms_median(),
+        "pass_ms_medians": measured.pass_medians().into_iter().map(|(k, v)| (k, json!(v))).collect::<serde_json::Map<_, _>>(),
         "shared_passes": renderer.shared_timings,
-        "frame_timings": timings,
-        "diagnostics": diagnostics.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        "frame_timings": measured.frames,
+        "diagnostics": measured.diagnostics.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
     });
+    let file = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::Write {
-        file: dir.join("timings.json"),
+        file: file.clone(),
         message: e.to_string(),
     })?;
-    std::fs::write(dir.join("timings.json"), text).map_err(|e| ssm_core::Error::Write {
-        file: dir.join("timings.json"),
+    std::fs::write(&file, text).map_err(|e| ssm_core::Error::Write {
+        file,
         message: e.to_string(),
     })?;
-    Ok(TechniqueRun {
-        frames: timings,
-        diagnostics,
-    })
+    Ok(measured)
 }
 
 /// Writes the G-buffer's world positions (`position.exr`, RGB; background pixels are 0).

@@ -8,9 +8,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ssm_bench::{
-    median, output_requirements, registry, render_technique, support_on, write_positions,
+    output_requirements, registry, render_technique, report, support_on, write_positions,
 };
-use ssm_core::{GpuContext, Renderer, Requirements};
+use ssm_core::{GpuContext, ParamValues, Renderer, Requirements, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
 
 #[derive(Parser)]
@@ -32,6 +32,33 @@ enum Command {
     Scenes,
     /// Render a scene with one or more techniques and write images and timings.
     Render(RenderArgs),
+    /// Render every technique (or those named) and the ground truth; write results.csv, report.md and index.html.
+    Compare(CompareArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// A built-in scene name, a scene manifest (.toml) or a model file.
+    #[arg(long)]
+    scene: String,
+    /// Technique names, comma-separated; default: every registered real-time technique this adapter can run.
+    #[arg(long, value_delimiter = ',')]
+    technique: Vec<String>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
+    #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
+    settings: Vec<String>,
+    /// Frames timed per technique after one warm-up; GPU time is their median.
+    #[arg(long, default_value_t = 5)]
+    frames: u32,
+    /// Output directory: results.csv, report.md, index.html and one folder of images per technique.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -72,6 +99,7 @@ fn main() -> ExitCode {
         Command::List => list(),
         Command::Scenes => scenes(),
         Command::Render(args) => render(&args),
+        Command::Compare(args) => compare(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -148,22 +176,7 @@ fn parse_setting(text: &str) -> Result<(&str, &str, &str)> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     let registry = registry()?;
-    let (scene, source) =
-        Scene::load(&args.scene).with_context(|| format!("loading scene `{}`", args.scene))?;
-    if let SceneSource::StagedModel(manifest) = &source {
-        say!(
-            "# staged scene for {} (save beside the model and edit):\n{}",
-            args.scene,
-            manifest.to_toml()
-        );
-    }
-    say!(
-        "scene: {} ({} triangles, {} instances, {} lights)",
-        args.scene,
-        scene.triangle_count(),
-        scene.instances.len(),
-        scene.lights.len()
-    );
+    let scene = load_scene(&args.scene)?;
     let settings: Vec<(&str, &str, &str)> = args
         .settings
         .iter()
@@ -182,12 +195,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     let mut needs = output_requirements();
     for name in &args.technique {
         let info = registry.get(name)?;
-        let params = info.params_from(
-            settings
-                .iter()
-                .filter(|(t, _, _)| t == name)
-                .map(|(_, p, v)| (*p, *v)),
-        )?;
+        let params = params_for(info, &settings)?;
         needs = needs.union((info.requirements)(&params)?);
         runs.push((info, params));
     }
@@ -213,14 +221,9 @@ fn render(args: &RenderArgs) -> Result<()> {
         let dir = args.out.join(info.name);
         // Technique errors name the technique already.
         let run = render_technique(&mut renderer, info, params, args.frames, &dir)?;
-        let gpu_ms: Vec<f64> = run.frames.iter().filter_map(|t| t.gpu_ms).collect();
-        let cpu_ms: Vec<f64> = run.frames.iter().map(|t| t.cpu_wall_ms).collect();
-        let time = match median(&gpu_ms) {
+        let time = match run.gpu_ms_median() {
             Some(ms) => format!("{ms:.3} ms GPU"),
-            None => format!(
-                "{:.3} ms CPU wall (no timestamps)",
-                median(&cpu_ms).unwrap_or(f64::NAN)
-            ),
+            None => format!("{:.3} ms CPU wall (no timestamps)", run.cpu_ms_median()),
         };
         progress.suspend(|| -> Result<()> {
             say!(
@@ -235,5 +238,154 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     progress.finish_and_clear();
     say!("adapter: {}", gpu.describe());
+    Ok(())
+}
+
+fn load_scene(spec: &str) -> Result<Scene> {
+    let (scene, source) = Scene::load(spec).with_context(|| format!("loading scene `{spec}`"))?;
+    if let SceneSource::StagedModel(manifest) = &source {
+        say!(
+            "# staged scene for {spec} (save beside the model and edit):\n{}",
+            manifest.to_toml()
+        );
+    }
+    say!(
+        "scene: {spec} ({} triangles, {} instances, {} lights)",
+        scene.triangle_count(),
+        scene.instances.len(),
+        scene.lights.len()
+    );
+    Ok(scene)
+}
+
+/// The parameter values of `info` from the `--set` assignments that name it.
+fn params_for(
+    info: &'static TechniqueInfo,
+    settings: &[(&str, &str, &str)],
+) -> Result<ParamValues> {
+    Ok(info.params_from(
+        settings
+            .iter()
+            .filter(|(t, _, _)| *t == info.name)
+            .map(|(_, p, v)| (*p, *v)),
+    )?)
+}
+
+fn compare(args: &CompareArgs) -> Result<()> {
+    let registry = registry()?;
+    let scene = load_scene(&args.scene)?;
+    let settings: Vec<(&str, &str, &str)> = args
+        .settings
+        .iter()
+        .map(|s| parse_setting(s))
+        .collect::<Result<_>>()?;
+    let reference_info = registry
+        .iter()
+        .find(|i| i.kind == TechniqueKind::GroundTruth)
+        .context("no ground-truth technique is registered")?;
+    let gpu = GpuContext::new()?;
+    let mut skipped: Vec<(String, String)> = Vec::new();
+    let mut runs = Vec::new();
+    if args.technique.is_empty() {
+        for info in registry
+            .iter()
+            .filter(|i| i.kind == TechniqueKind::Realtime)
+        {
+            let params = params_for(info, &settings)?;
+            // Unasked-for techniques this adapter cannot run are reported, not fatal.
+            match (info.requirements)(&params).and_then(|r| r.check_device(info.name, &gpu)) {
+                Ok(()) => runs.push((info, params)),
+                Err(e) => skipped.push((info.name.to_owned(), e.to_string())),
+            }
+        }
+    } else {
+        for name in &args.technique {
+            let info = registry.get(name)?;
+            runs.push((info, params_for(info, &settings)?));
+        }
+    }
+    for (technique, _, _) in &settings {
+        if *technique != reference_info.name
+            && !runs.iter().any(|(i, _)| i.name == *technique)
+            && !skipped.iter().any(|(n, _)| n == technique)
+        {
+            bail!("--set names technique `{technique}`, which is not compared");
+        }
+    }
+    let reference_params = params_for(reference_info, &settings)?;
+    let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
+    for (info, params) in &runs {
+        needs = needs.union((info.requirements)(params)?);
+    }
+    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    write_positions(&renderer, &args.out.join("position.exr"))?;
+
+    let progress = ProgressBar::new(runs.len() as u64 + 1);
+    progress.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    progress.set_message(format!("{} (ground truth)", reference_info.name));
+    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
+    report::write_images(
+        &args.out.join(reference_info.name),
+        &reference,
+        args.width,
+        args.height,
+        None,
+    )?;
+    let covered: Vec<bool> = renderer
+        .read_positions()?
+        .iter()
+        .map(|p| p[3] > 0.5)
+        .collect();
+    progress.inc(1);
+    let mut rows = Vec::new();
+    for (info, params) in &runs {
+        progress.set_message(info.name);
+        let measured = report::measure(&mut renderer, info, params, args.frames)?;
+        report::write_images(
+            &args.out.join(info.name),
+            &measured,
+            args.width,
+            args.height,
+            Some((&reference, &covered)),
+        )?;
+        rows.push(report::row(
+            &args.scene,
+            &renderer,
+            &measured,
+            &reference,
+            &covered,
+        ));
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+
+    let adapter = gpu.describe();
+    let reference_text = reference_params.to_string();
+    let context = report::ReportContext {
+        scene: &args.scene,
+        adapter: &adapter,
+        size: (args.width, args.height),
+        frames: args.frames,
+        reference_params: &reference_text,
+        skipped: &skipped,
+    };
+    let write = |name: &str, text: String| {
+        std::fs::write(args.out.join(name), text)
+            .with_context(|| format!("writing {}", args.out.join(name).display()))
+    };
+    write("results.csv", report::csv(&rows))?;
+    let markdown = report::markdown_report(&context, &rows);
+    write("report.md", markdown.clone())?;
+    write(
+        "index.html",
+        report::html_report(&context, &rows, reference_info.name),
+    )?;
+    say!("{markdown}");
+    say!("wrote {}", args.out.join("index.html").display());
     Ok(())
 }

@@ -199,6 +199,25 @@ pub fn ssim(
     if count == 0 { 1.0 } else { sum / count as f64 }
 }
 
+/// Mean FLIP error (Andersson et al. 2020, NVIDIA's ꟻLIP) of a shaded image
+/// against the shaded reference, both RGBA8 sRGB, at the default viewing
+/// condition (about 67 pixels per degree). 0 is identical; 1 is the largest error.
+///
+/// # Panics
+/// If the slices are not `width * height * 4` bytes.
+#[must_use]
+pub fn flip_mean(reference_rgba: &[u8], image_rgba: &[u8], width: u32, height: u32) -> f64 {
+    let rgb = |rgba: &[u8]| {
+        rgba.chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect::<Vec<u8>>()
+    };
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference_rgba));
+    let image = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(image_rgba));
+    let error = nv_flip::flip(reference, image, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    f64::from(nv_flip::FlipPool::from_image(&error).mean())
+}
+
 /// The signed error `image - reference` as an RGB heat map: white where
 /// equal, red where the technique is darker than the reference
 /// (over-shadowing), blue where it is lighter (under-shadowing), saturated at
@@ -316,6 +335,28 @@ mod tests {
                 ShadowClass::Umbra
             ]
         );
+    }
+
+    #[test]
+    fn flip_is_zero_for_identical_images_and_grows_with_the_difference() {
+        let (w, h) = (32u32, 32u32);
+        let grey: Vec<u8> = (0..w * h).flat_map(|_| [128, 128, 128, 255]).collect();
+        let mut dotted = grey.clone();
+        let mut dark = grey.clone();
+        for (i, pixel) in dotted.chunks_exact_mut(4).enumerate() {
+            if i % 7 == 0 {
+                pixel[..3].copy_from_slice(&[0, 0, 0]);
+            }
+        }
+        for pixel in dark.chunks_exact_mut(4) {
+            pixel[..3].copy_from_slice(&[0, 0, 0]);
+        }
+        assert!(flip_mean(&grey, &grey, w, h) < 1e-6);
+        let (some, all) = (
+            flip_mean(&grey, &dotted, w, h),
+            flip_mean(&grey, &dark, w, h),
+        );
+        assert!(some > 0.01 && all > some, "{some} {all}");
     }
 
     #[test]

@@ -1,0 +1,509 @@
+//! Measuring techniques against the ground truth, and writing what was
+//! measured: `results.csv`, `report.md` and an offline `index.html` with the
+//! images side by side.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ssm_core::image_io::{write_exr_gray, write_png_gray16, write_png_rgba8};
+use ssm_core::metrics::{ErrorMetrics, compare, flip_mean, heat_map};
+use ssm_core::{Error, FrameTimings, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
+
+use crate::median;
+
+/// One technique rendered and timed: its frames, outputs and diagnostics.
+pub struct Measured {
+    /// The technique.
+    pub info: &'static TechniqueInfo,
+    /// Its parameters.
+    pub params: ParamValues,
+    /// Timings of each measured frame (after one warm-up frame).
+    pub frames: Vec<FrameTimings>,
+    /// Diagnostics after the last frame.
+    pub diagnostics: Vec<(String, f64)>,
+    /// Visibility per light, row-major.
+    pub visibility: Vec<Vec<f32>>,
+    /// The shaded image, RGBA8 sRGB.
+    pub shaded: Vec<u8>,
+}
+
+impl Measured {
+    /// Median over frames of the GPU time (sum of the technique's passes).
+    #[must_use]
+    pub fn gpu_ms_median(&self) -> Option<f64> {
+        median(
+            &self
+                .frames
+                .iter()
+                .filter_map(|f| f.gpu_ms)
+                .collect::<Vec<_>>(),
+        )
+    }
+
+    /// Smallest GPU time over frames.
+    #[must_use]
+    pub fn gpu_ms_min(&self) -> Option<f64> {
+        self.frames.iter().filter_map(|f| f.gpu_ms).reduce(f64::min)
+    }
+
+    /// Median CPU wall time from recording to the GPU going idle.
+    #[must_use]
+    pub fn cpu_ms_median(&self) -> f64 {
+        median(
+            &self
+                .frames
+                .iter()
+                .map(|f| f.cpu_wall_ms)
+                .collect::<Vec<_>>(),
+        )
+        .unwrap_or(f64::NAN)
+    }
+
+    /// Median over frames of each pass's time, passes of one name summed within a frame, in first-seen order.
+    #[must_use]
+    pub fn pass_medians(&self) -> Vec<(String, f64)> {
+        let mut names: Vec<String> = Vec::new();
+        for frame in &self.frames {
+            for pass in &frame.passes {
+                if !names.contains(&pass.name) {
+                    names.push(pass.name.clone());
+                }
+            }
+        }
+        names
+            .into_iter()
+            .map(|name| {
+                let per_frame: Vec<f64> = self
+                    .frames
+                    .iter()
+                    .map(|f| {
+                        f.passes
+                            .iter()
+                            .filter(|p| p.name == name)
+                            .map(|p| p.ms)
+                            .sum()
+                    })
+                    .collect();
+                let ms = median(&per_frame).unwrap_or(f64::NAN);
+                (name, ms)
+            })
+            .collect()
+    }
+}
+
+/// Renders `info` with `params`: one warm-up frame, then `frames` timed frames; reads every light's visibility and the shaded image.
+///
+/// # Errors
+/// Technique or GPU errors, or visibility outside [0, 1].
+pub fn measure(
+    renderer: &mut Renderer,
+    info: &'static TechniqueInfo,
+    params: &ParamValues,
+    frames: u32,
+) -> Result<Measured> {
+    let mut technique = renderer.create_technique(info, params)?;
+    // Pipeline compilation and first-use allocation are not the technique's cost.
+    renderer.render(technique.as_mut(), info.name)?;
+    let mut timings = Vec::new();
+    for _ in 0..frames.max(1) {
+        timings.push(renderer.render(technique.as_mut(), info.name)?);
+    }
+    let visibility = (0..renderer.scene.light_count())
+        .map(|light| renderer.read_visibility(light, info.name))
+        .collect::<Result<Vec<_>>>()?;
+    let shaded = renderer.shade()?;
+    Ok(Measured {
+        info,
+        params: params.clone(),
+        frames: timings,
+        diagnostics: technique.diagnostics(),
+        visibility,
+        shaded,
+    })
+}
+
+/// Writes a measured technique's images under `dir`: `visibility.exr`/`.png`
+/// (light 0; `visibility-light<k>.*` for the others) and `shaded.png`; with a
+/// reference, also `heatmap.png` (light 0).
+///
+/// # Errors
+/// File errors.
+pub fn write_images(
+    dir: &Path,
+    measured: &Measured,
+    width: u32,
+    height: u32,
+    reference: Option<(&Measured, &[bool])>,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Write {
+        file: dir.into(),
+        message: e.to_string(),
+    })?;
+    for (light, visibility) in measured.visibility.iter().enumerate() {
+        let stem = if light == 0 {
+            "visibility".to_owned()
+        } else {
+            format!("visibility-light{light}")
+        };
+        write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, visibility)?;
+        write_png_gray16(&dir.join(format!("{stem}.png")), width, height, visibility)?;
+    }
+    write_png_rgba8(&dir.join("shaded.png"), width, height, &measured.shaded)?;
+    if let Some((reference, covered)) = reference {
+        let rgb = heat_map(
+            &reference.visibility[0],
+            &measured.visibility[0],
+            covered,
+            0.5,
+        );
+        let image = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| Error::Write {
+            file: dir.join("heatmap.png"),
+            message: "buffer size".into(),
+        })?;
+        image
+            .save(dir.join("heatmap.png"))
+            .map_err(|e| Error::Write {
+                file: dir.join("heatmap.png"),
+                message: e.to_string(),
+            })?;
+    }
+    Ok(())
+}
+
+/// One row of `results.csv` / `sweep.csv`.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Scene name as given.
+    pub scene: String,
+    /// Technique name.
+    pub technique: String,
+    /// Parameters, `name=value;...`.
+    pub params: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Median GPU ms per frame (sum of passes), when timestamps exist.
+    pub gpu_ms_median: Option<f64>,
+    /// Minimum GPU ms per frame.
+    pub gpu_ms_min: Option<f64>,
+    /// Median CPU wall ms per frame.
+    pub cpu_ms: f64,
+    /// Error metrics against the reference, averaged over lights.
+    pub metrics: ErrorMetrics,
+    /// Mean FLIP of the shaded image against the shaded reference.
+    pub flip: f64,
+    /// Adapter description.
+    pub adapter: String,
+    /// GPU timestamps or CPU wall time only.
+    pub timing_source: TimingSource,
+    /// Median ms per pass name.
+    pub passes: Vec<(String, f64)>,
+    /// Technique diagnostics.
+    pub diagnostics: Vec<(String, f64)>,
+}
+
+/// The leading columns of `results.csv`, in order; more follow.
+pub const CSV_COLUMNS: &[&str] = &[
+    "scene",
+    "technique",
+    "params",
+    "width",
+    "height",
+    "gpu_ms_median",
+    "gpu_ms_min",
+    "cpu_ms",
+    "mae_penumbra",
+    "rmse",
+    "max_abs",
+    "psnr",
+    "ssim",
+    "frac_over_0_05",
+    "adapter",
+    "flip_mean",
+    "mean_signed_error",
+    "penumbra_pixels",
+    "umbra_pixels",
+    "timing_source",
+    "passes_ms",
+    "diagnostics",
+];
+
+/// Builds the row of `measured` against `reference` (same pixels; `covered` marks the pixels with a surface).
+#[must_use]
+pub fn row(
+    scene: &str,
+    renderer: &Renderer,
+    measured: &Measured,
+    reference: &Measured,
+    covered: &[bool],
+) -> Row {
+    let (width, height) = (renderer.width(), renderer.height());
+    let per_light: Vec<ErrorMetrics> = measured
+        .visibility
+        .iter()
+        .zip(&reference.visibility)
+        .map(|(image, truth)| compare(truth, image, covered, width as usize, height as usize))
+        .collect();
+    Row {
+        scene: scene.to_owned(),
+        technique: measured.info.name.to_owned(),
+        params: measured.params.to_string(),
+        width,
+        height,
+        gpu_ms_median: measured.gpu_ms_median(),
+        gpu_ms_min: measured.gpu_ms_min(),
+        cpu_ms: measured.cpu_ms_median(),
+        metrics: average(&per_light),
+        flip: flip_mean(&reference.shaded, &measured.shaded, width, height),
+        adapter: renderer.gpu.describe(),
+        timing_source: measured
+            .frames
+            .first()
+            .map_or(TimingSource::CpuWallOnly, |f| f.source),
+        passes: measured.pass_medians(),
+        diagnostics: measured.diagnostics.clone(),
+    }
+}
+
+fn average(all: &[ErrorMetrics]) -> ErrorMetrics {
+    let n = all.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&ErrorMetrics) -> f64| all.iter().map(f).sum::<f64>() / n;
+    ErrorMetrics {
+        mae_penumbra: mean(&|m| m.mae_penumbra),
+        rmse: mean(&|m| m.rmse),
+        max_abs: all.iter().map(|m| m.max_abs).fold(0.0, f64::max),
+        psnr: mean(&|m| m.psnr),
+        ssim: mean(&|m| m.ssim),
+        frac_over_0_05: mean(&|m| m.frac_over_0_05),
+        mean_signed: mean(&|m| m.mean_signed),
+        pixels: all.iter().map(|m| m.pixels).sum(),
+        penumbra_pixels: all.iter().map(|m| m.penumbra_pixels).sum(),
+        umbra_pixels: all.iter().map(|m| m.umbra_pixels).sum(),
+    }
+}
+
+fn number(value: Option<f64>, decimals: usize) -> String {
+    match value {
+        Some(v) if v.is_infinite() => "inf".into(),
+        Some(v) if v.is_finite() => format!("{v:.decimals$}"),
+        _ => String::new(),
+    }
+}
+
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_owned()
+    }
+}
+
+fn pairs(items: &[(String, f64)]) -> String {
+    items
+        .iter()
+        .map(|(k, v)| format!("{k}={v:.4}"))
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+impl Row {
+    fn csv_fields(&self) -> Vec<String> {
+        let m = &self.metrics;
+        vec![
+            csv_field(&self.scene),
+            csv_field(&self.technique),
+            csv_field(&self.params),
+            self.width.to_string(),
+            self.height.to_string(),
+            number(self.gpu_ms_median, 4),
+            number(self.gpu_ms_min, 4),
+            number(Some(self.cpu_ms), 4),
+            number(Some(m.mae_penumbra), 6),
+            number(Some(m.rmse), 6),
+            number(Some(m.max_abs), 6),
+            number(Some(m.psnr), 4),
+            number(Some(m.ssim), 6),
+            number(Some(m.frac_over_0_05), 6),
+            csv_field(&self.adapter),
+            number(Some(self.flip), 6),
+            number(Some(m.mean_signed), 6),
+            m.penumbra_pixels.to_string(),
+            m.umbra_pixels.to_string(),
+            match self.timing_source {
+                TimingSource::GpuTimestamps => "gpu_timestamps".into(),
+                TimingSource::CpuWallOnly => "cpu_wall_only".into(),
+            },
+            csv_field(&pairs(&self.passes)),
+            csv_field(&pairs(&self.diagnostics)),
+        ]
+    }
+}
+
+/// The CSV text of `rows`, header first.
+#[must_use]
+pub fn csv(rows: &[Row]) -> String {
+    let mut out = CSV_COLUMNS.join(",") + "\n";
+    for row in rows {
+        out += &row.csv_fields().join(",");
+        out.push('\n');
+    }
+    out
+}
+
+/// The Markdown table of `rows`.
+#[must_use]
+pub fn markdown_table(rows: &[Row]) -> String {
+    let mut out = String::from(
+        "| technique | params | GPU ms (median) | GPU ms (min) | MAE penumbra | RMSE | max | PSNR dB | SSIM | > 0.05 | FLIP |\n",
+    );
+    out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for r in rows {
+        let m = &r.metrics;
+        let _ = writeln!(
+            out,
+            "| `{}` | {} | {} | {} | {:.4} | {:.4} | {:.3} | {} | {:.4} | {:.2}% | {:.4} |",
+            r.technique,
+            r.params.replace(';', "; "),
+            number(r.gpu_ms_median, 3),
+            number(r.gpu_ms_min, 3),
+            m.mae_penumbra,
+            m.rmse,
+            m.max_abs,
+            number(Some(m.psnr), 2),
+            m.ssim,
+            m.frac_over_0_05 * 100.0,
+            r.flip
+        );
+    }
+    out
+}
+
+/// What the report header says about the run.
+pub struct ReportContext<'a> {
+    /// Scene as given.
+    pub scene: &'a str,
+    /// Adapter description.
+    pub adapter: &'a str,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Timed frames per technique.
+    pub frames: u32,
+    /// The reference's parameters.
+    pub reference_params: &'a str,
+    /// Techniques not run, with the reason.
+    pub skipped: &'a [(String, String)],
+}
+
+/// `report.md`: the context and the table.
+#[must_use]
+pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
+    let mut out = format!(
+        "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]. Errors are against it, on the same pixels; GPU time is the sum of each technique's timed passes.\n\n",
+        context.scene,
+        context.size.0,
+        context.size.1,
+        context.frames,
+        context.adapter,
+        context.reference_params
+    );
+    out += &markdown_table(rows);
+    for (name, why) in context.skipped {
+        let _ = writeln!(out, "\nNot run: `{name}`: {why}");
+    }
+    out
+}
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// `index.html`: the table and, per technique, the shaded image, the
+/// visibility and the error heat map side by side; readable offline (images by
+/// relative path, no scripts or styles from elsewhere). A small script records
+/// on `<body data-images-loaded>` how many images loaded, for tests.
+#[must_use]
+pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &str) -> String {
+    let mut out = String::from(
+        "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>ssm compare</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\ntable { border-collapse: collapse; font-size: 0.9em; }\nth, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }\nth:first-child, th:nth-child(2), td:first-child, td:nth-child(2) { text-align: left; }\nfigure { margin: 1.2em 0; }\nfigure img { width: 32%; image-rendering: pixelated; border: 1px solid #ddd; }\n.legend { font-size: 0.9em; color: #555; }\n</style>\n</head>\n<body data-images-loaded=\"0\">\n",
+    );
+    let _ = writeln!(
+        out,
+        "<h1>ssm compare: <code>{}</code></h1>\n<p>{}×{}, median of {} frames after one warm-up, on {}. Ground truth: <code>{}</code> [{}].</p>",
+        escape(context.scene),
+        context.size.0,
+        context.size.1,
+        context.frames,
+        escape(context.adapter),
+        escape(reference_name),
+        escape(context.reference_params)
+    );
+    out += "<table>\n<tr><th>technique</th><th>params</th><th>GPU ms (median)</th><th>GPU ms (min)</th><th>MAE penumbra</th><th>RMSE</th><th>max</th><th>PSNR dB</th><th>SSIM</th><th>&gt; 0.05</th><th>FLIP</th></tr>\n";
+    for r in rows {
+        let m = &r.metrics;
+        let _ = writeln!(
+            out,
+            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.3}</td><td>{}</td><td>{:.4}</td><td>{:.2}%</td><td>{:.4}</td></tr>",
+            escape(&r.technique),
+            escape(&r.params.replace(';', "; ")),
+            number(r.gpu_ms_median, 3),
+            number(r.gpu_ms_min, 3),
+            m.mae_penumbra,
+            m.rmse,
+            m.max_abs,
+            number(Some(m.psnr), 2),
+            m.ssim,
+            m.frac_over_0_05 * 100.0,
+            r.flip
+        );
+    }
+    out += "</table>\n";
+    for (name, why) in context.skipped {
+        let _ = writeln!(
+            out,
+            "<p>Not run: <code>{}</code>: {}</p>",
+            escape(name),
+            escape(why)
+        );
+    }
+    out += "<p class=\"legend\">Each row: shaded image, visibility, and the error against the ground truth (red: darker than the reference, over-shadowing; blue: lighter, under-shadowing; full colour at an error of 0.5).</p>\n";
+    let _ = writeln!(
+        out,
+        "<figure><figcaption><code>{0}</code> (ground truth)</figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"></figure>",
+        escape(reference_name)
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "<figure><figcaption><code>{0}</code></figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"><img src=\"{0}/heatmap.png\" alt=\"{0} error\"></figure>",
+            escape(&r.technique)
+        );
+    }
+    out += "<script>\nwindow.addEventListener('load', () => {\n  const images = Array.from(document.images);\n  const loaded = images.filter((i) => i.complete && i.naturalWidth > 0).length;\n  document.body.dataset.imagesLoaded = loaded + '/' + images.length;\n});\n</script>\n</body>\n</html>\n";
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_fields_with_commas_are_quoted() {
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"x\""), "say \"x\"");
+        assert_eq!(csv_field("q\",x"), "\"q\"\",x\"");
+        assert_eq!(number(Some(f64::INFINITY), 2), "inf");
+        assert_eq!(number(None, 2), "");
+    }
+
+    #[test]
+    fn the_leading_columns_are_the_documented_ones() {
+        assert_eq!(
+            CSV_COLUMNS[..15].join(","),
+            "scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"
+        );
+    }
+}

@@ -1,0 +1,190 @@
+//! `ssm compare` end to end: the CSV has the documented columns and sane
+//! numbers, and `index.html` opens in headless Chromium with every image
+//! loaded. Chromium must be installed (scripts/install-deps.sh --for-tests):
+//! a missing browser fails the test, it does not skip it.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn ssm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .args(args)
+        .output()
+        .expect("the ssm binary runs")
+}
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ssm-report-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// Headless Chromium with the flags that keep it off the network.
+fn chromium(profile: &Path, args: &[&str]) -> std::process::Output {
+    let binary = ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|b| Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success()))
+        .unwrap_or_else(|| panic!("no Chromium found: install it with scripts/install-deps.sh --for-tests (Debian package chromium)"));
+    let profile_flag = format!("--user-data-dir={}", profile.display());
+    let mut command = Command::new(binary);
+    command.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--allow-file-access-from-files",
+        "--virtual-time-budget=5000",
+        &profile_flag,
+    ]);
+    command.args(args).output().expect("chromium runs")
+}
+
+#[test]
+fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
+    let out = scratch("compare");
+    let cache = scratch("cache");
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .env("SSM_CACHE_DIR", &cache)
+        .args([
+            "compare",
+            "--scene",
+            "parallel-square",
+            "--technique",
+            "hard,pcss",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--frames",
+            "2",
+            "--set",
+            "reference.samples=8",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().starts_with("scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"));
+    let rows: Vec<Vec<String>> = lines.map(|l| split_csv(l)).collect();
+    assert_eq!(rows.len(), 2);
+    let column = |row: &Vec<String>, i: usize| row[i].parse::<f64>().unwrap();
+    for row in &rows {
+        assert_eq!(row[0], "parallel-square");
+        assert!(column(row, 5) > 0.0, "GPU time is measured: {row:?}");
+        assert!(
+            (0.0..=1.0).contains(&column(row, 8)) && (0.0..=1.0).contains(&column(row, 12)),
+            "{row:?}"
+        );
+    }
+    let (hard, pcss) = (&rows[0], &rows[1]);
+    assert_eq!((hard[1].as_str(), pcss[1].as_str()), ("hard", "pcss"));
+    assert!(
+        column(pcss, 8) < column(hard, 8),
+        "pcss is nearer the ground truth than hard on parallel-square"
+    );
+    assert!(
+        std::fs::read_to_string(out.join("report.md"))
+            .unwrap()
+            .contains("| `pcss` |")
+    );
+    for file in [
+        "reference/shaded.png",
+        "hard/heatmap.png",
+        "pcss/visibility.png",
+        "pcss/visibility.exr",
+    ] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+
+    // The report, opened from disk with no network: every image loads.
+    let page = format!("file://{}", out.join("index.html").display());
+    let dom = chromium(&scratch("profile"), &["--dump-dom", &page]);
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    // Ground truth (2 images) + 2 techniques × 3 images.
+    assert!(
+        dom.contains("data-images-loaded=\"8/8\""),
+        "not every image loaded:\n{}",
+        &dom[..dom.len().min(2000)]
+    );
+    let screenshot = out.join("screenshot.png");
+    let shot = chromium(
+        &scratch("profile2"),
+        &[
+            "--window-size=1200,1600",
+            &format!("--screenshot={}", screenshot.display()),
+            &page,
+        ],
+    );
+    assert!(
+        screenshot.is_file(),
+        "{}",
+        String::from_utf8_lossy(&shot.stderr)
+    );
+    let image = image::open(&screenshot).unwrap().into_rgb8();
+    // Table text, grey scales and the heat maps' colours: a rendered page is far from uniform.
+    let colours: std::collections::HashSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() > 200,
+        "the page looks empty ({} colours)",
+        colours.len()
+    );
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&cache);
+}
+
+/// Splits one CSV line, honouring quotes.
+fn split_csv(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
+
+#[test]
+fn unknown_settings_in_compare_fail_with_one_line() {
+    let out = scratch("bad");
+    let output = ssm(&[
+        "compare",
+        "--scene",
+        "parallel-square",
+        "--technique",
+        "hard",
+        "--set",
+        "pcss.pcf_kernel=3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.lines().filter(|l| l.starts_with("error:")).count() == 1
+            && stderr.contains("not compared"),
+        "{stderr}"
+    );
+}
