@@ -80,7 +80,7 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     assert!(lines.next().unwrap().starts_with("scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"));
-    let rows: Vec<Vec<String>> = lines.map(|l| split_csv(l)).collect();
+    let rows: Vec<Vec<String>> = lines.map(split_csv).collect();
     assert_eq!(rows.len(), 2);
     let column = |row: &Vec<String>, i: usize| row[i].parse::<f64>().unwrap();
     for row in &rows {
