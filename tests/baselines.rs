@@ -33,15 +33,7 @@ fn pcss_follows_the_analytic_penumbra_and_hard_does_not() {
     let gpu = gpu();
     let scene = builtin("parallel-square").unwrap().build();
     let hard = render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT).unwrap();
-    let pcss = render(
-        &gpu,
-        &scene,
-        "pcss",
-        &[("pcf_kernel", "24"), ("blocker_kernel", "12")],
-        WIDTH,
-        HEIGHT,
-    )
-    .unwrap();
+    let pcss = render(&gpu, &scene, "pcss", &[("pcf_kernel", "24"), ("blocker_kernel", "12")], WIDTH, HEIGHT).unwrap();
     // Along the x axis through the penumbra: the exact visibility rises from 0 at x = 0.5 to 1 at x = 1.5.
     let (mut hard_error, mut pcss_error, mut samples) = (0.0, 0.0, 0);
     for step in 0..=20 {
@@ -56,19 +48,10 @@ fn pcss_follows_the_analytic_penumbra_and_hard_does_not() {
     // Hard shadows are off by 0.25 on average across a linear ramp; PCSS on parallel planes is close to exact,
     // up to the pixel footprint (about 0.05 world units here) and the regular-grid quantisation.
     assert!(pcss_error < 0.08, "pcss penumbra error {pcss_error}");
-    assert!(
-        pcss_error < hard_error * 0.5,
-        "pcss {pcss_error} vs hard {hard_error}"
-    );
+    assert!(pcss_error < hard_error * 0.5, "pcss {pcss_error} vs hard {hard_error}");
     // Half-way through the penumbra, half the light is visible.
-    let middle = at(
-        &pcss,
-        pixel_of(&scene, WIDTH, HEIGHT, Vec3::new(1.0, 0.0, 0.0)),
-    );
-    assert!(
-        (middle - 0.5).abs() < 0.1,
-        "pcss at the middle of the penumbra reads {middle}"
-    );
+    let middle = at(&pcss, pixel_of(&scene, WIDTH, HEIGHT, Vec3::new(1.0, 0.0, 0.0)));
+    assert!((middle - 0.5).abs() < 0.1, "pcss at the middle of the penumbra reads {middle}");
 }
 
 #[test]
@@ -77,21 +60,13 @@ fn every_builtin_scene_renders_with_both_baselines() {
     for entry in BUILTIN_SCENES {
         let scene = entry.build();
         for technique in ["hard", "pcss"] {
-            let rendered = render(&gpu, &scene, technique, &[], WIDTH, HEIGHT)
-                .unwrap_or_else(|e| panic!("{} / {technique}: {e}", entry.name));
+            let rendered =
+                render(&gpu, &scene, technique, &[], WIDTH, HEIGHT).unwrap_or_else(|e| panic!("{} / {technique}: {e}", entry.name));
             let shadowed = rendered.visibility.iter().filter(|v| **v < 0.5).count();
             let lit = rendered.visibility.iter().filter(|v| **v > 0.5).count();
             // Every built-in scene casts a visible shadow onto a lit receiver.
-            assert!(
-                shadowed > 50,
-                "{} / {technique}: only {shadowed} shadowed pixels",
-                entry.name
-            );
-            assert!(
-                lit > shadowed,
-                "{} / {technique}: {lit} lit vs {shadowed} shadowed",
-                entry.name
-            );
+            assert!(shadowed > 50, "{} / {technique}: only {shadowed} shadowed pixels", entry.name);
+            assert!(lit > shadowed, "{} / {technique}: {lit} lit vs {shadowed} shadowed", entry.name);
         }
     }
 }
@@ -102,14 +77,8 @@ fn pcss_receiver_plane_test_removes_self_shadowing_at_grazing_light() {
     let gpu = gpu();
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.instances.retain(|i| i.name == "ground");
-    scene.lights[0] = ssm_scene::RectLight::try_facing(
-        Vec3::new(-12.0, 0.25, 0.0),
-        Vec3::new(1.0, -0.02, 0.0),
-        Vec3::Z,
-        glam::Vec2::ONE,
-        1.0,
-    )
-    .unwrap();
+    scene.lights[0] =
+        ssm_scene::RectLight::try_facing(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), Vec3::Z, glam::Vec2::ONE, 1.0).unwrap();
     let lit_share = |settings: &[(&str, &str)]| {
         let rendered = render(&gpu, &scene, "pcss", settings, WIDTH, HEIGHT).unwrap();
         let covered = rendered.covered_visibility();
@@ -117,14 +86,6 @@ fn pcss_receiver_plane_test_removes_self_shadowing_at_grazing_light() {
     };
     let with_plane = lit_share(&[]);
     let without_plane = lit_share(&[("receiver_plane", "false")]);
-    assert!(
-        with_plane > 0.99,
-        "with the receiver plane, {:.1}% of the bare receiver reads lit",
-        with_plane * 100.0
-    );
-    assert!(
-        without_plane < 0.9,
-        "without it, the receiver shadows itself: {:.1}% lit",
-        without_plane * 100.0
-    );
+    assert!(with_plane > 0.99, "with the receiver plane, {:.1}% of the bare receiver reads lit", with_plane * 100.0);
+    assert!(without_plane < 0.9, "without it, the receiver shadows itself: {:.1}% lit", without_plane * 100.0);
 }

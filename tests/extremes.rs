@@ -15,9 +15,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Vec2, Vec3};
 use ssm_core::{Error, Registry};
 use ssm_integration_tests::{Rendered, gpu, link_techniques, render};
-use ssm_scene::{
-    Instance, Manifest, Mesh, RectLight, Role, Scene, SceneError, builtin, primitives,
-};
+use ssm_scene::{Instance, Manifest, Mesh, RectLight, Role, Scene, SceneError, builtin, primitives};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;
@@ -37,21 +35,14 @@ enum Expect {
 
 fn from_manifest(name: &str, text: &str) -> Scene {
     let origin = PathBuf::from(format!("extreme:{name}"));
-    Manifest::parse(text, &origin)
-        .unwrap()
-        .build(&origin, Path::new("."))
-        .unwrap()
+    Manifest::parse(text, &origin).unwrap().build(&origin, Path::new(".")).unwrap()
 }
 
 /// `parallel-square` with its light and occluder changed.
 fn parallel_square_with(light: RectLight, occluder_height: f32) -> Scene {
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.lights = vec![light];
-    let occluder = scene
-        .instances
-        .iter_mut()
-        .find(|i| i.role == Role::Occluder)
-        .unwrap();
+    let occluder = scene.instances.iter_mut().find(|i| i.role == Role::Occluder).unwrap();
     occluder.transform = Mat4::from_translation(Vec3::new(0.0, occluder_height, 0.0));
     scene
 }
@@ -63,43 +54,24 @@ fn square_light(centre: Vec3, normal: Vec3, size: f32) -> RectLight {
 fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
     let down = -Vec3::Y;
     let mut scenes = vec![
-        (
-            "occluder touching the receiver",
-            builtin("contact").unwrap().build(),
-            Expect::InRange,
-        ),
+        ("occluder touching the receiver", builtin("contact").unwrap().build(), Expect::InRange),
         // Atty et al., Eq. 3: the penumbra extent grows without bound as the occluder nears the light.
         (
             "occluder almost touching the light",
             parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 3.999),
             Expect::InRange,
         ),
-        (
-            "occluder in the light's plane",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 4.0),
-            Expect::InRange,
-        ),
-        (
-            "point light",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 0.0), 2.0),
-            Expect::NoPenumbra,
-        ),
+        ("occluder in the light's plane", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 4.0), Expect::InRange),
+        ("point light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 0.0), 2.0), Expect::NoPenumbra),
         (
             "light far larger than the occluder",
             parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 50.0), 2.0),
             Expect::InRange,
         ),
-        (
-            "tiny light",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1e-4), 2.0),
-            Expect::InRange,
-        ),
+        ("tiny light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1e-4), 2.0), Expect::InRange),
         (
             "grazing light",
-            parallel_square_with(
-                square_light(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), 1.0),
-                2.0,
-            ),
+            parallel_square_with(square_light(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), 1.0), 2.0),
             Expect::InRange,
         ),
         (
@@ -107,11 +79,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
             parallel_square_with(square_light(Vec3::new(0.0, -1.0, 0.0), down, 1.0), 2.0),
             Expect::AllDark,
         ),
-        (
-            "occluder behind the light",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 5.0),
-            Expect::AllLit,
-        ),
+        ("occluder behind the light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 5.0), Expect::AllLit),
     ];
 
     scenes.push((
@@ -147,10 +115,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
     scenes.push(("degenerate triangles", scene, Expect::InRange));
 
     // The same analytic scene at very small and very large scales: depth ranges of 1e-3 and 1e3.
-    for (name, scale) in [
-        ("scene a thousandth the size", 1e-3f32),
-        ("scene a thousand times the size", 1e3),
-    ] {
+    for (name, scale) in [("scene a thousandth the size", 1e-3f32), ("scene a thousand times the size", 1e3)] {
         let mut scene = builtin("parallel-square").unwrap().build();
         for instance in &mut scene.instances {
             instance.transform = Mat4::from_scale(Vec3::splat(scale)) * instance.transform;
@@ -166,9 +131,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
 
     // The coarsest closed mesh the sphere generator makes (3 segments, 2 rings: a triangular bipyramid), resting on the ground.
     let mut scene = builtin("floating-sphere").unwrap().build();
-    scene
-        .meshes
-        .push(primitives::sphere("bipyramid", 0.6, 3, 2));
+    scene.meshes.push(primitives::sphere("bipyramid", 0.6, 3, 2));
     scene.instances.push(Instance {
         name: "coarse sphere".into(),
         mesh: scene.meshes.len() - 1,
@@ -182,30 +145,17 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
 fn check(technique: &str, scene_name: &str, expect: Expect, rendered: &Rendered) {
     let covered = rendered.covered_visibility();
     assert!(!covered.is_empty(), "{scene_name}: the camera sees nothing");
-    let share = |keep: &dyn Fn(f32) -> bool| {
-        covered.iter().filter(|v| keep(**v)).count() as f32 / covered.len() as f32
-    };
+    let share = |keep: &dyn Fn(f32) -> bool| covered.iter().filter(|v| keep(**v)).count() as f32 / covered.len() as f32;
     match expect {
         Expect::InRange => {}
-        Expect::AllDark => assert!(
-            covered.iter().all(|v| *v == 0.0),
-            "{technique} / {scene_name}: lit pixels behind the light"
-        ),
+        Expect::AllDark => assert!(covered.iter().all(|v| *v == 0.0), "{technique} / {scene_name}: lit pixels behind the light"),
         Expect::AllLit => {
             let dark = share(&|v| v < 0.95);
-            assert!(
-                dark < 0.01,
-                "{technique} / {scene_name}: {:.1}% of pixels read below 0.95",
-                dark * 100.0
-            );
+            assert!(dark < 0.01, "{technique} / {scene_name}: {:.1}% of pixels read below 0.95", dark * 100.0);
         }
         Expect::NoPenumbra => {
             let penumbra = share(&|v| v > 0.02 && v < 0.98);
-            assert!(
-                penumbra < 0.01,
-                "{technique} / {scene_name}: {:.1}% of pixels in a penumbra",
-                penumbra * 100.0
-            );
+            assert!(penumbra < 0.01, "{technique} / {scene_name}: {:.1}% of pixels in a penumbra", penumbra * 100.0);
         }
     }
 }
@@ -223,13 +173,14 @@ fn every_technique_survives_every_extreme() {
                 Ok(rendered) => {
                     runs += 1;
                     if let Err(panic) =
-                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                            check(info.name, scene_name, expect, &rendered)
-                        }))
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| check(info.name, scene_name, expect, &rendered)))
                     {
-                        failures.push(panic.downcast_ref::<String>().cloned().unwrap_or_else(
-                            || format!("{} / {scene_name}: check failed", info.name),
-                        ));
+                        failures.push(
+                            panic
+                                .downcast_ref::<String>()
+                                .cloned()
+                                .unwrap_or_else(|| format!("{} / {scene_name}: check failed", info.name)),
+                        );
                     }
                 }
                 // A clear refusal is allowed; a wrong or broken output is not.
@@ -254,14 +205,8 @@ fn non_finite_geometry_is_a_typed_error_before_any_rendering() {
     }
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.instances[1].transform.w_axis.x = f32::INFINITY;
-    assert!(matches!(
-        render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT),
-        Err(Error::Scene(SceneError::InvalidTransform { .. }))
-    ));
+    assert!(matches!(render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT), Err(Error::Scene(SceneError::InvalidTransform { .. }))));
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.lights[0].half_size.x = f32::NAN;
-    assert!(matches!(
-        render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT),
-        Err(Error::Scene(SceneError::InvalidLight { .. }))
-    ));
+    assert!(matches!(render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT), Err(Error::Scene(SceneError::InvalidLight { .. }))));
 }

@@ -11,9 +11,7 @@ use ssm_integration_tests::{gpu, render};
 use ssm_scene::Scene;
 
 fn load(manifest: &str) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../models")
-        .join(manifest);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models").join(manifest);
     match Scene::load(path.to_str().unwrap()) {
         Ok((scene, _)) => scene,
         Err(e) => panic!("{e}\n(run scripts/fetch-models.sh to fetch the test models)"),
@@ -23,27 +21,15 @@ fn load(manifest: &str) -> Scene {
 #[test]
 fn fetched_models_render_with_both_baselines() {
     let gpu = gpu();
-    for (manifest, triangles) in [
-        ("dragon.toml", 202_520),
-        ("bunny.toml", 69_666),
-        ("sponza.toml", 66_000),
-    ] {
+    for (manifest, triangles) in [("dragon.toml", 202_520), ("bunny.toml", 69_666), ("sponza.toml", 66_000)] {
         let scene = load(manifest);
         // Receiver planes add two triangles; Sponza's quads are split, so only a lower bound holds there.
-        assert!(
-            scene.triangle_count() >= triangles,
-            "{manifest}: {} triangles",
-            scene.triangle_count()
-        );
+        assert!(scene.triangle_count() >= triangles, "{manifest}: {} triangles", scene.triangle_count());
         for technique in ["hard", "pcss"] {
-            let rendered = render(&gpu, &scene, technique, &[], 128, 96)
-                .unwrap_or_else(|e| panic!("{manifest} / {technique}: {e}"));
+            let rendered = render(&gpu, &scene, technique, &[], 128, 96).unwrap_or_else(|e| panic!("{manifest} / {technique}: {e}"));
             let shadowed = rendered.visibility.iter().filter(|v| **v < 0.5).count();
             let lit = rendered.visibility.iter().filter(|v| **v > 0.5).count();
-            assert!(
-                shadowed > 100 && lit > 100,
-                "{manifest} / {technique}: {shadowed} shadowed, {lit} lit"
-            );
+            assert!(shadowed > 100 && lit > 100, "{manifest} / {technique}: {shadowed} shadowed, {lit} lit");
         }
     }
 }

@@ -17,10 +17,7 @@ fn outside_technique_is_registered_and_listed_in_order() {
     let registry = Registry::global().unwrap();
     let names = registry.names();
     assert!(names.contains(&"front-of-light"), "{names:?}");
-    assert!(
-        names.contains(&"hard") && names.contains(&"pcss"),
-        "{names:?}"
-    );
+    assert!(names.contains(&"hard") && names.contains(&"pcss"), "{names:?}");
     let mut sorted = names.clone();
     sorted.sort_unstable();
     assert_eq!(names, sorted, "the listing is sorted by name");
@@ -51,15 +48,9 @@ primitive = "plane"
 size = [8.0, 8.0]
 role = "receiver"
 "#;
-    let scene = Manifest::parse(text, Path::new("inline.toml"))
-        .unwrap()
-        .build(Path::new("inline.toml"), Path::new("."))
-        .unwrap();
+    let scene = Manifest::parse(text, Path::new("inline.toml")).unwrap().build(Path::new("inline.toml"), Path::new(".")).unwrap();
     let rendered = render(&gpu, &scene, "front-of-light", &[], 64, 48).unwrap();
     let covered = rendered.covered_visibility();
     assert!(covered.len() > 500, "the plane covers the view");
-    assert!(
-        covered.iter().all(|v| *v == 0.0),
-        "everything is behind the light"
-    );
+    assert!(covered.iter().all(|v| *v == 0.0), "everything is behind the light");
 }

@@ -22,10 +22,7 @@ const SIZE: (u32, u32) = (128, 96);
 fn errors(samples: u32) -> (f32, f32, usize) {
     let gpu = gpu();
     let scene = builtin("parallel-square").unwrap().build();
-    let settings = [
-        ("samples", samples.to_string()),
-        ("cache", "false".to_owned()),
-    ];
+    let settings = [("samples", samples.to_string()), ("cache", "false".to_owned())];
     let settings: Vec<(&str, &str)> = settings.iter().map(|(k, v)| (*k, v.as_str())).collect();
     let rendered = render(&gpu, &scene, "reference", &settings, SIZE.0, SIZE.1).unwrap();
     let positions = rendered.renderer.read_positions().unwrap();
@@ -35,12 +32,7 @@ fn errors(samples: u32) -> (f32, f32, usize) {
         if p[3] < 0.5 {
             continue;
         }
-        let exact = parallel_rectangle_visibility(
-            light,
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec2::splat(0.5),
-            Vec3::new(p[0], p[1], p[2]),
-        );
+        let exact = parallel_rectangle_visibility(light, Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5), Vec3::new(p[0], p[1], p[2]));
         let error = (traced - exact).abs();
         max = max.max(error);
         if exact > 0.0 && exact < 1.0 {
@@ -62,18 +54,9 @@ fn ray_caster_matches_the_analytic_parallel_square_within_the_sampling_error() {
             4.0 / n_f,
             n_f.powf(-1.5)
         );
-        assert!(
-            penumbra > 500,
-            "the penumbra covers too few pixels ({penumbra}) to measure"
-        );
-        assert!(
-            max <= 4.0 / n_f + 1e-4,
-            "N = {n}: max error {max} above 4/N"
-        );
-        assert!(
-            mean <= n_f.powf(-1.5),
-            "N = {n}: mean error {mean} above N^-1.5"
-        );
+        assert!(penumbra > 500, "the penumbra covers too few pixels ({penumbra}) to measure");
+        assert!(max <= 4.0 / n_f + 1e-4, "N = {n}: max error {max} above 4/N");
+        assert!(mean <= n_f.powf(-1.5), "N = {n}: mean error {mean} above N^-1.5");
         means.push(mean);
     }
     // The error falls with N (about as N^-1.5: 8x from N = 8 to 32; ask for 3x).
@@ -84,15 +67,8 @@ fn ray_caster_matches_the_analytic_parallel_square_within_the_sampling_error() {
 fn cached_results_are_identical_and_keyed_by_their_inputs() {
     let scene = builtin("parallel-square").unwrap().build();
     let truth = GroundTruth::new(&scene);
-    let points: Vec<Option<SurfacePoint>> = (0..64)
-        .map(|i| {
-            Some(SurfacePoint {
-                position: Vec3::new(i as f32 * 0.04, 0.0, 0.3),
-                normal: Vec3::Y,
-            })
-        })
-        .chain([None])
-        .collect();
+    let points: Vec<Option<SurfacePoint>> =
+        (0..64).map(|i| Some(SurfacePoint { position: Vec3::new(i as f32 * 0.04, 0.0, 0.3), normal: Vec3::Y })).chain([None]).collect();
     let dir = std::env::temp_dir().join(format!("ssm-reference-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let light = &scene.lights[0];
@@ -101,11 +77,7 @@ fn cached_results_are_identical_and_keyed_by_their_inputs() {
     let again = truth.trace_cached(light, &points, 8, 1, &dir);
     assert!(again.cached && again.rays == 0);
     assert_eq!(first.visibility, again.visibility);
-    assert_eq!(
-        *first.visibility.last().unwrap(),
-        1.0,
-        "a pixel without a surface is lit"
-    );
+    assert_eq!(*first.visibility.last().unwrap(), 1.0, "a pixel without a surface is lit");
     // A different sample count or seed is a different entry.
     assert!(!truth.trace_cached(light, &points, 4, 1, &dir).cached);
     assert!(!truth.trace_cached(light, &points, 8, 2, &dir).cached);
@@ -119,20 +91,11 @@ fn a_point_behind_the_light_or_a_point_light_gives_exact_answers() {
     let truth = GroundTruth::new(&scene);
     let mut light = scene.lights[0];
     let mut rng = ssm_core::reference::SplitMix64::for_pixel(1, 0);
-    let behind = SurfacePoint {
-        position: Vec3::new(0.0, 5.0, 0.0),
-        normal: Vec3::Y,
-    };
+    let behind = SurfacePoint { position: Vec3::new(0.0, 5.0, 0.0), normal: Vec3::Y };
     assert_eq!(truth.visibility(&light, &behind, 8, &mut rng), 0.0);
     light.half_size = Vec2::ZERO;
-    let under = SurfacePoint {
-        position: Vec3::new(0.9, 0.0, 0.0),
-        normal: Vec3::Y,
-    };
-    let beside = SurfacePoint {
-        position: Vec3::new(1.1, 0.0, 0.0),
-        normal: Vec3::Y,
-    };
+    let under = SurfacePoint { position: Vec3::new(0.9, 0.0, 0.0), normal: Vec3::Y };
+    let beside = SurfacePoint { position: Vec3::new(1.1, 0.0, 0.0), normal: Vec3::Y };
     assert_eq!(truth.visibility(&light, &under, 8, &mut rng), 0.0);
     assert_eq!(truth.visibility(&light, &beside, 8, &mut rng), 1.0);
 }

@@ -45,24 +45,13 @@ fn every_wgsl_file_parses_and_validates() {
         let module = match naga::front::wgsl::parse_str(&composed) {
             Ok(module) => module,
             Err(e) => {
-                failures.push(format!(
-                    "{}:\n{}",
-                    file.display(),
-                    e.emit_to_string(&composed)
-                ));
+                failures.push(format!("{}:\n{}", file.display(), e.emit_to_string(&composed)));
                 continue;
             }
         };
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        );
+        let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default());
         if let Err(e) = validator.validate(&module) {
-            failures.push(format!(
-                "{}:\n{}",
-                file.display(),
-                e.emit_to_string(&composed)
-            ));
+            failures.push(format!("{}:\n{}", file.display(), e.emit_to_string(&composed)));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
@@ -72,18 +61,13 @@ fn every_wgsl_file_parses_and_validates() {
 fn embedded_common_shaders_match_the_files() {
     let root = shaders_dir();
     for (path, text) in COMMON_SHADERS {
-        let on_disk =
-            std::fs::read_to_string(root.join(path)).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let on_disk = std::fs::read_to_string(root.join(path)).unwrap_or_else(|e| panic!("{path}: {e}"));
         assert_eq!(&on_disk, text, "{path}");
     }
     // Every file under common/ is importable at run time.
     let mut files = Vec::new();
     wgsl_files(&root.join("common"), &mut files);
-    assert_eq!(
-        files.len(),
-        COMMON_SHADERS.len(),
-        "a file under shaders/common is missing from COMMON_SHADERS"
-    );
+    assert_eq!(files.len(), COMMON_SHADERS.len(), "a file under shaders/common is missing from COMMON_SHADERS");
 }
 
 #[test]
@@ -93,27 +77,15 @@ fn unknown_imports_and_cycles_are_errors() {
         "b.wgsl" => Some("// #import a.wgsl\nfn b() {}".to_owned()),
         _ => None,
     };
-    assert!(
-        compose_with("// #import nope.wgsl", &lookup)
-            .unwrap_err()
-            .contains("nope.wgsl")
-    );
-    assert!(
-        compose_with("// #import a.wgsl", &lookup)
-            .unwrap_err()
-            .contains("cycle")
-    );
+    assert!(compose_with("// #import nope.wgsl", &lookup).unwrap_err().contains("nope.wgsl"));
+    assert!(compose_with("// #import a.wgsl", &lookup).unwrap_err().contains("cycle"));
     let diamond = |import: &str| match import {
         "a.wgsl" => Some("// #import c.wgsl\nfn a() {}".to_owned()),
         "b.wgsl" => Some("// #import c.wgsl\nfn b() {}".to_owned()),
         "c.wgsl" => Some("fn c() {}".to_owned()),
         _ => None,
     };
-    let composed = compose_with(
-        "// #import a.wgsl\n// #import b.wgsl\nfn main() {}",
-        &diamond,
-    )
-    .unwrap();
+    let composed = compose_with("// #import a.wgsl\n// #import b.wgsl\nfn main() {}", &diamond).unwrap();
     assert_eq!(composed.matches("fn c()").count(), 1, "{composed}");
     assert!(composed.find("fn c()") < composed.find("fn a()"));
 }

@@ -48,18 +48,12 @@ pub fn render(
     link_techniques();
     let info = Registry::global()?.get(technique)?;
     let params = info.params_from(settings.iter().copied())?;
-    let needs = (info.requirements)(&params)?.union(Requirements {
-        gbuffer: true,
-        ..Requirements::NONE
-    });
+    let needs = (info.requirements)(&params)?.union(Requirements { gbuffer: true, ..Requirements::NONE });
     let mut renderer = Renderer::new(gpu, scene, width, height, &needs)?;
     let mut instance = renderer.create_technique(info, &params)?;
     renderer.render(instance.as_mut(), technique)?;
     let visibility = renderer.read_visibility(0, technique)?;
-    Ok(Rendered {
-        renderer,
-        visibility,
-    })
+    Ok(Rendered { renderer, visibility })
 }
 
 impl Rendered {
@@ -69,16 +63,8 @@ impl Rendered {
     /// If the positions cannot be read back.
     #[must_use]
     pub fn covered_visibility(&self) -> Vec<f32> {
-        let positions = self
-            .renderer
-            .read_positions()
-            .unwrap_or_else(|e| panic!("{e}"));
-        self.visibility
-            .iter()
-            .zip(&positions)
-            .filter(|(_, p)| p[3] > 0.5)
-            .map(|(v, _)| *v)
-            .collect()
+        let positions = self.renderer.read_positions().unwrap_or_else(|e| panic!("{e}"));
+        self.visibility.iter().zip(&positions).filter(|(_, p)| p[3] > 0.5).map(|(v, _)| *v).collect()
     }
 }
 
@@ -87,12 +73,8 @@ impl Rendered {
 pub fn pixel_of(scene: &Scene, width: u32, height: u32, world: Vec3) -> (u32, u32) {
     let view_proj = scene.camera.projection(width as f32 / height as f32) * scene.camera.view();
     let ndc = view_proj.project_point3(world);
-    let x = ((ndc.x * 0.5 + 0.5) * width as f32)
-        .floor()
-        .clamp(0.0, width as f32 - 1.0);
-    let y = ((0.5 - ndc.y * 0.5) * height as f32)
-        .floor()
-        .clamp(0.0, height as f32 - 1.0);
+    let x = ((ndc.x * 0.5 + 0.5) * width as f32).floor().clamp(0.0, width as f32 - 1.0);
+    let y = ((0.5 - ndc.y * 0.5) * height as f32).floor().clamp(0.0, height as f32 - 1.0);
     (x as u32, y as u32)
 }
 
@@ -158,50 +140,29 @@ pub fn compare_with_reference(
 ) -> Result<(), String> {
     let reference_path = directory.join(format!("{name}.png"));
     let to_png = |values: &[f32]| {
-        let pixels: Vec<u16> = values
-            .iter()
-            .map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16)
-            .collect();
+        let pixels: Vec<u16> = values.iter().map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16).collect();
         image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
     };
     let Some(actual) = to_png(values) else {
-        return Err(format!(
-            "{name}: {} values for {width}x{height}",
-            values.len()
-        ));
+        return Err(format!("{name}: {} values for {width}x{height}", values.len()));
     };
     if bless {
         std::fs::create_dir_all(directory).map_err(|e| e.to_string())?;
-        return actual
-            .save(&reference_path)
-            .map_err(|e| format!("{}: {e}", reference_path.display()));
+        return actual.save(&reference_path).map_err(|e| format!("{}: {e}", reference_path.display()));
     }
     let reference = match image::open(&reference_path) {
         Ok(image) => image.into_luma16(),
         Err(e) => {
-            return Err(format!(
-                "{}: {e}; render it with {BLESS_VARIABLE}=1 and review it before committing",
-                reference_path.display()
-            ));
+            return Err(format!("{}: {e}; render it with {BLESS_VARIABLE}=1 and review it before committing", reference_path.display()));
         }
     };
     if reference.dimensions() != (width, height) {
-        return Err(format!(
-            "{name}: reference is {:?}, image is {width}x{height}",
-            reference.dimensions()
-        ));
+        return Err(format!("{name}: reference is {:?}, image is {width}x{height}", reference.dimensions()));
     }
-    let differences: Vec<f32> = actual
-        .pixels()
-        .zip(reference.pixels())
-        .map(|(a, r)| (f32::from(a.0[0]) - f32::from(r.0[0])) / 65535.0)
-        .collect();
+    let differences: Vec<f32> =
+        actual.pixels().zip(reference.pixels()).map(|(a, r)| (f32::from(a.0[0]) - f32::from(r.0[0])) / 65535.0).collect();
     let mean = differences.iter().map(|d| d.abs()).sum::<f32>() / differences.len() as f32;
-    let wrong_share = differences
-        .iter()
-        .filter(|d| d.abs() > tolerance.pixel)
-        .count() as f32
-        / differences.len() as f32;
+    let wrong_share = differences.iter().filter(|d| d.abs() > tolerance.pixel).count() as f32 / differences.len() as f32;
     if mean <= tolerance.mean && wrong_share <= tolerance.wrong_share {
         return Ok(());
     }
@@ -212,11 +173,7 @@ pub fn compare_with_reference(
         let d = differences[(y * width + x) as usize];
         let strength = (d.abs() * 4.0).min(1.0) * 255.0;
         // Red: darker than the reference (more shadow); blue: lighter.
-        if d < 0.0 {
-            image::Rgb([strength as u8, 0, 0])
-        } else {
-            image::Rgb([0, 0, strength as u8])
-        }
+        if d < 0.0 { image::Rgb([strength as u8, 0, 0]) } else { image::Rgb([0, 0, strength as u8]) }
     });
     let _ = diff.save(&diff_path);
     Err(format!(

@@ -2,6 +2,7 @@
 //! list of linked technique crates and the rendering of one technique to files.
 
 pub mod report;
+pub mod sweep;
 
 use std::path::Path;
 
@@ -13,12 +14,7 @@ use ssm_core::{GpuContext, ParamValues, Registry, Renderer, Requirements, Techni
 /// registrations reach the registry. A new technique crate adds one line here
 /// and one dependency in this crate's manifest.
 pub fn link_techniques() -> [&'static str; 4] {
-    [
-        ssm_core::reference::link(),
-        ssm_hard::link(),
-        ssm_multi_sm::link(),
-        ssm_pcss::link(),
-    ]
+    [ssm_core::reference::link(), ssm_hard::link(), ssm_multi_sm::link(), ssm_pcss::link()]
 }
 
 /// The registry, with every technique crate linked.
@@ -39,21 +35,14 @@ pub fn median(values: &[f64]) -> Option<f64> {
     }
     sorted.sort_by(f64::total_cmp);
     let mid = sorted.len() / 2;
-    Some(if sorted.len().is_multiple_of(2) {
-        (sorted[mid - 1] + sorted[mid]) * 0.5
-    } else {
-        sorted[mid]
-    })
+    Some(if sorted.len().is_multiple_of(2) { (sorted[mid - 1] + sorted[mid]) * 0.5 } else { sorted[mid] })
 }
 
 /// The shared inputs every output of `ssm render` needs: the G-buffer, for
 /// the shaded image and the world positions.
 #[must_use]
 pub fn output_requirements() -> Requirements {
-    Requirements {
-        gbuffer: true,
-        ..Requirements::NONE
-    }
+    Requirements { gbuffer: true, ..Requirements::NONE }
 }
 
 /// Renders `info` with `params` for one warm-up and `frames` timed frames
@@ -87,14 +76,8 @@ pub fn render_technique(
         "diagnostics": measured.diagnostics.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
     });
     let file = dir.join("timings.json");
-    let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::Write {
-        file: file.clone(),
-        message: e.to_string(),
-    })?;
-    std::fs::write(&file, text).map_err(|e| ssm_core::Error::Write {
-        file,
-        message: e.to_string(),
-    })?;
+    let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::Write { file: file.clone(), message: e.to_string() })?;
+    std::fs::write(&file, text).map_err(|e| ssm_core::Error::Write { file, message: e.to_string() })?;
     Ok(measured)
 }
 
@@ -104,16 +87,7 @@ pub fn render_technique(
 /// GPU or file errors.
 pub fn write_positions(renderer: &Renderer, file: &Path) -> ssm_core::Result<()> {
     let positions = renderer.read_positions()?;
-    let rgb: Vec<[f32; 3]> = positions
-        .iter()
-        .map(|p| {
-            if p[3] > 0.5 {
-                [p[0], p[1], p[2]]
-            } else {
-                [0.0; 3]
-            }
-        })
-        .collect();
+    let rgb: Vec<[f32; 3]> = positions.iter().map(|p| if p[3] > 0.5 { [p[0], p[1], p[2]] } else { [0.0; 3] }).collect();
     write_exr_rgb(file, renderer.width(), renderer.height(), &rgb)
 }
 

@@ -7,18 +7,12 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use ssm_bench::{
-    output_requirements, registry, render_technique, report, support_on, write_positions,
-};
+use ssm_bench::{output_requirements, registry, render_technique, report, support_on, sweep, write_positions};
 use ssm_core::{GpuContext, ParamValues, Renderer, Requirements, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
 
 #[derive(Parser)]
-#[command(
-    name = "ssm",
-    version,
-    about = "Soft-shadow techniques as plug-ins, compared on identical scenes"
-)]
+#[command(name = "ssm", version, about = "Soft-shadow techniques as plug-ins, compared on identical scenes")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -34,6 +28,42 @@ enum Command {
     Render(RenderArgs),
     /// Render every technique (or those named) and the ground truth; write results.csv, report.md and index.html.
     Compare(CompareArgs),
+    /// Vary techniques' parameters over a grid; write sweep.csv and the time-against-error plot (PNG, SVG).
+    Sweep(SweepArgs),
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// A built-in scene name, a scene manifest (.toml) or a model file.
+    #[arg(long, required_unless_present = "list_presets")]
+    scene: Option<String>,
+    /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step); repeatable.
+    #[arg(long = "vary", value_name = "TECHNIQUE.PARAM=V1,V2,...")]
+    varies: Vec<String>,
+    /// A named set of --vary axes (see `ssm sweep --list-presets`).
+    #[arg(long)]
+    preset: Option<String>,
+    /// List the presets and exit.
+    #[arg(long)]
+    list_presets: bool,
+    /// Fixed parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
+    #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
+    settings: Vec<String>,
+    /// The error measure plotted against time.
+    #[arg(long, value_enum, default_value = "mae-penumbra")]
+    error: sweep::ErrorAxis,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Frames timed per point after one warm-up.
+    #[arg(long, default_value_t = 3)]
+    frames: u32,
+    /// Output directory: sweep.csv, sweep.png, sweep.svg.
+    #[arg(long, required_unless_present = "list_presets")]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -100,15 +130,13 @@ fn main() -> ExitCode {
         Command::Scenes => scenes(),
         Command::Render(args) => render(&args),
         Command::Compare(args) => compare(&args),
+        Command::Sweep(args) => sweep_command(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that stopped reading (`ssm list | head`) is not a failure.
         Err(error)
-            if error.chain().any(|e| {
-                e.downcast_ref::<std::io::Error>()
-                    .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
-            }) =>
+            if error.chain().any(|e| e.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)) =>
         {
             ExitCode::SUCCESS
         }
@@ -136,14 +164,7 @@ fn list() -> Result<()> {
             say!("  runs here: {}", support_on(gpu, info));
         }
         for spec in info.params {
-            say!(
-                "  --set {}.{}={}  ({}; {})",
-                info.name,
-                spec.name,
-                spec.default_value(),
-                spec.range_text(),
-                spec.doc
-            );
+            say!("  --set {}.{}={}  ({}; {})", info.name, spec.name, spec.default_value(), spec.range_text(), spec.doc);
         }
         say!("");
     }
@@ -153,41 +174,25 @@ fn list() -> Result<()> {
 fn scenes() -> Result<()> {
     for scene in BUILTIN_SCENES {
         let built = scene.build();
-        say!(
-            "{:<16} {:>7} triangles  {}",
-            scene.name,
-            built.triangle_count(),
-            scene.summary
-        );
+        say!("{:<16} {:>7} triangles  {}", scene.name, built.triangle_count(), scene.summary);
     }
     Ok(())
 }
 
 /// Splits `technique.param=value`.
 fn parse_setting(text: &str) -> Result<(&str, &str, &str)> {
-    let (key, value) = text
-        .split_once('=')
-        .with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
-    let (technique, param) = key
-        .split_once('.')
-        .with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
+    let (key, value) = text.split_once('=').with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
+    let (technique, param) = key.split_once('.').with_context(|| format!("--set `{text}`: expected <technique>.<param>=<value>"))?;
     Ok((technique.trim(), param.trim(), value.trim()))
 }
 
 fn render(args: &RenderArgs) -> Result<()> {
     let registry = registry()?;
     let scene = load_scene(&args.scene)?;
-    let settings: Vec<(&str, &str, &str)> = args
-        .settings
-        .iter()
-        .map(|s| parse_setting(s))
-        .collect::<Result<_>>()?;
+    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
     for (technique, _, _) in &settings {
         if !args.technique.iter().any(|t| t == technique) {
-            bail!(
-                "--set names technique `{technique}`, which is not among --technique {}",
-                args.technique.join(",")
-            );
+            bail!("--set names technique `{technique}`, which is not among --technique {}", args.technique.join(","));
         }
     }
     // Resolve every technique and its parameters before touching the GPU: a typo fails fast.
@@ -200,22 +205,12 @@ fn render(args: &RenderArgs) -> Result<()> {
         runs.push((info, params));
     }
     let gpu = GpuContext::new()?;
-    let mut renderer = Renderer::new(
-        &gpu,
-        &scene,
-        args.width,
-        args.height,
-        &Requirements { ..needs },
-    )?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &Requirements { ..needs })?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
     let progress = ProgressBar::new(runs.len() as u64);
-    progress.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     for (info, params) in &runs {
         progress.set_message(info.name);
         let dir = args.out.join(info.name);
@@ -226,12 +221,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             None => format!("{:.3} ms CPU wall (no timestamps)", run.cpu_ms_median()),
         };
         progress.suspend(|| -> Result<()> {
-            say!(
-                "{:<8} {time}  [{}]  -> {}",
-                info.name,
-                params,
-                dir.display()
-            );
+            say!("{:<8} {time}  [{}]  -> {}", info.name, params, dir.display());
             Ok(())
         })?;
         progress.inc(1);
@@ -244,53 +234,28 @@ fn render(args: &RenderArgs) -> Result<()> {
 fn load_scene(spec: &str) -> Result<Scene> {
     let (scene, source) = Scene::load(spec).with_context(|| format!("loading scene `{spec}`"))?;
     if let SceneSource::StagedModel(manifest) = &source {
-        say!(
-            "# staged scene for {spec} (save beside the model and edit):\n{}",
-            manifest.to_toml()
-        );
+        say!("# staged scene for {spec} (save beside the model and edit):\n{}", manifest.to_toml());
     }
-    say!(
-        "scene: {spec} ({} triangles, {} instances, {} lights)",
-        scene.triangle_count(),
-        scene.instances.len(),
-        scene.lights.len()
-    );
+    say!("scene: {spec} ({} triangles, {} instances, {} lights)", scene.triangle_count(), scene.instances.len(), scene.lights.len());
     Ok(scene)
 }
 
 /// The parameter values of `info` from the `--set` assignments that name it.
-fn params_for(
-    info: &'static TechniqueInfo,
-    settings: &[(&str, &str, &str)],
-) -> Result<ParamValues> {
-    Ok(info.params_from(
-        settings
-            .iter()
-            .filter(|(t, _, _)| *t == info.name)
-            .map(|(_, p, v)| (*p, *v)),
-    )?)
+fn params_for(info: &'static TechniqueInfo, settings: &[(&str, &str, &str)]) -> Result<ParamValues> {
+    Ok(info.params_from(settings.iter().filter(|(t, _, _)| *t == info.name).map(|(_, p, v)| (*p, *v)))?)
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {
     let registry = registry()?;
     let scene = load_scene(&args.scene)?;
-    let settings: Vec<(&str, &str, &str)> = args
-        .settings
-        .iter()
-        .map(|s| parse_setting(s))
-        .collect::<Result<_>>()?;
-    let reference_info = registry
-        .iter()
-        .find(|i| i.kind == TechniqueKind::GroundTruth)
-        .context("no ground-truth technique is registered")?;
+    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
+    let reference_info =
+        registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
     let gpu = GpuContext::new()?;
     let mut skipped: Vec<(String, String)> = Vec::new();
     let mut runs = Vec::new();
     if args.technique.is_empty() {
-        for info in registry
-            .iter()
-            .filter(|i| i.kind == TechniqueKind::Realtime)
-        {
+        for info in registry.iter().filter(|i| i.kind == TechniqueKind::Realtime) {
             let params = params_for(info, &settings)?;
             // Unasked-for techniques this adapter cannot run are reported, not fatal.
             match (info.requirements)(&params).and_then(|r| r.check_device(info.name, &gpu)) {
@@ -318,48 +283,22 @@ fn compare(args: &CompareArgs) -> Result<()> {
         needs = needs.union((info.requirements)(params)?);
     }
     let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
     let progress = ProgressBar::new(runs.len() as u64 + 1);
-    progress.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
-    report::write_images(
-        &args.out.join(reference_info.name),
-        &reference,
-        args.width,
-        args.height,
-        None,
-    )?;
-    let covered: Vec<bool> = renderer
-        .read_positions()?
-        .iter()
-        .map(|p| p[3] > 0.5)
-        .collect();
+    report::write_images(&args.out.join(reference_info.name), &reference, args.width, args.height, None)?;
+    let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
     progress.inc(1);
     let mut rows = Vec::new();
     for (info, params) in &runs {
         progress.set_message(info.name);
         let measured = report::measure(&mut renderer, info, params, args.frames)?;
-        report::write_images(
-            &args.out.join(info.name),
-            &measured,
-            args.width,
-            args.height,
-            Some((&reference, &covered)),
-        )?;
-        rows.push(report::row(
-            &args.scene,
-            &renderer,
-            &measured,
-            &reference,
-            &covered,
-        ));
+        report::write_images(&args.out.join(info.name), &measured, args.width, args.height, Some((&reference, &covered)))?;
+        rows.push(report::row(&args.scene, &renderer, &measured, &reference, &covered));
         progress.inc(1);
     }
     progress.finish_and_clear();
@@ -375,17 +314,100 @@ fn compare(args: &CompareArgs) -> Result<()> {
         skipped: &skipped,
     };
     let write = |name: &str, text: String| {
-        std::fs::write(args.out.join(name), text)
-            .with_context(|| format!("writing {}", args.out.join(name).display()))
+        std::fs::write(args.out.join(name), text).with_context(|| format!("writing {}", args.out.join(name).display()))
     };
     write("results.csv", report::csv(&rows))?;
     let markdown = report::markdown_report(&context, &rows);
     write("report.md", markdown.clone())?;
-    write(
-        "index.html",
-        report::html_report(&context, &rows, reference_info.name),
-    )?;
+    write("index.html", report::html_report(&context, &rows, reference_info.name))?;
     say!("{markdown}");
     say!("wrote {}", args.out.join("index.html").display());
+    Ok(())
+}
+
+fn sweep_command(args: &SweepArgs) -> Result<()> {
+    if args.list_presets {
+        for preset in sweep::PRESETS {
+            say!("{:<18} {}\n{:<18} --vary {}", preset.name, preset.summary, "", preset.varies.join(" --vary "));
+        }
+        return Ok(());
+    }
+    let (Some(scene_spec), Some(out)) = (&args.scene, &args.out) else { bail!("--scene and --out are required") };
+    let registry = registry()?;
+    let mut specs: Vec<String> = args.varies.clone();
+    if let Some(name) = &args.preset {
+        specs.extend(sweep::preset(name)?.varies.iter().map(|v| (*v).to_owned()));
+    }
+    if specs.is_empty() {
+        bail!("nothing to sweep: give --vary or --preset (see --list-presets)");
+    }
+    let varies: Vec<sweep::Vary> = specs.iter().map(|s| sweep::Vary::parse(s)).collect::<Result<_>>()?;
+    let mut techniques: Vec<&'static TechniqueInfo> = Vec::new();
+    for vary in &varies {
+        let info = registry.get(&vary.technique)?;
+        if !techniques.iter().any(|t| t.name == info.name) {
+            techniques.push(info);
+        }
+    }
+    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
+    // Every grid point's parameters, resolved before the GPU is touched: a bad value fails fast.
+    let mut points: Vec<(&'static TechniqueInfo, ParamValues, String)> = Vec::new();
+    for info in &techniques {
+        let axes: Vec<&sweep::Vary> = varies.iter().filter(|v| v.technique == info.name).collect();
+        for point in sweep::grid(&axes) {
+            let mut params = params_for(info, &settings)?;
+            for (name, value) in &point {
+                params.set(name, value)?;
+            }
+            points.push((info, params, sweep::point_label(&point)));
+        }
+    }
+    let scene = load_scene(scene_spec)?;
+    let reference_info =
+        registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
+    let reference_params = params_for(reference_info, &settings)?;
+    let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
+    for (info, params, _) in &points {
+        needs = needs.union((info.requirements)(params)?);
+    }
+    let gpu = GpuContext::new()?;
+    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let progress = ProgressBar::new(points.len() as u64 + 1);
+    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    progress.set_message("reference");
+    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
+    let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
+    progress.inc(1);
+    let (mut rows, mut labels) = (Vec::new(), Vec::new());
+    for (info, params, label) in &points {
+        progress.set_message(format!("{} {label}", info.name));
+        let measured = report::measure(&mut renderer, info, params, args.frames)?;
+        rows.push(report::row(scene_spec, &renderer, &measured, &reference, &covered));
+        labels.push(label.clone());
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    std::fs::write(out.join("sweep.csv"), report::csv(&rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
+    let title = format!("{} at {}x{} on {}", scene_spec, args.width, args.height, gpu.info.name);
+    sweep::plot(&rows, &labels, args.error, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
+    let front = sweep::pareto_front(&rows.iter().map(|r| (sweep::time_of(r), args.error.of(r))).collect::<Vec<_>>());
+    for (index, (row, label)) in rows.iter().zip(&labels).enumerate() {
+        let mark = if front.contains(&index) { "*" } else { " " };
+        say!(
+            "{mark} {:<10} {:<14} {:>9.3} ms  {} {:.4}",
+            row.technique,
+            label,
+            sweep::time_of(row),
+            args.error.label(),
+            args.error.of(row)
+        );
+    }
+    say!(
+        "(* on the Pareto front)\nwrote {}, {} and {}",
+        out.join("sweep.csv").display(),
+        out.join("sweep.png").display(),
+        out.join("sweep.svg").display()
+    );
     Ok(())
 }

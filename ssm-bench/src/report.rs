@@ -31,13 +31,7 @@ impl Measured {
     /// Median over frames of the GPU time (sum of the technique's passes).
     #[must_use]
     pub fn gpu_ms_median(&self) -> Option<f64> {
-        median(
-            &self
-                .frames
-                .iter()
-                .filter_map(|f| f.gpu_ms)
-                .collect::<Vec<_>>(),
-        )
+        median(&self.frames.iter().filter_map(|f| f.gpu_ms).collect::<Vec<_>>())
     }
 
     /// Smallest GPU time over frames.
@@ -49,14 +43,7 @@ impl Measured {
     /// Median CPU wall time from recording to the GPU going idle.
     #[must_use]
     pub fn cpu_ms_median(&self) -> f64 {
-        median(
-            &self
-                .frames
-                .iter()
-                .map(|f| f.cpu_wall_ms)
-                .collect::<Vec<_>>(),
-        )
-        .unwrap_or(f64::NAN)
+        median(&self.frames.iter().map(|f| f.cpu_wall_ms).collect::<Vec<_>>()).unwrap_or(f64::NAN)
     }
 
     /// Median over frames of each pass's time, passes of one name summed within a frame, in first-seen order.
@@ -73,17 +60,8 @@ impl Measured {
         names
             .into_iter()
             .map(|name| {
-                let per_frame: Vec<f64> = self
-                    .frames
-                    .iter()
-                    .map(|f| {
-                        f.passes
-                            .iter()
-                            .filter(|p| p.name == name)
-                            .map(|p| p.ms)
-                            .sum()
-                    })
-                    .collect();
+                let per_frame: Vec<f64> =
+                    self.frames.iter().map(|f| f.passes.iter().filter(|p| p.name == name).map(|p| p.ms).sum()).collect();
                 let ms = median(&per_frame).unwrap_or(f64::NAN);
                 (name, ms)
             })
@@ -95,12 +73,7 @@ impl Measured {
 ///
 /// # Errors
 /// Technique or GPU errors, or visibility outside [0, 1].
-pub fn measure(
-    renderer: &mut Renderer,
-    info: &'static TechniqueInfo,
-    params: &ParamValues,
-    frames: u32,
-) -> Result<Measured> {
+pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &ParamValues, frames: u32) -> Result<Measured> {
     let mut technique = renderer.create_technique(info, params)?;
     // Pipeline compilation and first-use allocation are not the technique's cost.
     renderer.render(technique.as_mut(), info.name)?;
@@ -108,18 +81,10 @@ pub fn measure(
     for _ in 0..frames.max(1) {
         timings.push(renderer.render(technique.as_mut(), info.name)?);
     }
-    let visibility = (0..renderer.scene.light_count())
-        .map(|light| renderer.read_visibility(light, info.name))
-        .collect::<Result<Vec<_>>>()?;
+    let visibility =
+        (0..renderer.scene.light_count()).map(|light| renderer.read_visibility(light, info.name)).collect::<Result<Vec<_>>>()?;
     let shaded = renderer.shade()?;
-    Ok(Measured {
-        info,
-        params: params.clone(),
-        frames: timings,
-        diagnostics: technique.diagnostics(),
-        visibility,
-        shaded,
-    })
+    Ok(Measured { info, params: params.clone(), frames: timings, diagnostics: technique.diagnostics(), visibility, shaded })
 }
 
 /// Writes a measured technique's images under `dir`: `visibility.exr`/`.png`
@@ -128,44 +93,19 @@ pub fn measure(
 ///
 /// # Errors
 /// File errors.
-pub fn write_images(
-    dir: &Path,
-    measured: &Measured,
-    width: u32,
-    height: u32,
-    reference: Option<(&Measured, &[bool])>,
-) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Write {
-        file: dir.into(),
-        message: e.to_string(),
-    })?;
+pub fn write_images(dir: &Path, measured: &Measured, width: u32, height: u32, reference: Option<(&Measured, &[bool])>) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Write { file: dir.into(), message: e.to_string() })?;
     for (light, visibility) in measured.visibility.iter().enumerate() {
-        let stem = if light == 0 {
-            "visibility".to_owned()
-        } else {
-            format!("visibility-light{light}")
-        };
+        let stem = if light == 0 { "visibility".to_owned() } else { format!("visibility-light{light}") };
         write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, visibility)?;
         write_png_gray16(&dir.join(format!("{stem}.png")), width, height, visibility)?;
     }
     write_png_rgba8(&dir.join("shaded.png"), width, height, &measured.shaded)?;
     if let Some((reference, covered)) = reference {
-        let rgb = heat_map(
-            &reference.visibility[0],
-            &measured.visibility[0],
-            covered,
-            0.5,
-        );
-        let image = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| Error::Write {
-            file: dir.join("heatmap.png"),
-            message: "buffer size".into(),
-        })?;
-        image
-            .save(dir.join("heatmap.png"))
-            .map_err(|e| Error::Write {
-                file: dir.join("heatmap.png"),
-                message: e.to_string(),
-            })?;
+        let rgb = heat_map(&reference.visibility[0], &measured.visibility[0], covered, 0.5);
+        let image = image::RgbImage::from_raw(width, height, rgb)
+            .ok_or_else(|| Error::Write { file: dir.join("heatmap.png"), message: "buffer size".into() })?;
+        image.save(dir.join("heatmap.png")).map_err(|e| Error::Write { file: dir.join("heatmap.png"), message: e.to_string() })?;
     }
     Ok(())
 }
@@ -231,13 +171,7 @@ pub const CSV_COLUMNS: &[&str] = &[
 
 /// Builds the row of `measured` against `reference` (same pixels; `covered` marks the pixels with a surface).
 #[must_use]
-pub fn row(
-    scene: &str,
-    renderer: &Renderer,
-    measured: &Measured,
-    reference: &Measured,
-    covered: &[bool],
-) -> Row {
+pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Measured, covered: &[bool]) -> Row {
     let (width, height) = (renderer.width(), renderer.height());
     let per_light: Vec<ErrorMetrics> = measured
         .visibility
@@ -257,10 +191,7 @@ pub fn row(
         metrics: average(&per_light),
         flip: flip_mean(&reference.shaded, &measured.shaded, width, height),
         adapter: renderer.gpu.describe(),
-        timing_source: measured
-            .frames
-            .first()
-            .map_or(TimingSource::CpuWallOnly, |f| f.source),
+        timing_source: measured.frames.first().map_or(TimingSource::CpuWallOnly, |f| f.source),
         passes: measured.pass_medians(),
         diagnostics: measured.diagnostics.clone(),
     }
@@ -292,19 +223,11 @@ fn number(value: Option<f64>, decimals: usize) -> String {
 }
 
 fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_owned()
-    }
+    if text.contains([',', '"', '\n']) { format!("\"{}\"", text.replace('"', "\"\"")) } else { text.to_owned() }
 }
 
 fn pairs(items: &[(String, f64)]) -> String {
-    items
-        .iter()
-        .map(|(k, v)| format!("{k}={v:.4}"))
-        .collect::<Vec<_>>()
-        .join(";")
+    items.iter().map(|(k, v)| format!("{k}={v:.4}")).collect::<Vec<_>>().join(";")
 }
 
 impl Row {
@@ -400,12 +323,7 @@ pub struct ReportContext<'a> {
 pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     let mut out = format!(
         "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]. Errors are against it, on the same pixels; GPU time is the sum of each technique's timed passes.\n\n",
-        context.scene,
-        context.size.0,
-        context.size.1,
-        context.frames,
-        context.adapter,
-        context.reference_params
+        context.scene, context.size.0, context.size.1, context.frames, context.adapter, context.reference_params
     );
     out += &markdown_table(rows);
     for (name, why) in context.skipped {
@@ -415,10 +333,7 @@ pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
 }
 
 fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
 /// `index.html`: the table and, per technique, the shaded image, the
@@ -462,12 +377,7 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     }
     out += "</table>\n";
     for (name, why) in context.skipped {
-        let _ = writeln!(
-            out,
-            "<p>Not run: <code>{}</code>: {}</p>",
-            escape(name),
-            escape(why)
-        );
+        let _ = writeln!(out, "<p>Not run: <code>{}</code>: {}</p>", escape(name), escape(why));
     }
     out += "<p class=\"legend\">Each row: shaded image, visibility, and the error against the ground truth (red: darker than the reference, over-shadowing; blue: lighter, under-shadowing; full colour at an error of 0.5).</p>\n";
     let _ = writeln!(
@@ -493,7 +403,7 @@ mod tests {
     #[test]
     fn csv_fields_with_commas_are_quoted() {
         assert_eq!(csv_field("a,b"), "\"a,b\"");
-        assert_eq!(csv_field("say \"x\""), "say \"x\"");
+        assert_eq!(csv_field("say \"x\""), "\"say \"\"x\"\"\"");
         assert_eq!(csv_field("q\",x"), "\"q\"\",x\"");
         assert_eq!(number(Some(f64::INFINITY), 2), "inf");
         assert_eq!(number(None, 2), "");

@@ -10,10 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn ssm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_ssm"))
-        .args(args)
-        .output()
-        .expect("the ssm binary runs")
+    Command::new(env!("CARGO_BIN_EXE_ssm")).args(args).output().expect("the ssm binary runs")
 }
 
 fn scratch(test: &str) -> PathBuf {
@@ -71,43 +68,26 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
         ])
         .output()
         .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
 
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
-    assert!(lines.next().unwrap().starts_with("scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"));
+    assert!(lines.next().unwrap().starts_with(
+        "scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"
+    ));
     let rows: Vec<Vec<String>> = lines.map(split_csv).collect();
     assert_eq!(rows.len(), 2);
     let column = |row: &Vec<String>, i: usize| row[i].parse::<f64>().unwrap();
     for row in &rows {
         assert_eq!(row[0], "parallel-square");
         assert!(column(row, 5) > 0.0, "GPU time is measured: {row:?}");
-        assert!(
-            (0.0..=1.0).contains(&column(row, 8)) && (0.0..=1.0).contains(&column(row, 12)),
-            "{row:?}"
-        );
+        assert!((0.0..=1.0).contains(&column(row, 8)) && (0.0..=1.0).contains(&column(row, 12)), "{row:?}");
     }
     let (hard, pcss) = (&rows[0], &rows[1]);
     assert_eq!((hard[1].as_str(), pcss[1].as_str()), ("hard", "pcss"));
-    assert!(
-        column(pcss, 8) < column(hard, 8),
-        "pcss is nearer the ground truth than hard on parallel-square"
-    );
-    assert!(
-        std::fs::read_to_string(out.join("report.md"))
-            .unwrap()
-            .contains("| `pcss` |")
-    );
-    for file in [
-        "reference/shaded.png",
-        "hard/heatmap.png",
-        "pcss/visibility.png",
-        "pcss/visibility.exr",
-    ] {
+    assert!(column(pcss, 8) < column(hard, 8), "pcss is nearer the ground truth than hard on parallel-square");
+    assert!(std::fs::read_to_string(out.join("report.md")).unwrap().contains("| `pcss` |"));
+    for file in ["reference/shaded.png", "hard/heatmap.png", "pcss/visibility.png", "pcss/visibility.exr"] {
         assert!(out.join(file).is_file(), "{file}");
     }
 
@@ -116,33 +96,14 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     let dom = chromium(&scratch("profile"), &["--dump-dom", &page]);
     let dom = String::from_utf8_lossy(&dom.stdout);
     // Ground truth (2 images) + 2 techniques × 3 images.
-    assert!(
-        dom.contains("data-images-loaded=\"8/8\""),
-        "not every image loaded:\n{}",
-        &dom[..dom.len().min(2000)]
-    );
+    assert!(dom.contains("data-images-loaded=\"8/8\""), "not every image loaded:\n{}", &dom[..dom.len().min(2000)]);
     let screenshot = out.join("screenshot.png");
-    let shot = chromium(
-        &scratch("profile2"),
-        &[
-            "--window-size=1200,1600",
-            &format!("--screenshot={}", screenshot.display()),
-            &page,
-        ],
-    );
-    assert!(
-        screenshot.is_file(),
-        "{}",
-        String::from_utf8_lossy(&shot.stderr)
-    );
+    let shot = chromium(&scratch("profile2"), &["--window-size=1200,1600", &format!("--screenshot={}", screenshot.display()), &page]);
+    assert!(screenshot.is_file(), "{}", String::from_utf8_lossy(&shot.stderr));
     let image = image::open(&screenshot).unwrap().into_rgb8();
     // Table text, grey scales and the heat maps' colours: a rendered page is far from uniform.
     let colours: std::collections::HashSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
-    assert!(
-        colours.len() > 200,
-        "the page looks empty ({} colours)",
-        colours.len()
-    );
+    assert!(colours.len() > 200, "the page looks empty ({} colours)", colours.len());
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }
@@ -182,9 +143,50 @@ fn unknown_settings_in_compare_fail_with_one_line() {
     ]);
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        stderr.lines().filter(|l| l.starts_with("error:")).count() == 1
-            && stderr.contains("not compared"),
-        "{stderr}"
-    );
+    assert!(stderr.lines().filter(|l| l.starts_with("error:")).count() == 1 && stderr.contains("not compared"), "{stderr}");
+}
+
+#[test]
+fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
+    let out = scratch("sweep");
+    let cache = scratch("sweep-cache");
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .env("SSM_CACHE_DIR", &cache)
+        .args([
+            "sweep",
+            "--scene",
+            "parallel-square",
+            "--vary",
+            "pcss.blocker_kernel:pcf_kernel=3:5,7:15",
+            "--vary",
+            "multi-sm.samples=1,4,16",
+            "--set",
+            "reference.samples=8",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--frames",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(split_csv).collect();
+    assert_eq!(rows.len(), 5, "{csv}");
+    assert!(rows[1][2].contains("blocker_kernel=7") && rows[1][2].contains("pcf_kernel=15"), "{:?}", rows[1]);
+    // multi-sm's error falls with K along the sweep.
+    let mae: Vec<f64> = rows[2..].iter().map(|r| r[8].parse().unwrap()).collect();
+    assert!(mae[0] > mae[1] && mae[1] > mae[2], "{mae:?}");
+    let png = image::open(out.join("sweep.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (1000, 700));
+    let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
+    assert!(svg.contains("Pareto front") && svg.contains("multi-sm") && svg.contains("<circle"), "the plot has its legend and points");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.lines().any(|l| l.starts_with('*')), "the Pareto front is marked:\n{stdout}");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&cache);
 }

@@ -4,9 +4,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::{
-    color_attachment, fullscreen_pipeline, labelled_view, render_texture, texture_entry,
-};
+use crate::passes::{color_attachment, fullscreen_pipeline, labelled_view, render_texture, texture_entry};
 use crate::shader::create_shader;
 
 /// The composite pass and its target.
@@ -28,40 +26,18 @@ impl Composite {
     ///
     /// # Errors
     /// [`Error::Gpu`](crate::Error::Gpu) if the shader is rejected.
-    pub fn new(
-        gpu: &GpuContext,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        visibility_views: &[wgpu::TextureView],
-    ) -> Result<Self> {
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, gbuffer: &GBuffer, visibility_views: &[wgpu::TextureView]) -> Result<Self> {
         let device = &gpu.device;
-        let target = render_texture(
-            device,
-            "composite_target",
-            scene.width,
-            scene.height,
-            Self::FORMAT,
-            wgpu::TextureUsages::COPY_SRC,
-        );
+        let target = render_texture(device, "composite_target", scene.width, scene.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
         let target_view = labelled_view(&target, "composite_target");
         let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite_visibility_layout"),
             entries: &[texture_entry(0)],
         });
-        let module = create_shader(
-            gpu,
-            "composite_shader",
-            include_str!("../../shaders/core/composite.wgsl"),
-        )?;
+        let module = create_shader(gpu, "composite_shader", include_str!("../../shaders/core/composite.wgsl"))?;
         let layouts = [&scene.uniform_layout, &gbuffer.layout, &visibility_layout];
-        let base_pipeline = fullscreen_pipeline(
-            device,
-            "composite_base_pipeline",
-            &module,
-            "composite_base",
-            &layouts,
-            Self::FORMAT.into(),
-        );
+        let base_pipeline =
+            fullscreen_pipeline(device, "composite_base_pipeline", &module, "composite_base", &layouts, Self::FORMAT.into());
         // Additive: each light adds its term to what the base pass wrote (blending is linear on sRGB targets).
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
@@ -70,20 +46,10 @@ impl Composite {
         };
         let light_target = wgpu::ColorTargetState {
             format: Self::FORMAT,
-            blend: Some(wgpu::BlendState {
-                color: additive,
-                alpha: additive,
-            }),
+            blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
             write_mask: wgpu::ColorWrites::ALL,
         };
-        let light_pipeline = fullscreen_pipeline(
-            device,
-            "composite_light_pipeline",
-            &module,
-            "composite_light",
-            &layouts,
-            light_target,
-        );
+        let light_pipeline = fullscreen_pipeline(device, "composite_light_pipeline", &module, "composite_light", &layouts, light_target);
         let visibility_groups = visibility_views
             .iter()
             .enumerate()
@@ -91,20 +57,11 @@ impl Composite {
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&format!("composite_visibility_bind_group_{light}")),
                     layout: &visibility_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(view),
-                    }],
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) }],
                 })
             })
             .collect();
-        Ok(Self {
-            target,
-            target_view,
-            base_pipeline,
-            light_pipeline,
-            visibility_groups,
-        })
+        Ok(Self { target, target_view, base_pipeline, light_pipeline, visibility_groups })
     }
 
     /// Records the composite of every light's visibility.
@@ -112,10 +69,7 @@ impl Composite {
         encoder.push_debug_group("composite");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("composite"),
-            color_attachments: &[color_attachment(
-                &self.target_view,
-                Some(wgpu::Color::BLACK),
-            )],
+            color_attachments: &[color_attachment(&self.target_view, Some(wgpu::Color::BLACK))],
             ..Default::default()
         });
         pass.set_bind_group(1, &gbuffer.bind_group, &[]);

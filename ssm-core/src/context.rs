@@ -69,14 +69,9 @@ impl GpuContext {
     /// [`ContextError::NoAdapter`] with the command that installs Mesa's software
     /// driver; [`ContextError::NoDevice`] if the adapter refuses.
     pub fn new() -> Result<Self, ContextError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
-            &instance, None,
-        ))
-        .map_err(|e| ContextError::NoAdapter {
-            detail: e.to_string(),
-        })?;
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
+            .map_err(|e| ContextError::NoAdapter { detail: e.to_string() })?;
         let info = adapter.get_info();
         let features = adapter.features() & OPTIONAL_FEATURES;
         let descriptor = wgpu::DeviceDescriptor {
@@ -88,13 +83,8 @@ impl GpuContext {
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
         };
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&descriptor)).map_err(|e| {
-                ContextError::NoDevice {
-                    adapter: info.name.clone(),
-                    detail: e.to_string(),
-                }
-            })?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))
+            .map_err(|e| ContextError::NoDevice { adapter: info.name.clone(), detail: e.to_string() })?;
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&errors);
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
@@ -102,14 +92,7 @@ impl GpuContext {
                 list.push(error.to_string());
             }
         }));
-        Ok(Self {
-            instance,
-            adapter,
-            device,
-            queue,
-            info,
-            errors,
-        })
+        Ok(Self { instance, adapter, device, queue, info, errors })
     }
 
     /// The features the device was created with.
@@ -128,19 +111,13 @@ impl GpuContext {
     #[must_use]
     pub fn describe(&self) -> String {
         let i = &self.info;
-        format!(
-            "{} [{:?} {:?}, {} {}]",
-            i.name, i.backend, i.device_type, i.driver, i.driver_info
-        )
+        format!("{} [{:?} {:?}, {} {}]", i.name, i.backend, i.device_type, i.driver, i.driver_info)
     }
 
     /// Errors wgpu reported since the last call, oldest first.
     #[must_use]
     pub fn take_errors(&self) -> Vec<String> {
-        self.errors
-            .lock()
-            .map(|mut list| std::mem::take(&mut *list))
-            .unwrap_or_default()
+        self.errors.lock().map(|mut list| std::mem::take(&mut *list)).unwrap_or_default()
     }
 
     /// Blocks until the GPU has finished everything submitted so far.
@@ -148,12 +125,6 @@ impl GpuContext {
     /// # Errors
     /// The poll error as text (device lost, timeout).
     pub fn wait_idle(&self) -> Result<(), String> {
-        self.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: None,
-                timeout: None,
-            })
-            .map(|_| ())
-            .map_err(|e| e.to_string())
+        self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).map(|_| ()).map_err(|e| e.to_string())
     }
 }

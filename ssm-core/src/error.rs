@@ -37,9 +37,7 @@ pub enum Error {
         second: String,
     },
     /// The device lacks features the technique needs.
-    #[error(
-        "technique `{technique}` needs device features {features:?} that this adapter ({adapter}) does not offer"
-    )]
+    #[error("technique `{technique}` needs device features {features:?} that this adapter ({adapter}) does not offer")]
     MissingFeatures {
         /// Technique name.
         technique: String,
@@ -59,9 +57,7 @@ pub enum Error {
         allowed: String,
     },
     /// A technique used a shared input it did not declare in its requirements.
-    #[error(
-        "technique `{technique}` uses the shared {input} but did not declare it in its Requirements"
-    )]
+    #[error("technique `{technique}` uses the shared {input} but did not declare it in its Requirements")]
     UndeclaredRequirement {
         /// Technique name.
         technique: String,

@@ -22,12 +22,7 @@ impl SharedInputs {
     /// # Errors
     /// [`Error::UndeclaredRequirement`].
     pub fn gbuffer(&self, technique: &str) -> Result<&GBuffer> {
-        self.gbuffer
-            .as_ref()
-            .ok_or_else(|| Error::UndeclaredRequirement {
-                technique: technique.into(),
-                input: "G-buffer",
-            })
+        self.gbuffer.as_ref().ok_or_else(|| Error::UndeclaredRequirement { technique: technique.into(), input: "G-buffer" })
     }
 
     /// The adjacency, or an error naming `technique` if it was not declared.
@@ -35,12 +30,7 @@ impl SharedInputs {
     /// # Errors
     /// [`Error::UndeclaredRequirement`].
     pub fn adjacency(&self, technique: &str) -> Result<&ssm_scene::Adjacency> {
-        self.adjacency
-            .as_ref()
-            .ok_or_else(|| Error::UndeclaredRequirement {
-                technique: technique.into(),
-                input: "mesh adjacency",
-            })
+        self.adjacency.as_ref().ok_or_else(|| Error::UndeclaredRequirement { technique: technique.into(), input: "mesh adjacency" })
     }
 }
 
@@ -82,21 +72,14 @@ impl Frame<'_> {
     /// Begins a compute pass labelled `label`, timed under that name.
     pub fn compute_pass(&mut self, label: &str) -> wgpu::ComputePass<'_> {
         let timestamp_writes = self.timer.compute_pass(label);
-        self.encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes,
-            })
+        self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes })
     }
 
     /// Submits what was recorded so far and starts a new encoder, so that the
     /// technique can read results back in the middle of the frame (PVSM's tile
     /// grid, for instance). Returns the submission to wait for.
     pub fn submit_and_replace(&mut self, label: &str) -> wgpu::SubmissionIndex {
-        let next = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        let next = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         let done = std::mem::replace(&mut self.encoder, next);
         self.gpu.queue.submit([done.finish()])
     }

@@ -44,30 +44,9 @@ impl GBuffer {
     pub fn new(gpu: &GpuContext, scene: &GpuScene) -> Result<Self> {
         let device = &gpu.device;
         let (width, height) = (scene.width, scene.height);
-        let position = render_texture(
-            device,
-            "gbuffer_position",
-            width,
-            height,
-            Self::POSITION_FORMAT,
-            wgpu::TextureUsages::COPY_SRC,
-        );
-        let normal = render_texture(
-            device,
-            "gbuffer_normal",
-            width,
-            height,
-            Self::NORMAL_FORMAT,
-            wgpu::TextureUsages::COPY_SRC,
-        );
-        let depth = render_texture(
-            device,
-            "gbuffer_depth",
-            width,
-            height,
-            Self::DEPTH_FORMAT,
-            wgpu::TextureUsages::empty(),
-        );
+        let position = render_texture(device, "gbuffer_position", width, height, Self::POSITION_FORMAT, wgpu::TextureUsages::COPY_SRC);
+        let normal = render_texture(device, "gbuffer_normal", width, height, Self::NORMAL_FORMAT, wgpu::TextureUsages::COPY_SRC);
+        let depth = render_texture(device, "gbuffer_depth", width, height, Self::DEPTH_FORMAT, wgpu::TextureUsages::empty());
         let position_view = labelled_view(&position, "gbuffer_position");
         let normal_view = labelled_view(&normal, "gbuffer_normal");
         let depth_view = labelled_view(&depth, "gbuffer_depth");
@@ -79,21 +58,11 @@ impl GBuffer {
             label: Some("gbuffer_bind_group"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&position_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&normal_view),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&position_view) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&normal_view) },
             ],
         });
-        let module = create_shader(
-            gpu,
-            "gbuffer_shader",
-            include_str!("../../shaders/core/gbuffer.wgsl"),
-        )?;
+        let module = create_shader(gpu, "gbuffer_shader", include_str!("../../shaders/core/gbuffer.wgsl"))?;
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer_pipeline_layout"),
             bind_group_layouts: &[Some(&scene.uniform_layout)],
@@ -122,34 +91,16 @@ impl GBuffer {
                 module: &module,
                 entry_point: Some("gbuffer_fragment"),
                 compilation_options: Default::default(),
-                targets: &[
-                    Some(Self::POSITION_FORMAT.into()),
-                    Some(Self::NORMAL_FORMAT.into()),
-                ],
+                targets: &[Some(Self::POSITION_FORMAT.into()), Some(Self::NORMAL_FORMAT.into())],
             }),
             multiview_mask: None,
             cache: None,
         });
-        Ok(Self {
-            position,
-            position_view,
-            normal,
-            normal_view,
-            depth,
-            depth_view,
-            layout,
-            bind_group,
-            pipeline,
-        })
+        Ok(Self { position, position_view, normal, normal_view, depth, depth_view, layout, bind_group, pipeline })
     }
 
     /// Records the G-buffer pass, timed as `gbuffer`.
-    pub fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        timer: &mut PassTimer,
-    ) {
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, timer: &mut PassTimer) {
         let timestamp_writes = timer.render_pass("gbuffer");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
@@ -159,10 +110,7 @@ impl GBuffer {
             ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
             timestamp_writes,

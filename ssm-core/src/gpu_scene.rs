@@ -30,8 +30,7 @@ pub const ROLE_RECEIVES: u32 = 2;
 
 impl SceneVertex {
     /// Attributes: 0 position, 1 normal, 2 role (as in `shaders/common/scene.wgsl`).
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
 
     /// The vertex buffer layout every scene pipeline uses.
     #[must_use]
@@ -111,8 +110,7 @@ impl GpuScene {
         // Three index lists, concatenated in role order afterwards.
         let mut by_role: [Vec<u32>; 3] = Default::default();
         for triangle in scene.world_triangles() {
-            let flags = (u32::from(triangle.role.casts()) * ROLE_CASTS)
-                | (u32::from(triangle.role.receives()) * ROLE_RECEIVES);
+            let flags = (u32::from(triangle.role.casts()) * ROLE_CASTS) | (u32::from(triangle.role.receives()) * ROLE_RECEIVES);
             let slot = match triangle.role {
                 Role::Occluder => 0,
                 Role::Both => 1,
@@ -130,11 +128,7 @@ impl GpuScene {
         }
         let [occluder_only, both, receiver_only] = by_role.each_ref().map(|list| list.len() as u32);
         let indices: Vec<u32> = by_role.concat();
-        let ranges = [
-            0..indices.len() as u32,
-            0..occluder_only + both,
-            occluder_only..occluder_only + both + receiver_only,
-        ];
+        let ranges = [0..indices.len() as u32, 0..occluder_only + both, occluder_only..occluder_only + both + receiver_only];
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene_vertex_buffer"),
             contents: bytemuck::cast_slice(&vertices),
@@ -158,11 +152,7 @@ impl GpuScene {
             entries: &[wgpu::BindGroupLayoutEntry {
                 binding: 0,
                 visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
+                ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
                 count: None,
             }],
         });
@@ -170,18 +160,11 @@ impl GpuScene {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
                 layout: &uniform_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                }],
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
             })
         };
         let camera_bind_group = uniform_group("scene_camera_bind_group", &camera_buffer);
-        let light_frames: Vec<LightFrame> = scene
-            .lights
-            .iter()
-            .map(|light| LightFrame::fit(light, &bounds))
-            .collect();
+        let light_frames: Vec<LightFrame> = scene.lights.iter().map(|light| LightFrame::fit(light, &bounds)).collect();
         let light_buffers: Vec<wgpu::Buffer> = light_frames
             .iter()
             .enumerate()
@@ -196,9 +179,7 @@ impl GpuScene {
         let light_bind_groups = light_buffers
             .iter()
             .enumerate()
-            .map(|(index, buffer)| {
-                uniform_group(&format!("light_frame_bind_group_{index}"), buffer)
-            })
+            .map(|(index, buffer)| uniform_group(&format!("light_frame_bind_group_{index}"), buffer))
             .collect();
         Self {
             vertex_buffer,
@@ -253,11 +234,6 @@ fn camera_uniform(scene: &Scene, width: u32, height: u32) -> CameraUniform {
         view_proj: view_proj.to_cols_array_2d(),
         inverse_view_proj: view_proj.inverse().to_cols_array_2d(),
         position: Vec4::from((scene.camera.position, 1.0)).to_array(),
-        viewport: [
-            width as f32,
-            height as f32,
-            1.0 / width as f32,
-            1.0 / height as f32,
-        ],
+        viewport: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
     }
 }

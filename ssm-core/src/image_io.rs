@@ -3,28 +3,19 @@
 
 use std::path::Path;
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
-    WritableImage,
-};
+use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec, WritableImage};
 
 use crate::error::{Error, Result};
 
 fn write_error(file: &Path, message: impl std::fmt::Display) -> Error {
-    Error::Write {
-        file: file.into(),
-        message: message.to_string(),
-    }
+    Error::Write { file: file.into(), message: message.to_string() }
 }
 
 fn check_len(file: &Path, len: usize, width: u32, height: u32, channels: usize) -> Result<()> {
     if len == width as usize * height as usize * channels {
         Ok(())
     } else {
-        Err(write_error(
-            file,
-            format!("{len} values for a {width}x{height} image of {channels} channels"),
-        ))
+        Err(write_error(file, format!("{len} values for a {width}x{height} image of {channels} channels")))
     }
 }
 
@@ -42,10 +33,7 @@ pub fn write_exr_gray(file: &Path, width: u32, height: u32, values: &[f32]) -> R
         Encoding::FAST_LOSSLESS,
         AnyChannels::sort(channels),
     );
-    Image::from_layer(layer)
-        .write()
-        .to_file(file)
-        .map_err(|e| write_error(file, e))
+    Image::from_layer(layer).write().to_file(file).map_err(|e| write_error(file, e))
 }
 
 /// Writes RGB float triples as lossless OpenEXR.
@@ -67,12 +55,9 @@ pub fn write_exr_rgb(file: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> 
 /// [`Error::Write`] naming the file.
 pub fn write_png_gray16(file: &Path, width: u32, height: u32, values: &[f32]) -> Result<()> {
     check_len(file, values.len(), width, height, 1)?;
-    let pixels: Vec<u16> = values
-        .iter()
-        .map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16)
-        .collect();
-    let image = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
-        .ok_or_else(|| write_error(file, "buffer size"))?;
+    let pixels: Vec<u16> = values.iter().map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16).collect();
+    let image =
+        image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels).ok_or_else(|| write_error(file, "buffer size"))?;
     image.save(file).map_err(|e| write_error(file, e))
 }
 
@@ -82,7 +67,6 @@ pub fn write_png_gray16(file: &Path, width: u32, height: u32, values: &[f32]) ->
 /// [`Error::Write`] naming the file.
 pub fn write_png_rgba8(file: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
     check_len(file, rgba.len(), width, height, 4)?;
-    let image = image::RgbaImage::from_raw(width, height, rgba.to_vec())
-        .ok_or_else(|| write_error(file, "buffer size"))?;
+    let image = image::RgbaImage::from_raw(width, height, rgba.to_vec()).ok_or_else(|| write_error(file, "buffer size"))?;
     image.save(file).map_err(|e| write_error(file, e))
 }

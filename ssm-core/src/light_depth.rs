@@ -67,14 +67,8 @@ impl LightDepthMap {
     pub fn new(gpu: &GpuContext, scene: &GpuScene, desc: &LightDepthMapDesc<'_>) -> Result<Self> {
         let device = &gpu.device;
         let label = desc.label;
-        let linear_depth = render_texture(
-            device,
-            &format!("{label}_linear_depth"),
-            desc.width,
-            desc.height,
-            Self::FORMAT,
-            wgpu::TextureUsages::COPY_SRC,
-        );
+        let linear_depth =
+            render_texture(device, &format!("{label}_linear_depth"), desc.width, desc.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
         let depth = render_texture(
             device,
             &format!("{label}_depth"),
@@ -83,9 +77,7 @@ impl LightDepthMap {
             wgpu::TextureFormat::Depth32Float,
             wgpu::TextureUsages::empty(),
         );
-        let bias = DepthBiasUniform {
-            values: [desc.constant_bias, desc.slope_bias, 0.0, 0.0],
-        };
+        let bias = DepthBiasUniform { values: [desc.constant_bias, desc.slope_bias, 0.0, 0.0] };
         let bias_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&format!("{label}_bias_uniform")),
             contents: bytemuck::bytes_of(&bias),
@@ -98,16 +90,9 @@ impl LightDepthMap {
         let bias_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(&format!("{label}_bias_bind_group")),
             layout: &bias_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: bias_buffer.as_entire_binding(),
-            }],
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: bias_buffer.as_entire_binding() }],
         });
-        let module = create_shader(
-            gpu,
-            &format!("{label}_shader"),
-            include_str!("../../shaders/core/light_depth.wgsl"),
-        )?;
+        let module = create_shader(gpu, &format!("{label}_shader"), include_str!("../../shaders/core/light_depth.wgsl"))?;
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(&format!("{label}_pipeline_layout")),
             bind_group_layouts: &[Some(&scene.uniform_layout), Some(&bias_layout)],
@@ -122,11 +107,7 @@ impl LightDepthMap {
                 compilation_options: Default::default(),
                 buffers: &[Some(SceneVertex::layout())],
             },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: desc.cull_mode,
-                front_face: wgpu::FrontFace::Ccw,
-                ..Default::default()
-            },
+            primitive: wgpu::PrimitiveState { cull_mode: desc.cull_mode, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(true),
@@ -169,21 +150,10 @@ impl LightDepthMap {
         let scene = frame.scene;
         let mut pass = frame.render_pass(
             &self.label,
-            &[color_attachment(
-                &self.linear_depth_view,
-                Some(wgpu::Color {
-                    r: f64::from(NO_SURFACE),
-                    g: 0.0,
-                    b: 0.0,
-                    a: 0.0,
-                }),
-            )],
+            &[color_attachment(&self.linear_depth_view, Some(wgpu::Color { r: f64::from(NO_SURFACE), g: 0.0, b: 0.0, a: 0.0 }))],
             Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
                 stencil_ops: None,
             }),
         );
@@ -216,29 +186,17 @@ impl ShadowMapSettings {
     pub const BIAS_PARAMS: [ParamSpec; 3] = [
         ParamSpec {
             name: "constant_bias",
-            kind: ParamKind::Float {
-                default: 1e-3,
-                min: 0.0,
-                max: 0.1,
-            },
+            kind: ParamKind::Float { default: 1e-3, min: 0.0, max: 0.1 },
             doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
         },
         ParamSpec {
             name: "slope_bias",
-            kind: ParamKind::Float {
-                default: 1.5,
-                min: 0.0,
-                max: 16.0,
-            },
+            kind: ParamKind::Float { default: 1.5, min: 0.0, max: 16.0 },
             doc: "slope-scaled bias: multiples of the depth change across one texel",
         },
         ParamSpec {
             name: "normal_offset",
-            kind: ParamKind::Float {
-                default: 1.0,
-                min: 0.0,
-                max: 8.0,
-            },
+            kind: ParamKind::Float { default: 1.0, min: 0.0, max: 8.0 },
             doc: "lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011)",
         },
     ];
@@ -263,22 +221,14 @@ impl ShadowMapSettings {
     /// A parameter error.
     pub fn screen_space_requirements(params: &crate::ParamValues) -> Result<crate::Requirements> {
         let settings = Self::from_params(params)?;
-        Ok(crate::Requirements {
-            gbuffer: true,
-            max_texture_size: settings.size,
-            ..crate::Requirements::NONE
-        })
+        Ok(crate::Requirements { gbuffer: true, max_texture_size: settings.size, ..crate::Requirements::NONE })
     }
 
     /// Builds the depth map over all geometry, labelled `label`.
     ///
     /// # Errors
     /// A GPU error if the pipeline is rejected.
-    pub fn depth_map(
-        &self,
-        setup: &crate::TechniqueSetup<'_>,
-        label: &str,
-    ) -> Result<LightDepthMap> {
+    pub fn depth_map(&self, setup: &crate::TechniqueSetup<'_>, label: &str) -> Result<LightDepthMap> {
         let diagonal = setup.scene.bounds.size().length();
         LightDepthMap::new(
             setup.gpu,

@@ -45,20 +45,12 @@ impl LightFrame {
         let min_depth = extent * 1e-4;
         let local = |p: Vec3| {
             let offset = p - light.centre;
-            Vec3::new(
-                offset.dot(light.u_axis),
-                offset.dot(light.v_axis),
-                offset.dot(normal),
-            )
+            Vec3::new(offset.dot(light.u_axis), offset.dot(light.v_axis), offset.dot(normal))
         };
         // The box clipped to depth >= min_depth: its corners in front, plus the
         // crossings of its edges with that plane.
         let corners = bounds.corners().map(local);
-        let mut points: Vec<Vec3> = corners
-            .iter()
-            .copied()
-            .filter(|c| c.z >= min_depth)
-            .collect();
+        let mut points: Vec<Vec3> = corners.iter().copied().filter(|c| c.z >= min_depth).collect();
         for (a, b) in BOX_EDGES {
             let (pa, pb) = (corners[a], corners[b]);
             if (pa.z - min_depth) * (pb.z - min_depth) < 0.0 {
@@ -81,10 +73,7 @@ impl LightFrame {
         // Same aspect ratio as the light (Atty et al., Sec. 3.2); point lights are square.
         if !light.is_point() {
             let aspect = light.half_size.x / light.half_size.y;
-            tan_half = Vec2::new(
-                tan_half.x.max(tan_half.y * aspect),
-                tan_half.y.max(tan_half.x / aspect),
-            );
+            tan_half = Vec2::new(tan_half.x.max(tan_half.y * aspect), tan_half.y.max(tan_half.x / aspect));
         } else {
             tan_half = Vec2::splat(tan_half.max_element());
         }
@@ -93,16 +82,8 @@ impl LightFrame {
         let near = (near * 0.98).max(min_depth);
         let far = far * 1.02 + min_depth;
         let fov_y = 2.0 * tan_half.y.atan();
-        let projection =
-            glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, near, far);
-        Self {
-            light: *light,
-            view,
-            projection,
-            tan_half,
-            near,
-            far,
-        }
+        let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, near, far);
+        Self { light: *light, view, projection, tan_half, near, far }
     }
 
     /// World to clip.
@@ -123,20 +104,7 @@ impl LightFrame {
     }
 }
 
-const BOX_EDGES: [(usize, usize); 12] = [
-    (0, 1),
-    (2, 3),
-    (4, 5),
-    (6, 7),
-    (0, 2),
-    (1, 3),
-    (4, 6),
-    (5, 7),
-    (0, 4),
-    (1, 5),
-    (2, 6),
-    (3, 7),
-];
+const BOX_EDGES: [(usize, usize); 12] = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
 
 /// [`LightFrame`] as the uniform `shaders/common/light_frame.wgsl` declares.
 #[repr(C)]
@@ -187,29 +155,13 @@ mod tests {
             let frame = LightFrame::fit(&scene.lights[0], &bounds);
             for corner in bounds.corners() {
                 let uvd = frame.uv_depth(corner);
-                assert!(
-                    uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0,
-                    "{}: {corner} -> {uvd}",
-                    entry.name
-                );
+                assert!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0, "{}: {corner} -> {uvd}", entry.name);
                 assert!(uvd.z >= frame.near && uvd.z <= frame.far, "{}", entry.name);
                 // The matrix path (as the rasteriser sees it) and the closed form agree.
                 let clip = frame.view_proj() * corner.extend(1.0);
                 let ndc = clip.truncate() / clip.w;
-                assert!(
-                    (0.5 + 0.5 * ndc.x - uvd.x).abs() < 1e-4,
-                    "{}: u {} vs {}",
-                    entry.name,
-                    0.5 + 0.5 * ndc.x,
-                    uvd.x
-                );
-                assert!(
-                    (0.5 - 0.5 * ndc.y - uvd.y).abs() < 1e-4,
-                    "{}: v {} vs {}",
-                    entry.name,
-                    0.5 - 0.5 * ndc.y,
-                    uvd.y
-                );
+                assert!((0.5 + 0.5 * ndc.x - uvd.x).abs() < 1e-4, "{}: u {} vs {}", entry.name, 0.5 + 0.5 * ndc.x, uvd.x);
+                assert!((0.5 - 0.5 * ndc.y - uvd.y).abs() < 1e-4, "{}: v {} vs {}", entry.name, 0.5 - 0.5 * ndc.y, uvd.y);
                 assert!(ndc.z >= 0.0 && ndc.z <= 1.0);
             }
         }
@@ -220,10 +172,7 @@ mod tests {
         let scene = builtin("parallel-square").unwrap().build();
         let frame = LightFrame::fit(&scene.lights[0], &scene.bounds());
         let centre = frame.uv_depth(Vec3::ZERO);
-        assert!(
-            (centre - Vec3::new(0.5, 0.5, 4.0)).length() < 1e-5,
-            "{centre}"
-        );
+        assert!((centre - Vec3::new(0.5, 0.5, 4.0)).length() < 1e-5, "{centre}");
         // +X is the light's u axis, +Z its v axis.
         assert!(frame.uv_depth(Vec3::X).x > 0.5 && frame.uv_depth(Vec3::Z).y > 0.5);
         // Square light: square frustum.

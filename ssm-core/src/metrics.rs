@@ -67,22 +67,10 @@ pub struct ErrorMetrics {
 /// # Panics
 /// If the slices' lengths differ from `width * height`.
 #[must_use]
-pub fn compare(
-    reference: &[f32],
-    image: &[f32],
-    covered: &[bool],
-    width: usize,
-    height: usize,
-) -> ErrorMetrics {
-    assert!(
-        reference.len() == width * height
-            && image.len() == reference.len()
-            && covered.len() == reference.len(),
-        "image sizes differ"
-    );
+pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize, height: usize) -> ErrorMetrics {
+    assert!(reference.len() == width * height && image.len() == reference.len() && covered.len() == reference.len(), "image sizes differ");
     let classes = classify(reference, covered);
-    let (mut count, mut squared, mut max_abs, mut over, mut signed) =
-        (0usize, 0.0f64, 0.0f64, 0usize, 0.0f64);
+    let (mut count, mut squared, mut max_abs, mut over, mut signed) = (0usize, 0.0f64, 0.0f64, 0usize, 0.0f64);
     let (mut shadow_sum, mut shadow_count) = (0.0f64, 0usize);
     for ((&r, &v), class) in reference.iter().zip(image).zip(&classes) {
         if *class == ShadowClass::Background {
@@ -102,26 +90,15 @@ pub fn compare(
     let n = count.max(1) as f64;
     let mse = squared / n;
     ErrorMetrics {
-        mae_penumbra: if shadow_count == 0 {
-            0.0
-        } else {
-            shadow_sum / shadow_count as f64
-        },
+        mae_penumbra: if shadow_count == 0 { 0.0 } else { shadow_sum / shadow_count as f64 },
         rmse: mse.sqrt(),
         max_abs,
-        psnr: if mse == 0.0 {
-            f64::INFINITY
-        } else {
-            -10.0 * mse.log10()
-        },
+        psnr: if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() },
         ssim: ssim(reference, image, covered, width, height),
         frac_over_0_05: over as f64 / n,
         mean_signed: signed / n,
         pixels: count,
-        penumbra_pixels: classes
-            .iter()
-            .filter(|c| **c == ShadowClass::Penumbra)
-            .count(),
+        penumbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Penumbra).count(),
         umbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Umbra).count(),
     }
 }
@@ -130,18 +107,10 @@ pub fn compare(
 /// an 11×11 Gaussian window (σ = 1.5, clamped at the borders), with
 /// C1 = (0.01)² and C2 = (0.03)² for a dynamic range of 1 (Wang et al. 2004).
 #[must_use]
-pub fn ssim(
-    reference: &[f32],
-    image: &[f32],
-    covered: &[bool],
-    width: usize,
-    height: usize,
-) -> f64 {
+pub fn ssim(reference: &[f32], image: &[f32], covered: &[bool], width: usize, height: usize) -> f64 {
     const RADIUS: i64 = 5;
     const SIGMA: f64 = 1.5;
-    let weights: Vec<f64> = (-RADIUS..=RADIUS)
-        .map(|i| (-((i * i) as f64) / (2.0 * SIGMA * SIGMA)).exp())
-        .collect();
+    let weights: Vec<f64> = (-RADIUS..=RADIUS).map(|i| (-((i * i) as f64) / (2.0 * SIGMA * SIGMA)).exp()).collect();
     let total: f64 = weights.iter().sum();
     let weights: Vec<f64> = weights.iter().map(|w| w / total).collect();
     // Separable blur with clamped borders.
@@ -150,23 +119,15 @@ pub fn ssim(
         let mut horizontal = vec![0.0; values.len()];
         for y in 0..height {
             for x in 0..width {
-                horizontal[y * width + x] = (-RADIUS..=RADIUS)
-                    .map(|k| {
-                        weights[(k + RADIUS) as usize]
-                            * values[y * width + clamp(x as i64 + k, width)]
-                    })
-                    .sum();
+                horizontal[y * width + x] =
+                    (-RADIUS..=RADIUS).map(|k| weights[(k + RADIUS) as usize] * values[y * width + clamp(x as i64 + k, width)]).sum();
             }
         }
         let mut out = vec![0.0; values.len()];
         for y in 0..height {
             for x in 0..width {
-                out[y * width + x] = (-RADIUS..=RADIUS)
-                    .map(|k| {
-                        weights[(k + RADIUS) as usize]
-                            * horizontal[clamp(y as i64 + k, height) * width + x]
-                    })
-                    .sum();
+                out[y * width + x] =
+                    (-RADIUS..=RADIUS).map(|k| weights[(k + RADIUS) as usize] * horizontal[clamp(y as i64 + k, height) * width + x]).sum();
             }
         }
         out
@@ -175,11 +136,7 @@ pub fn ssim(
     let y: Vec<f64> = image.iter().map(|v| f64::from(*v)).collect();
     let product = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).collect::<Vec<f64>>();
     let (mean_x, mean_y) = (blur(&x), blur(&y));
-    let (mean_xx, mean_yy, mean_xy) = (
-        blur(&product(&x, &x)),
-        blur(&product(&y, &y)),
-        blur(&product(&x, &y)),
-    );
+    let (mean_xx, mean_yy, mean_xy) = (blur(&product(&x, &x)), blur(&product(&y, &y)), blur(&product(&x, &y)));
     let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
     let (mut sum, mut count) = (0.0, 0usize);
     for i in 0..x.len() {
@@ -187,13 +144,8 @@ pub fn ssim(
             continue;
         }
         let (mx, my) = (mean_x[i], mean_y[i]);
-        let (vx, vy, cov) = (
-            mean_xx[i] - mx * mx,
-            mean_yy[i] - my * my,
-            mean_xy[i] - mx * my,
-        );
-        sum +=
-            ((2.0 * mx * my + c1) * (2.0 * cov + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+        let (vx, vy, cov) = (mean_xx[i] - mx * mx, mean_yy[i] - my * my, mean_xy[i] - mx * my);
+        sum += ((2.0 * mx * my + c1) * (2.0 * cov + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
         count += 1;
     }
     if count == 0 { 1.0 } else { sum / count as f64 }
@@ -207,11 +159,7 @@ pub fn ssim(
 /// If the slices are not `width * height * 4` bytes.
 #[must_use]
 pub fn flip_mean(reference_rgba: &[u8], image_rgba: &[u8], width: u32, height: u32) -> f64 {
-    let rgb = |rgba: &[u8]| {
-        rgba.chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect::<Vec<u8>>()
-    };
+    let rgb = |rgba: &[u8]| rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<u8>>();
     let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference_rgba));
     let image = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(image_rgba));
     let error = nv_flip::flip(reference, image, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
@@ -233,11 +181,7 @@ pub fn heat_map(reference: &[f32], image: &[f32], covered: &[bool], full_scale: 
         let t = ((v - r) / full_scale).clamp(-1.0, 1.0);
         let fade = ((1.0 - t.abs()) * 255.0).round() as u8;
         // Towards red (255, 0, 0) for t < 0, towards blue (0, 0, 255) for t > 0.
-        out.extend_from_slice(&if t < 0.0 {
-            [255, fade, fade]
-        } else {
-            [fade, fade, 255]
-        });
+        out.extend_from_slice(&if t < 0.0 { [255, fade, fade] } else { [fade, fade, 255] });
     }
     out
 }
@@ -247,9 +191,7 @@ mod tests {
     use super::*;
 
     fn ramp(width: usize, height: usize) -> Vec<f32> {
-        (0..width * height)
-            .map(|i| (i % width) as f32 / (width - 1) as f32)
-            .collect()
+        (0..width * height).map(|i| (i % width) as f32 / (width - 1) as f32).collect()
     }
 
     #[test]
@@ -257,10 +199,7 @@ mod tests {
         let (w, h) = (24, 16);
         let reference = ramp(w, h);
         let m = compare(&reference, &reference, &vec![true; w * h], w, h);
-        assert_eq!(
-            (m.mae_penumbra, m.rmse, m.max_abs, m.frac_over_0_05),
-            (0.0, 0.0, 0.0, 0.0)
-        );
+        assert_eq!((m.mae_penumbra, m.rmse, m.max_abs, m.frac_over_0_05), (0.0, 0.0, 0.0, 0.0));
         assert!(m.psnr.is_infinite());
         assert!((m.ssim - 1.0).abs() < 1e-12, "{}", m.ssim);
     }
@@ -271,17 +210,9 @@ mod tests {
         let reference: Vec<f32> = vec![0.5; w * h];
         let image: Vec<f32> = vec![0.6; w * h];
         let m = compare(&reference, &image, &vec![true; w * h], w, h);
-        assert!(
-            (m.rmse - 0.1).abs() < 1e-6
-                && (m.max_abs - 0.1).abs() < 1e-6
-                && (m.mae_penumbra - 0.1).abs() < 1e-6
-        );
+        assert!((m.rmse - 0.1).abs() < 1e-6 && (m.max_abs - 0.1).abs() < 1e-6 && (m.mae_penumbra - 0.1).abs() < 1e-6);
         assert!((m.mean_signed - 0.1).abs() < 1e-6);
-        assert!(
-            (m.psnr - 20.0).abs() < 1e-4,
-            "PSNR of a 0.1 offset is 20 dB, got {}",
-            m.psnr
-        );
+        assert!((m.psnr - 20.0).abs() < 1e-4, "PSNR of a 0.1 offset is 20 dB, got {}", m.psnr);
         assert_eq!(m.frac_over_0_05, 1.0);
         // Flat images: variances are 0, so SSIM is the luminance term (2·0.5·0.6 + C1)/(0.25 + 0.36 + C1).
         let expected = (2.0 * 0.5 * 0.6 + 1e-4) / (0.25 + 0.36 + 1e-4);
@@ -296,11 +227,7 @@ mod tests {
         image[15 * w + 15] = 1.0;
         let m = compare(&reference, &image, &vec![true; w * h], w, h);
         assert_eq!(m.max_abs, 1.0);
-        assert!(
-            (m.rmse - (1.0f64 / 900.0).sqrt()).abs() < 1e-9,
-            "{}",
-            m.rmse
-        );
+        assert!((m.rmse - (1.0f64 / 900.0).sqrt()).abs() < 1e-9, "{}", m.rmse);
         assert!((m.mae_penumbra - 1.0 / 900.0).abs() < 1e-9);
         assert!((m.frac_over_0_05 - 1.0 / 900.0).abs() < 1e-9);
         assert!((m.psnr - 10.0 * 900f64.log10()).abs() < 1e-9);
@@ -318,22 +245,11 @@ mod tests {
         let covered = vec![false, true, true, true];
         let m = compare(&reference, &image, &covered, 4, 1);
         assert_eq!(m.pixels, 3);
-        assert!(
-            (m.max_abs - 0.2).abs() < 1e-6,
-            "the background pixel's error of 1 is not counted"
-        );
-        assert!(
-            (m.mae_penumbra - 0.05).abs() < 1e-6,
-            "mean of 0.1 and 0.0 over the penumbra and umbra pixels"
-        );
+        assert!((m.max_abs - 0.2).abs() < 1e-6, "the background pixel's error of 1 is not counted");
+        assert!((m.mae_penumbra - 0.05).abs() < 1e-6, "mean of 0.1 and 0.0 over the penumbra and umbra pixels");
         assert_eq!(
             classify(&reference, &covered),
-            vec![
-                ShadowClass::Background,
-                ShadowClass::Lit,
-                ShadowClass::Penumbra,
-                ShadowClass::Umbra
-            ]
+            vec![ShadowClass::Background, ShadowClass::Lit, ShadowClass::Penumbra, ShadowClass::Umbra]
         );
     }
 
@@ -352,21 +268,13 @@ mod tests {
             pixel[..3].copy_from_slice(&[0, 0, 0]);
         }
         assert!(flip_mean(&grey, &grey, w, h) < 1e-6);
-        let (some, all) = (
-            flip_mean(&grey, &dotted, w, h),
-            flip_mean(&grey, &dark, w, h),
-        );
+        let (some, all) = (flip_mean(&grey, &dotted, w, h), flip_mean(&grey, &dark, w, h));
         assert!(some > 0.01 && all > some, "{some} {all}");
     }
 
     #[test]
     fn heat_map_colours_say_which_way() {
-        let map = heat_map(
-            &[0.5, 0.5, 0.5, 0.5],
-            &[0.5, 0.0, 1.0, 0.5],
-            &[true, true, true, false],
-            0.5,
-        );
+        let map = heat_map(&[0.5, 0.5, 0.5, 0.5], &[0.5, 0.0, 1.0, 0.5], &[true, true, true, false], 0.5);
         assert_eq!(&map[0..3], &[255, 255, 255]);
         assert_eq!(&map[3..6], &[255, 0, 0], "darker than the reference: red");
         assert_eq!(&map[6..9], &[0, 0, 255], "lighter: blue");

@@ -78,18 +78,10 @@ impl ParamSpec {
     /// # Errors
     /// [`ParamError::Invalid`] or [`ParamError::OutOfRange`].
     pub fn parse(&self, technique: &str, text: &str) -> Result<ParamValue, ParamError> {
-        let invalid = || ParamError::Invalid {
-            technique: technique.into(),
-            name: self.name.into(),
-            value: text.into(),
-            expected: self.range_text(),
-        };
-        let out_of_range = || ParamError::OutOfRange {
-            technique: technique.into(),
-            name: self.name.into(),
-            value: text.into(),
-            range: self.range_text(),
-        };
+        let invalid =
+            || ParamError::Invalid { technique: technique.into(), name: self.name.into(), value: text.into(), expected: self.range_text() };
+        let out_of_range =
+            || ParamError::OutOfRange { technique: technique.into(), name: self.name.into(), value: text.into(), range: self.range_text() };
         let text = text.trim();
         match self.kind {
             ParamKind::Bool { .. } => match text {
@@ -99,28 +91,16 @@ impl ParamSpec {
             },
             ParamKind::Int { min, max, .. } => {
                 let value: i64 = text.parse().map_err(|_| invalid())?;
-                if (min..=max).contains(&value) {
-                    Ok(ParamValue::Int(value))
-                } else {
-                    Err(out_of_range())
-                }
+                if (min..=max).contains(&value) { Ok(ParamValue::Int(value)) } else { Err(out_of_range()) }
             }
             ParamKind::Float { min, max, .. } => {
                 let value: f64 = text.parse().map_err(|_| invalid())?;
                 if !value.is_finite() {
                     return Err(invalid());
                 }
-                if (min..=max).contains(&value) {
-                    Ok(ParamValue::Float(value))
-                } else {
-                    Err(out_of_range())
-                }
+                if (min..=max).contains(&value) { Ok(ParamValue::Float(value)) } else { Err(out_of_range()) }
             }
-            ParamKind::Choice { options, .. } => options
-                .iter()
-                .find(|o| **o == text)
-                .map(|o| ParamValue::Choice(o))
-                .ok_or_else(invalid),
+            ParamKind::Choice { options, .. } => options.iter().find(|o| **o == text).map(|o| ParamValue::Choice(o)).ok_or_else(invalid),
         }
     }
 }
@@ -188,9 +168,7 @@ pub enum ParamError {
         range: String,
     },
     /// A technique read its own parameter with the wrong type: a bug in the technique.
-    #[error(
-        "technique `{technique}` read parameter `{name}` as {wanted}, but it is declared otherwise"
-    )]
+    #[error("technique `{technique}` read parameter `{name}` as {wanted}, but it is declared otherwise")]
     WrongType {
         /// Technique name.
         technique: String,
@@ -214,11 +192,7 @@ impl ParamValues {
     /// Every parameter at its default.
     #[must_use]
     pub fn defaults(technique: &'static str, specs: &'static [ParamSpec]) -> Self {
-        Self {
-            technique,
-            specs,
-            values: specs.iter().map(|s| (s.name, s.default_value())).collect(),
-        }
+        Self { technique, specs, values: specs.iter().map(|s| (s.name, s.default_value())).collect() }
     }
 
     /// Sets `name` from text.
@@ -226,45 +200,22 @@ impl ParamValues {
     /// # Errors
     /// [`ParamError::Unknown`], [`ParamError::Invalid`] or [`ParamError::OutOfRange`].
     pub fn set(&mut self, name: &str, text: &str) -> Result<(), ParamError> {
-        let spec =
-            self.specs
-                .iter()
-                .find(|s| s.name == name)
-                .ok_or_else(|| ParamError::Unknown {
-                    technique: self.technique.into(),
-                    name: name.into(),
-                    known: if self.specs.is_empty() {
-                        "(none)".into()
-                    } else {
-                        self.specs
-                            .iter()
-                            .map(|s| s.name)
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    },
-                })?;
+        let spec = self.specs.iter().find(|s| s.name == name).ok_or_else(|| ParamError::Unknown {
+            technique: self.technique.into(),
+            name: name.into(),
+            known: if self.specs.is_empty() { "(none)".into() } else { self.specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ") },
+        })?;
         let value = spec.parse(self.technique, text)?;
         self.values.insert(spec.name, value);
         Ok(())
     }
 
     fn get(&self, name: &str, wanted: &'static str) -> Result<ParamValue, ParamError> {
-        self.values
-            .get(name)
-            .copied()
-            .ok_or_else(|| ParamError::WrongType {
-                technique: self.technique.into(),
-                name: name.into(),
-                wanted,
-            })
+        self.values.get(name).copied().ok_or_else(|| ParamError::WrongType { technique: self.technique.into(), name: name.into(), wanted })
     }
 
     fn wrong(&self, name: &str, wanted: &'static str) -> ParamError {
-        ParamError::WrongType {
-            technique: self.technique.into(),
-            name: name.into(),
-            wanted,
-        }
+        ParamError::WrongType { technique: self.technique.into(), name: name.into(), wanted }
     }
 
     /// A bool parameter.
@@ -319,9 +270,7 @@ impl ParamValues {
 
     /// Every (name, value), in declaration order.
     pub fn iter(&self) -> impl Iterator<Item = (&'static str, ParamValue)> + '_ {
-        self.specs
-            .iter()
-            .filter_map(|s| self.values.get(s.name).map(|v| (s.name, *v)))
+        self.specs.iter().filter_map(|s| self.values.get(s.name).map(|v| (s.name, *v)))
     }
 }
 
@@ -345,37 +294,10 @@ mod tests {
     use super::*;
 
     const SPECS: &[ParamSpec] = &[
-        ParamSpec {
-            name: "size",
-            kind: ParamKind::Int {
-                default: 256,
-                min: 32,
-                max: 2048,
-            },
-            doc: "map size",
-        },
-        ParamSpec {
-            name: "bias",
-            kind: ParamKind::Float {
-                default: 0.5,
-                min: 0.0,
-                max: 4.0,
-            },
-            doc: "bias",
-        },
-        ParamSpec {
-            name: "two_sided",
-            kind: ParamKind::Bool { default: false },
-            doc: "two-sided",
-        },
-        ParamSpec {
-            name: "accumulation",
-            kind: ParamKind::Choice {
-                default: "f32",
-                options: &["f16", "f32"],
-            },
-            doc: "precision",
-        },
+        ParamSpec { name: "size", kind: ParamKind::Int { default: 256, min: 32, max: 2048 }, doc: "map size" },
+        ParamSpec { name: "bias", kind: ParamKind::Float { default: 0.5, min: 0.0, max: 4.0 }, doc: "bias" },
+        ParamSpec { name: "two_sided", kind: ParamKind::Bool { default: false }, doc: "two-sided" },
+        ParamSpec { name: "accumulation", kind: ParamKind::Choice { default: "f32", options: &["f16", "f32"] }, doc: "precision" },
     ];
 
     #[test]
@@ -386,47 +308,20 @@ mod tests {
         values.set("two_sided", "true").unwrap();
         values.set("accumulation", "f16").unwrap();
         values.set("bias", "1.5").unwrap();
-        assert_eq!(
-            values.to_string(),
-            "size=1024;bias=1.5;two_sided=true;accumulation=f16"
-        );
-        assert!(matches!(
-            values.float("size"),
-            Err(ParamError::WrongType { .. })
-        ));
+        assert_eq!(values.to_string(), "size=1024;bias=1.5;two_sided=true;accumulation=f16");
+        assert!(matches!(values.float("size"), Err(ParamError::WrongType { .. })));
     }
 
     #[test]
     fn bad_values_are_typed_errors() {
         let mut values = ParamValues::defaults("t", SPECS);
-        assert!(matches!(
-            values.set("sise", "1"),
-            Err(ParamError::Unknown { .. })
-        ));
-        assert!(matches!(
-            values.set("size", "4096"),
-            Err(ParamError::OutOfRange { .. })
-        ));
-        assert!(matches!(
-            values.set("size", "big"),
-            Err(ParamError::Invalid { .. })
-        ));
-        assert!(matches!(
-            values.set("bias", "NaN"),
-            Err(ParamError::Invalid { .. })
-        ));
-        assert!(matches!(
-            values.set("bias", "inf"),
-            Err(ParamError::Invalid { .. })
-        ));
-        assert!(matches!(
-            values.set("accumulation", "f64"),
-            Err(ParamError::Invalid { .. })
-        ));
+        assert!(matches!(values.set("sise", "1"), Err(ParamError::Unknown { .. })));
+        assert!(matches!(values.set("size", "4096"), Err(ParamError::OutOfRange { .. })));
+        assert!(matches!(values.set("size", "big"), Err(ParamError::Invalid { .. })));
+        assert!(matches!(values.set("bias", "NaN"), Err(ParamError::Invalid { .. })));
+        assert!(matches!(values.set("bias", "inf"), Err(ParamError::Invalid { .. })));
+        assert!(matches!(values.set("accumulation", "f64"), Err(ParamError::Invalid { .. })));
         let message = values.set("sise", "1").unwrap_err().to_string();
-        assert!(
-            message.contains("size, bias, two_sided, accumulation"),
-            "{message}"
-        );
+        assert!(message.contains("size, bias, two_sided, accumulation"), "{message}");
     }
 }

@@ -22,11 +22,7 @@ pub const fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
         count: None,
     }
 }
@@ -43,18 +39,12 @@ pub fn render_texture(
 ) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | extra,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
         view_formats: &[],
     })
 }
@@ -62,10 +52,7 @@ pub fn render_texture(
 /// A view of the whole texture, labelled `<texture label>_view`.
 #[must_use]
 pub fn labelled_view(texture: &wgpu::Texture, label: &str) -> wgpu::TextureView {
-    texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some(&format!("{label}_view")),
-        ..Default::default()
-    })
+    texture.create_view(&wgpu::TextureViewDescriptor { label: Some(&format!("{label}_view")), ..Default::default() })
 }
 
 /// A full-screen pass pipeline: the shared full-screen triangle vertex stage
@@ -80,8 +67,7 @@ pub fn fullscreen_pipeline(
     bind_group_layouts: &[&wgpu::BindGroupLayout],
     target: wgpu::ColorTargetState,
 ) -> wgpu::RenderPipeline {
-    let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
-        bind_group_layouts.iter().copied().map(Some).collect();
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = bind_group_layouts.iter().copied().map(Some).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(&format!("{label}_layout")),
         bind_group_layouts: &layouts,
@@ -90,12 +76,7 @@ pub fn fullscreen_pipeline(
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("fullscreen_vertex"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
+        vertex: wgpu::VertexState { module, entry_point: Some("fullscreen_vertex"), compilation_options: Default::default(), buffers: &[] },
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: None,
         multisample: wgpu::MultisampleState::default(),
@@ -112,18 +93,12 @@ pub fn fullscreen_pipeline(
 
 /// A colour attachment that clears to `clear` (or loads when `None`) and stores.
 #[must_use]
-pub fn color_attachment(
-    view: &wgpu::TextureView,
-    clear: Option<wgpu::Color>,
-) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+pub fn color_attachment(view: &wgpu::TextureView, clear: Option<wgpu::Color>) -> Option<wgpu::RenderPassColorAttachment<'_>> {
     Some(wgpu::RenderPassColorAttachment {
         view,
         depth_slice: None,
         resolve_target: None,
-        ops: wgpu::Operations {
-            load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
-            store: wgpu::StoreOp::Store,
-        },
+        ops: wgpu::Operations { load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear), store: wgpu::StoreOp::Store },
     })
 }
 
@@ -136,8 +111,7 @@ pub fn compute_pipeline(
     entry: &str,
     bind_group_layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
-    let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
-        bind_group_layouts.iter().copied().map(Some).collect();
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = bind_group_layouts.iter().copied().map(Some).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(&format!("{label}_layout")),
         bind_group_layouts: &layouts,

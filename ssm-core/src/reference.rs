@@ -59,8 +59,7 @@ impl ReferenceImage {
     /// Shadow rays per second of wall time, when rays were traced.
     #[must_use]
     pub fn rays_per_second(&self) -> Option<f64> {
-        (self.rays > 0 && !self.elapsed.is_zero())
-            .then(|| self.rays as f64 / self.elapsed.as_secs_f64())
+        (self.rays > 0 && !self.elapsed.is_zero()).then(|| self.rays as f64 / self.elapsed.as_secs_f64())
     }
 }
 
@@ -71,35 +70,17 @@ impl GroundTruth {
         let mut hasher = Fnv64::new();
         let triangles: Vec<Triangle> = scene
             .world_triangles()
-            .filter(|t| {
-                (t.corners[1] - t.corners[0])
-                    .cross(t.corners[2] - t.corners[0])
-                    .length_squared()
-                    > 0.0
-            })
+            .filter(|t| (t.corners[1] - t.corners[0]).cross(t.corners[2] - t.corners[0]).length_squared() > 0.0)
             .map(|t| {
                 for corner in t.corners {
                     hasher.write_f32s(&corner.to_array());
                 }
-                Triangle {
-                    v0: Vec3A::from(t.corners[0]),
-                    v1: Vec3A::from(t.corners[1]),
-                    v2: Vec3A::from(t.corners[2]),
-                }
+                Triangle { v0: Vec3A::from(t.corners[0]), v1: Vec3A::from(t.corners[1]), v2: Vec3A::from(t.corners[2]) }
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &triangles,
-            obvhs::BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
+        let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
         let extent = scene.bounds().size().length().max(1e-6);
-        Self {
-            triangles,
-            bvh,
-            surface_offset: extent * 1e-5,
-            geometry_hash: hasher.finish(),
-        }
+        Self { triangles, bvh, surface_offset: extent * 1e-5, geometry_hash: hasher.finish() }
     }
 
     /// True when the segment from `origin` to `target` crosses no triangle.
@@ -110,27 +91,14 @@ impl GroundTruth {
             return true;
         }
         // Stop just short of the light, so that geometry lying in the light's plane does not count twice.
-        let ray = Ray::new(
-            Vec3A::from(origin),
-            Vec3A::from(offset / distance),
-            0.0,
-            distance * (1.0 - 1e-6),
-        );
-        self.bvh.ray_traverse_miss(ray, |ray, id| {
-            self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray)
-        })
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
+        self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
     }
 
     /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
     /// samples jittered by `rng`. Points behind the light's plane see none of it.
     #[must_use]
-    pub fn visibility(
-        &self,
-        light: &RectLight,
-        point: &SurfacePoint,
-        samples_per_axis: u32,
-        rng: &mut SplitMix64,
-    ) -> f32 {
+    pub fn visibility(&self, light: &RectLight, point: &SurfacePoint, samples_per_axis: u32, rng: &mut SplitMix64) -> f32 {
         if (point.position - light.centre).dot(light.normal()) <= 0.0 {
             return 0.0;
         }
@@ -142,11 +110,7 @@ impl GroundTruth {
                 let stratum = (Vec2::new(i as f32, j as f32) + jitter) / n as f32 * 2.0 - Vec2::ONE;
                 let sample = light.point(stratum.x, stratum.y);
                 // Leave the surface on the side facing this sample, so that it does not shadow itself.
-                let side = if point.normal.dot(sample - point.position) >= 0.0 {
-                    1.0
-                } else {
-                    -1.0
-                };
+                let side = if point.normal.dot(sample - point.position) >= 0.0 { 1.0 } else { -1.0 };
                 let origin = point.position + point.normal * (side * self.surface_offset);
                 if self.unoccluded(origin, sample) {
                     visible += 1;
@@ -158,35 +122,19 @@ impl GroundTruth {
 
     /// Traces every pixel (`None`: no surface, visibility 1) on all cores.
     #[must_use]
-    pub fn trace(
-        &self,
-        light: &RectLight,
-        points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
-        seed: u64,
-    ) -> ReferenceImage {
+    pub fn trace(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> ReferenceImage {
         let start = Instant::now();
         let visibility: Vec<f32> = points
             .par_iter()
             .enumerate()
             .map(|(index, point)| match point {
-                Some(point) => self.visibility(
-                    light,
-                    point,
-                    samples_per_axis,
-                    &mut SplitMix64::for_pixel(seed, index as u64),
-                ),
+                Some(point) => self.visibility(light, point, samples_per_axis, &mut SplitMix64::for_pixel(seed, index as u64)),
                 None => 1.0,
             })
             .collect();
         let traced = points.iter().filter(|p| p.is_some()).count() as u64;
         let rays = traced * u64::from(samples_per_axis.max(1)).pow(2);
-        ReferenceImage {
-            visibility,
-            rays,
-            elapsed: start.elapsed(),
-            cached: false,
-        }
+        ReferenceImage { visibility, rays, elapsed: start.elapsed(), cached: false }
     }
 
     /// As [`GroundTruth::trace`], through a cache in `cache_dir` keyed by a hash
@@ -201,30 +149,15 @@ impl GroundTruth {
         seed: u64,
         cache_dir: &Path,
     ) -> ReferenceImage {
-        let file = cache_dir.join(format!(
-            "{:016x}.f32",
-            self.cache_key(light, points, samples_per_axis, seed)
-        ));
+        let file = cache_dir.join(format!("{:016x}.f32", self.cache_key(light, points, samples_per_axis, seed)));
         if let Ok(bytes) = std::fs::read(&file)
             && bytes.len() == points.len() * 4
         {
-            let visibility = bytes
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect();
-            return ReferenceImage {
-                visibility,
-                rays: 0,
-                elapsed: Duration::ZERO,
-                cached: true,
-            };
+            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            return ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true };
         }
         let image = self.trace(light, points, samples_per_axis, seed);
-        let bytes: Vec<u8> = image
-            .visibility
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect();
+        let bytes: Vec<u8> = image.visibility.iter().flat_map(|v| v.to_le_bytes()).collect();
         // Write then rename, so that a concurrent reader never sees half a file.
         let partial = file.with_extension(format!("partial{}", std::process::id()));
         if std::fs::create_dir_all(cache_dir).is_ok() && std::fs::write(&partial, bytes).is_ok() {
@@ -233,44 +166,18 @@ impl GroundTruth {
         image
     }
 
-    fn cache_key(
-        &self,
-        light: &RectLight,
-        points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
-        seed: u64,
-    ) -> u64 {
+    fn cache_key(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> u64 {
         let mut hasher = Fnv64::new();
         hasher.write(&REFERENCE_VERSION.to_le_bytes());
         hasher.write(&self.geometry_hash.to_le_bytes());
-        hasher.write_f32s(&[
-            light.centre.x,
-            light.centre.y,
-            light.centre.z,
-            light.u_axis.x,
-            light.u_axis.y,
-            light.u_axis.z,
-        ]);
-        hasher.write_f32s(&[
-            light.v_axis.x,
-            light.v_axis.y,
-            light.v_axis.z,
-            light.half_size.x,
-            light.half_size.y,
-        ]);
+        hasher.write_f32s(&[light.centre.x, light.centre.y, light.centre.z, light.u_axis.x, light.u_axis.y, light.u_axis.z]);
+        hasher.write_f32s(&[light.v_axis.x, light.v_axis.y, light.v_axis.z, light.half_size.x, light.half_size.y]);
         hasher.write(&samples_per_axis.to_le_bytes());
         hasher.write(&seed.to_le_bytes());
         hasher.write(&(points.len() as u64).to_le_bytes());
         for point in points {
             match point {
-                Some(p) => hasher.write_f32s(&[
-                    p.position.x,
-                    p.position.y,
-                    p.position.z,
-                    p.normal.x,
-                    p.normal.y,
-                    p.normal.z,
-                ]),
+                Some(p) => hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]),
                 None => hasher.write(&[0xff]),
             }
         }
@@ -309,19 +216,11 @@ pub fn default_cache_dir() -> PathBuf {
 /// occluder; `occluder_half_size` its half extents along the light's u and v.
 /// Used to test the ray caster on `parallel-square`.
 #[must_use]
-pub fn parallel_rectangle_visibility(
-    light: &RectLight,
-    occluder_centre: Vec3,
-    occluder_half_size: Vec2,
-    point: Vec3,
-) -> f32 {
+pub fn parallel_rectangle_visibility(light: &RectLight, occluder_centre: Vec3, occluder_half_size: Vec2, point: Vec3) -> f32 {
     let normal = light.normal();
     let local = |p: Vec3| {
         let offset = p - light.centre;
-        (
-            Vec2::new(offset.dot(light.u_axis), offset.dot(light.v_axis)),
-            offset.dot(normal),
-        )
+        (Vec2::new(offset.dot(light.u_axis), offset.dot(light.v_axis)), offset.dot(normal))
     };
     let (point_uv, point_depth) = local(point);
     let (occluder_uv, occluder_depth) = local(occluder_centre);
@@ -336,15 +235,7 @@ pub fn parallel_rectangle_visibility(
     if light.is_point() {
         // One ray, to the centre: where does it cross the occluder's plane?
         let crossing = point_uv - point_uv / scale;
-        return if (crossing - occluder_uv)
-            .abs()
-            .cmple(occluder_half_size)
-            .all()
-        {
-            0.0
-        } else {
-            1.0
-        };
+        return if (crossing - occluder_uv).abs().cmple(occluder_half_size).all() { 0.0 } else { 1.0 };
     }
     let low = point_uv + (occluder_uv - occluder_half_size - point_uv) * scale;
     let high = point_uv + (occluder_uv + occluder_half_size - point_uv) * scale;
@@ -363,9 +254,7 @@ impl SplitMix64 {
     /// A generator for pixel `index` of a run seeded with `seed`.
     #[must_use]
     pub fn for_pixel(seed: u64, index: u64) -> Self {
-        let mut mixer = Self {
-            state: seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15),
-        };
+        let mut mixer = Self { state: seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) };
         // Decorrelate neighbouring pixels before use.
         mixer.next_u64();
         mixer
@@ -422,14 +311,7 @@ mod tests {
     fn analytic_formula_matches_the_hand_computed_parallel_square() {
         let scene = builtin("parallel-square").unwrap().build();
         let light = &scene.lights[0];
-        let exact = |x: f32, z: f32| {
-            parallel_rectangle_visibility(
-                light,
-                Vec3::new(0.0, 2.0, 0.0),
-                Vec2::splat(0.5),
-                Vec3::new(x, 0.0, z),
-            )
-        };
+        let exact = |x: f32, z: f32| parallel_rectangle_visibility(light, Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5), Vec3::new(x, 0.0, z));
         assert_eq!(exact(0.0, 0.0), 0.0);
         assert_eq!(exact(2.0, 0.0), 1.0);
         // Half-way through the penumbra along x, half the light is hidden.
@@ -447,10 +329,7 @@ mod tests {
         let mean = samples.iter().sum::<f32>() / samples.len() as f32;
         assert!((mean - 0.5).abs() < 0.01, "{mean}");
         assert_eq!(samples[0], b.next_f32());
-        assert_ne!(
-            SplitMix64::for_pixel(7, 4).next_u64(),
-            SplitMix64::for_pixel(7, 3).next_u64()
-        );
+        assert_ne!(SplitMix64::for_pixel(7, 4).next_u64(), SplitMix64::for_pixel(7, 3).next_u64());
     }
 }
 
@@ -461,22 +340,10 @@ pub const NAME: &str = "reference";
 pub const PARAMS: &[crate::ParamSpec] = &[
     crate::ParamSpec {
         name: "samples",
-        kind: crate::ParamKind::Int {
-            default: 16,
-            min: 1,
-            max: 256,
-        },
+        kind: crate::ParamKind::Int { default: 16, min: 1, max: 256 },
         doc: "light samples per axis (N): N×N stratified, jittered shadow rays per pixel",
     },
-    crate::ParamSpec {
-        name: "seed",
-        kind: crate::ParamKind::Int {
-            default: 1,
-            min: 0,
-            max: i64::MAX,
-        },
-        doc: "seed of the jitter",
-    },
+    crate::ParamSpec { name: "seed", kind: crate::ParamKind::Int { default: 1, min: 0, max: i64::MAX }, doc: "seed of the jitter" },
     crate::ParamSpec {
         name: "cache",
         kind: crate::ParamKind::Bool { default: true },
@@ -503,14 +370,8 @@ impl ReferenceTechnique {
     fn points(&mut self, frame: &crate::Frame<'_>) -> crate::Result<&[Option<SurfacePoint>]> {
         if self.points.is_none() {
             let gbuffer = frame.shared.gbuffer(NAME)?;
-            let positions = crate::readback::read_texture(
-                frame.gpu,
-                &gbuffer.position,
-                16,
-                "G-buffer positions",
-            )?;
-            let normals =
-                crate::readback::read_texture(frame.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
+            let positions = crate::readback::read_texture(frame.gpu, &gbuffer.position, 16, "G-buffer positions")?;
+            let normals = crate::readback::read_texture(frame.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
             let positions: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&positions);
             let normals: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&normals);
             self.points = Some(
@@ -531,21 +392,13 @@ impl ReferenceTechnique {
 }
 
 impl crate::ShadowTechnique for ReferenceTechnique {
-    fn render(
-        &mut self,
-        frame: &mut crate::Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> crate::Result<()> {
+    fn render(&mut self, frame: &mut crate::Frame<'_>, light: usize, output: &wgpu::TextureView) -> crate::Result<()> {
         let rect = frame
             .scene
             .light_frames
             .get(light)
             .map(|f| f.light)
-            .ok_or_else(|| crate::Error::Technique {
-                technique: NAME.into(),
-                message: format!("no light {light}"),
-            })?;
+            .ok_or_else(|| crate::Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
         if self.traced_per_light.len() <= light {
             self.traced_per_light.resize(light + 1, None);
         }
@@ -559,26 +412,15 @@ impl crate::ShadowTechnique for ReferenceTechnique {
             };
             self.traced_per_light[light] = Some(image);
         }
-        let Some(image) = &self.traced_per_light[light] else {
-            unreachable!("traced above")
-        };
+        let Some(image) = &self.traced_per_light[light] else { unreachable!("traced above") };
         let (width, height) = (self.traced.width(), self.traced.height());
         frame.gpu.queue.write_texture(
             self.traced.as_image_copy(),
             bytemuck::cast_slice(&image.visibility),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width * 4),
-                rows_per_image: Some(height),
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
+            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         );
-        self.upload
-            .encode(frame, light, output, Some(&self.traced_group), None);
+        self.upload.encode(frame, light, output, Some(&self.traced_group), None);
         Ok(())
     }
 
@@ -591,18 +433,12 @@ impl crate::ShadowTechnique for ReferenceTechnique {
         let rays: u64 = images.iter().map(|i| i.rays).sum();
         let seconds: f64 = images.iter().map(|i| i.elapsed.as_secs_f64()).sum();
         let mut out = vec![
-            (
-                "reference_lights_from_cache".to_owned(),
-                images.iter().filter(|i| i.cached).count() as f64,
-            ),
+            ("reference_lights_from_cache".to_owned(), images.iter().filter(|i| i.cached).count() as f64),
             ("reference_rays".to_owned(), rays as f64),
             ("reference_trace_ms".to_owned(), seconds * 1e3),
         ];
         if rays > 0 && seconds > 0.0 {
-            out.push((
-                "reference_rays_per_second".to_owned(),
-                rays as f64 / seconds,
-            ));
+            out.push(("reference_rays_per_second".to_owned(), rays as f64 / seconds));
         }
         out
     }
@@ -612,14 +448,8 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
     let params = setup.params;
     let device = &setup.gpu.device;
     let (width, height) = (setup.scene.width, setup.scene.height);
-    let traced = crate::passes::render_texture(
-        device,
-        "reference_traced",
-        width,
-        height,
-        crate::VISIBILITY_FORMAT,
-        wgpu::TextureUsages::COPY_DST,
-    );
+    let traced =
+        crate::passes::render_texture(device, "reference_traced", width, height, crate::VISIBILITY_FORMAT, wgpu::TextureUsages::COPY_DST);
     let traced_view = crate::passes::labelled_view(&traced, "reference_traced");
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("reference_traced_layout"),
@@ -628,16 +458,10 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
     let traced_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("reference_traced_bind_group"),
         layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::TextureView(&traced_view),
-        }],
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&traced_view) }],
     });
-    let module = crate::shader::create_shader(
-        setup.gpu,
-        "reference_upload_shader",
-        include_str!("../../shaders/core/reference_upload.wgsl"),
-    )?;
+    let module =
+        crate::shader::create_shader(setup.gpu, "reference_upload_shader", include_str!("../../shaders/core/reference_upload.wgsl"))?;
     let upload = crate::ScreenPass::new(
         setup,
         NAME,
@@ -666,12 +490,7 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling)",
     kind: crate::TechniqueKind::GroundTruth,
     params: PARAMS,
-    requirements: |_| {
-        Ok(crate::Requirements {
-            gbuffer: true,
-            ..crate::Requirements::NONE
-        })
-    },
+    requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,
 };
 

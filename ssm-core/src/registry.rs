@@ -23,11 +23,7 @@ impl Registry {
         let mut map: BTreeMap<&'static str, &'static TechniqueInfo> = BTreeMap::new();
         for info in entries {
             if let Some(first) = map.insert(info.name, info) {
-                return Err(Error::DuplicateTechnique {
-                    name: info.name.into(),
-                    first: first.summary.into(),
-                    second: info.summary.into(),
-                });
+                return Err(Error::DuplicateTechnique { name: info.name.into(), first: first.summary.into(), second: info.summary.into() });
             }
         }
         Ok(Self { entries: map })
@@ -38,25 +34,18 @@ impl Registry {
     /// # Errors
     /// [`Error::DuplicateTechnique`] when two crates register one name.
     pub fn global() -> Result<&'static Self> {
-        static GLOBAL: OnceLock<std::result::Result<Registry, (String, String, String)>> =
-            OnceLock::new();
+        static GLOBAL: OnceLock<std::result::Result<Registry, (String, String, String)>> = OnceLock::new();
         let built = GLOBAL.get_or_init(|| {
             Self::from_entries(inventory::iter::<TechniqueInfo>).map_err(|e| match e {
-                Error::DuplicateTechnique {
-                    name,
-                    first,
-                    second,
-                } => (name, first, second),
+                Error::DuplicateTechnique { name, first, second } => (name, first, second),
                 other => (String::new(), other.to_string(), String::new()),
             })
         });
-        built
-            .as_ref()
-            .map_err(|(name, first, second)| Error::DuplicateTechnique {
-                name: name.clone(),
-                first: first.clone(),
-                second: second.clone(),
-            })
+        built.as_ref().map_err(|(name, first, second)| Error::DuplicateTechnique {
+            name: name.clone(),
+            first: first.clone(),
+            second: second.clone(),
+        })
     }
 
     /// The technique called `name`.
@@ -64,13 +53,7 @@ impl Registry {
     /// # Errors
     /// [`Error::UnknownTechnique`] listing the registered names.
     pub fn get(&self, name: &str) -> Result<&'static TechniqueInfo> {
-        self.entries
-            .get(name)
-            .copied()
-            .ok_or_else(|| Error::UnknownTechnique {
-                name: name.into(),
-                known: self.names().join(", "),
-            })
+        self.entries.get(name).copied().ok_or_else(|| Error::UnknownTechnique { name: name.into(), known: self.names().join(", ") })
     }
 
     /// Every technique, sorted by name.
@@ -91,10 +74,7 @@ mod tests {
     use crate::technique::{Requirements, TechniqueKind};
 
     fn no_create(_: &crate::TechniqueSetup<'_>) -> Result<Box<dyn crate::ShadowTechnique>> {
-        Err(Error::Technique {
-            technique: "test".into(),
-            message: "not creatable".into(),
-        })
+        Err(Error::Technique { technique: "test".into(), message: "not creatable".into() })
     }
 
     static ALPHA: TechniqueInfo = TechniqueInfo {
@@ -131,18 +111,12 @@ mod tests {
         assert_eq!(registry.names(), vec!["alpha", "beta"]);
         assert_eq!(registry.get("beta").unwrap().summary, "b");
         let err = registry.get("gamma").unwrap_err().to_string();
-        assert!(
-            err.contains("gamma") && err.contains("alpha, beta"),
-            "{err}"
-        );
+        assert!(err.contains("gamma") && err.contains("alpha, beta"), "{err}");
     }
 
     #[test]
     fn duplicate_names_are_an_error() {
         let err = Registry::from_entries([&ALPHA, &BETA, &ALPHA_AGAIN]).unwrap_err();
-        assert!(
-            matches!(err, Error::DuplicateTechnique { ref name, .. } if name == "alpha"),
-            "{err}"
-        );
+        assert!(matches!(err, Error::DuplicateTechnique { ref name, .. } if name == "alpha"), "{err}");
     }
 }

@@ -49,21 +49,11 @@ impl Renderer {
     ///
     /// # Errors
     /// [`Error::Scene`] for an invalid scene, [`Error::InvalidSize`], or a GPU error.
-    pub fn new(
-        gpu: &GpuContext,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        needs: &Requirements,
-    ) -> Result<Self> {
+    pub fn new(gpu: &GpuContext, scene: &Scene, width: u32, height: u32, needs: &Requirements) -> Result<Self> {
         scene.validate()?;
         let max = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
-            return Err(Error::InvalidSize {
-                width,
-                height,
-                problem: format!("each side must be in [1, {max}] on this adapter"),
-            });
+            return Err(Error::InvalidSize { width, height, problem: format!("each side must be in [1, {max}] on this adapter") });
         }
         let gpu = gpu.clone();
         let gpu_scene = GpuScene::new(&gpu, scene, width, height);
@@ -72,24 +62,15 @@ impl Renderer {
         let mut shared_timings = Vec::new();
         if needs.gbuffer {
             let gbuffer = GBuffer::new(&gpu, &gpu_scene)?;
-            let mut encoder = gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("gbuffer_encoder"),
-                });
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer_encoder") });
             encoder.push_debug_group("gbuffer");
             gbuffer.encode(&mut encoder, &gpu_scene, &mut timer);
             encoder.pop_debug_group();
             timer.resolve(&mut encoder);
             let start = Instant::now();
             gpu.queue.submit([encoder.finish()]);
-            gpu.wait_idle().map_err(|e| Error::Gpu {
-                during: "rendering the G-buffer".into(),
-                messages: vec![e],
-            })?;
-            shared_timings = timer
-                .read(&gpu, start.elapsed().as_secs_f64() * 1e3)?
-                .passes;
+            gpu.wait_idle().map_err(|e| Error::Gpu { during: "rendering the G-buffer".into(), messages: vec![e] })?;
+            shared_timings = timer.read(&gpu, start.elapsed().as_secs_f64() * 1e3)?.passes;
             timer.reset();
             shared.gbuffer = Some(gbuffer);
         }
@@ -127,14 +108,7 @@ impl Renderer {
 
     fn check_gpu_errors(&self, during: &str) -> Result<()> {
         let messages = self.gpu.take_errors();
-        if messages.is_empty() {
-            Ok(())
-        } else {
-            Err(Error::Gpu {
-                during: during.into(),
-                messages,
-            })
-        }
+        if messages.is_empty() { Ok(()) } else { Err(Error::Gpu { during: during.into(), messages }) }
     }
 
     /// Creates a technique with `params`, after checking its requirements
@@ -143,18 +117,8 @@ impl Renderer {
     /// # Errors
     /// [`Error::MissingFeatures`], [`Error::LimitTooLow`], [`Error::UndeclaredRequirement`],
     /// or whatever the technique's constructor reports.
-    pub fn create_technique(
-        &self,
-        info: &TechniqueInfo,
-        params: &ParamValues,
-    ) -> Result<Box<dyn ShadowTechnique>> {
-        create_checked(
-            info,
-            &self.gpu,
-            (&self.scene, &self.cpu_scene),
-            &self.shared,
-            params,
-        )
+    pub fn create_technique(&self, info: &TechniqueInfo, params: &ParamValues) -> Result<Box<dyn ShadowTechnique>> {
+        create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), &self.shared, params)
     }
 
     /// Renders one frame of `technique` (registered as `name`) for every
@@ -162,11 +126,7 @@ impl Renderer {
     ///
     /// # Errors
     /// The technique's own errors, or [`Error::Gpu`] if wgpu reported any.
-    pub fn render(
-        &mut self,
-        technique: &mut dyn ShadowTechnique,
-        name: &str,
-    ) -> Result<FrameTimings> {
+    pub fn render(&mut self, technique: &mut dyn ShadowTechnique, name: &str) -> Result<FrameTimings> {
         let start = Instant::now();
         self.timer.reset();
         let mut frame = Frame {
@@ -176,22 +136,16 @@ impl Renderer {
             encoder: self
                 .gpu
                 .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some(&format!("{name}_frame_encoder")),
-                }),
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{name}_frame_encoder")) }),
             timer: &mut self.timer,
         };
         for (light, (_, view)) in self.visibility.iter().enumerate() {
             // The contract: the target starts fully lit.
-            drop(
-                frame
-                    .encoder
-                    .begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("visibility_clear"),
-                        color_attachments: &[color_attachment(view, Some(wgpu::Color::WHITE))],
-                        ..Default::default()
-                    }),
-            );
+            drop(frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("visibility_clear"),
+                color_attachments: &[color_attachment(view, Some(wgpu::Color::WHITE))],
+                ..Default::default()
+            }));
             frame.timer.set_light(light);
             frame.encoder.push_debug_group(name);
             let result = technique.render(&mut frame, light, view);
@@ -201,10 +155,7 @@ impl Renderer {
         let Frame { mut encoder, .. } = frame;
         self.timer.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
-        self.gpu.wait_idle().map_err(|e| Error::Gpu {
-            during: format!("rendering `{name}`"),
-            messages: vec![e],
-        })?;
+        self.gpu.wait_idle().map_err(|e| Error::Gpu { during: format!("rendering `{name}`"), messages: vec![e] })?;
         let cpu_wall_ms = start.elapsed().as_secs_f64() * 1e3;
         self.check_gpu_errors(&format!("rendering `{name}`"))?;
         self.timer.read(&self.gpu, cpu_wall_ms)
@@ -216,20 +167,13 @@ impl Renderer {
     /// # Errors
     /// [`Error::InvalidOutput`] naming `technique` and the first bad pixel, or a readback error.
     pub fn read_visibility(&self, light: usize, technique: &str) -> Result<Vec<f32>> {
-        let (texture, _) = self.visibility.get(light).ok_or_else(|| Error::Readback {
-            what: format!("visibility of light {light}"),
-            detail: "no such light".into(),
-        })?;
+        let (texture, _) = self
+            .visibility
+            .get(light)
+            .ok_or_else(|| Error::Readback { what: format!("visibility of light {light}"), detail: "no such light".into() })?;
         let bytes = read_texture(&self.gpu, texture, 4, "visibility")?;
-        let values: Vec<f32> = bytes
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        let bad = |v: &f32| {
-            !(v.is_finite()
-                && *v >= -VISIBILITY_RANGE_TOLERANCE
-                && *v <= 1.0 + VISIBILITY_RANGE_TOLERANCE)
-        };
+        let values: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        let bad = |v: &f32| !(v.is_finite() && *v >= -VISIBILITY_RANGE_TOLERANCE && *v <= 1.0 + VISIBILITY_RANGE_TOLERANCE);
         if let Some(first) = values.iter().position(bad) {
             let width = self.scene.width as usize;
             return Err(Error::InvalidOutput {
@@ -271,22 +215,11 @@ impl Renderer {
     pub fn shade(&mut self) -> Result<Vec<u8>> {
         let gbuffer = self.shared.gbuffer("composite shading")?;
         if self.composite.is_none() {
-            let views: Vec<wgpu::TextureView> = self
-                .visibility
-                .iter()
-                .map(|(_, view)| view.clone())
-                .collect();
+            let views: Vec<wgpu::TextureView> = self.visibility.iter().map(|(_, view)| view.clone()).collect();
             self.composite = Some(Composite::new(&self.gpu, &self.scene, gbuffer, &views)?);
         }
-        let Some(composite) = &self.composite else {
-            unreachable!("built above")
-        };
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("composite_encoder"),
-            });
+        let Some(composite) = &self.composite else { unreachable!("built above") };
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("composite_encoder") });
         composite.encode(&mut encoder, &self.scene, gbuffer);
         self.gpu.queue.submit([encoder.finish()]);
         let pixels = read_texture(&self.gpu, &composite.target, 4, "shaded image")?;
@@ -315,11 +248,6 @@ fn casting_adjacency(scene: &Scene) -> Adjacency {
     }
     let indices = (0..positions.len() as u32).collect();
     // Normals are not used by adjacency; welding happens on positions.
-    let mesh = Mesh {
-        name: "casting geometry".into(),
-        normals: vec![glam::Vec3::Y; positions.len()],
-        positions,
-        indices,
-    };
+    let mesh = Mesh { name: "casting geometry".into(), normals: vec![glam::Vec3::Y; positions.len()], positions, indices };
     Adjacency::of(&mesh)
 }

@@ -37,19 +37,8 @@ impl ScreenPass {
         let gbuffer = setup.shared.gbuffer(technique)?;
         let mut layouts = vec![&setup.scene.uniform_layout, &gbuffer.layout];
         layouts.extend(own_layout);
-        let pipeline = fullscreen_pipeline(
-            &setup.gpu.device,
-            &format!("{label}_pipeline"),
-            module,
-            fragment,
-            &layouts,
-            target,
-        );
-        Ok(Self {
-            label: label.to_owned(),
-            pipeline,
-            gbuffer_bind_group: gbuffer.bind_group.clone(),
-        })
+        let pipeline = fullscreen_pipeline(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target);
+        Ok(Self { label: label.to_owned(), pipeline, gbuffer_bind_group: gbuffer.bind_group.clone() })
     }
 
     /// Records the pass for `light` into `target`, with `own_group` at group 2.

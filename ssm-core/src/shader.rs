@@ -10,10 +10,7 @@ use crate::error::{Error, Result};
 /// `(import path, text)` of one file under `shaders/common/`.
 macro_rules! common_shader {
     ($file:literal) => {
-        (
-            concat!("common/", $file),
-            include_str!(concat!("../../shaders/common/", $file)),
-        )
+        (concat!("common/", $file), include_str!(concat!("../../shaders/common/", $file)))
     };
 }
 
@@ -34,10 +31,7 @@ pub const IMPORT_PREFIX: &str = "// #import ";
 ///
 /// # Errors
 /// The name of an import `lookup` does not know, or an import cycle.
-pub fn compose_with(
-    source: &str,
-    lookup: &dyn Fn(&str) -> Option<String>,
-) -> std::result::Result<String, String> {
+pub fn compose_with(source: &str, lookup: &dyn Fn(&str) -> Option<String>) -> std::result::Result<String, String> {
     fn visit(
         source: &str,
         lookup: &dyn Fn(&str) -> Option<String>,
@@ -77,16 +71,8 @@ pub fn compose_with(
 /// # Errors
 /// [`Error::Shader`] naming `label` and the unknown import.
 pub fn compose(label: &str, source: &str) -> Result<String> {
-    compose_with(source, &|path| {
-        COMMON_SHADERS
-            .iter()
-            .find(|(p, _)| *p == path)
-            .map(|(_, text)| (*text).to_owned())
-    })
-    .map_err(|problem| Error::Shader {
-        shader: label.into(),
-        problem,
-    })
+    compose_with(source, &|path| COMMON_SHADERS.iter().find(|(p, _)| *p == path).map(|(_, text)| (*text).to_owned()))
+        .map_err(|problem| Error::Shader { shader: label.into(), problem })
 }
 
 /// Assembles and compiles a shader module labelled `label`.
@@ -95,19 +81,8 @@ pub fn compose(label: &str, source: &str) -> Result<String> {
 /// [`Error::Shader`] for a bad import, [`Error::Gpu`] when wgpu rejects the WGSL.
 pub fn create_shader(gpu: &GpuContext, label: &str, source: &str) -> Result<wgpu::ShaderModule> {
     let code = compose(label, source)?;
-    let module = gpu
-        .device
-        .create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(code.into()),
-        });
+    let module =
+        gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(code.into()) });
     let messages = gpu.take_errors();
-    if messages.is_empty() {
-        Ok(module)
-    } else {
-        Err(Error::Gpu {
-            during: format!("compiling shader `{label}`"),
-            messages,
-        })
-    }
+    if messages.is_empty() { Ok(module) } else { Err(Error::Gpu { during: format!("compiling shader `{label}`"), messages }) }
 }

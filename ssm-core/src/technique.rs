@@ -28,13 +28,7 @@ pub struct Requirements {
 
 impl Requirements {
     /// Nothing at all.
-    pub const NONE: Self = Self {
-        gbuffer: false,
-        roles: false,
-        adjacency: false,
-        features: wgpu::Features::empty(),
-        max_texture_size: 0,
-    };
+    pub const NONE: Self = Self { gbuffer: false, roles: false, adjacency: false, features: wgpu::Features::empty(), max_texture_size: 0 };
 
     /// Everything either asks for.
     #[must_use]
@@ -55,11 +49,7 @@ impl Requirements {
     pub fn check_device(&self, technique: &str, gpu: &GpuContext) -> Result<()> {
         let missing = self.features - gpu.features();
         if !missing.is_empty() {
-            return Err(Error::MissingFeatures {
-                technique: technique.into(),
-                features: missing,
-                adapter: gpu.describe(),
-            });
+            return Err(Error::MissingFeatures { technique: technique.into(), features: missing, adapter: gpu.describe() });
         }
         let allowed = gpu.device.limits().max_texture_dimension_2d;
         if self.max_texture_size > allowed {
@@ -88,11 +78,7 @@ impl Requirements {
         for (name, _) in self.features.iter_names() {
             parts.push(name.to_owned());
         }
-        if parts.is_empty() {
-            "nothing".into()
-        } else {
-            parts.join(", ")
-        }
+        if parts.is_empty() { "nothing".into() } else { parts.join(", ") }
     }
 }
 
@@ -128,12 +114,7 @@ pub trait ShadowTechnique {
     ///
     /// # Errors
     /// Anything the technique cannot do with this scene or frame.
-    fn render(
-        &mut self,
-        frame: &mut Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> Result<()>;
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()>;
 
     /// Scalar diagnostics of the last frame, reported beside the error metrics
     /// (SSSM's reuse share, PVSM's tile count...). Empty by default.
@@ -182,10 +163,7 @@ impl TechniqueInfo {
     ///
     /// # Errors
     /// [`Error::Param`] for an unknown name or bad value.
-    pub fn params_from<'s>(
-        &self,
-        assignments: impl IntoIterator<Item = (&'s str, &'s str)>,
-    ) -> Result<ParamValues> {
+    pub fn params_from<'s>(&self, assignments: impl IntoIterator<Item = (&'s str, &'s str)>) -> Result<ParamValues> {
         let mut values = self.default_params();
         for (name, value) in assignments {
             values.set(name, value)?;
@@ -196,10 +174,7 @@ impl TechniqueInfo {
 
 impl std::fmt::Debug for TechniqueInfo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("TechniqueInfo")
-            .field("name", &self.name)
-            .field("summary", &self.summary)
-            .finish_non_exhaustive()
+        f.debug_struct("TechniqueInfo").field("name", &self.name).field("summary", &self.summary).finish_non_exhaustive()
     }
 }
 
@@ -238,10 +213,7 @@ pub(crate) fn create_checked(
     let requirements = (info.requirements)(params)?;
     requirements.check_device(info.name, gpu)?;
     if requirements.gbuffer && shared.gbuffer.is_none() {
-        return Err(Error::UndeclaredRequirement {
-            technique: info.name.into(),
-            input: "G-buffer (the renderer was built without it)",
-        });
+        return Err(Error::UndeclaredRequirement { technique: info.name.into(), input: "G-buffer (the renderer was built without it)" });
     }
     if requirements.adjacency && shared.adjacency.is_none() {
         return Err(Error::UndeclaredRequirement {
@@ -249,20 +221,7 @@ pub(crate) fn create_checked(
             input: "mesh adjacency (the renderer was built without it)",
         });
     }
-    let technique = (info.create)(&TechniqueSetup {
-        gpu,
-        scene,
-        cpu_scene,
-        shared,
-        params,
-    })?;
+    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, params })?;
     let messages = gpu.take_errors();
-    if messages.is_empty() {
-        Ok(technique)
-    } else {
-        Err(Error::Gpu {
-            during: format!("creating technique `{}`", info.name),
-            messages,
-        })
-    }
+    if messages.is_empty() { Ok(technique) } else { Err(Error::Gpu { during: format!("creating technique `{}`", info.name), messages }) }
 }

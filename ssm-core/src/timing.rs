@@ -80,12 +80,7 @@ impl PassTimer {
             }),
             period_ns: f64::from(gpu.queue.get_timestamp_period()),
         });
-        Self {
-            queries,
-            scopes: Vec::new(),
-            untimed: 0,
-            light: 0,
-        }
+        Self { queries, scopes: Vec::new(), untimed: 0, light: 0 }
     }
 
     /// True when passes are timed on the GPU.
@@ -118,22 +113,20 @@ impl PassTimer {
 
     /// Timestamp writes for a render pass called `name`.
     pub fn render_pass(&mut self, name: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.allocate(name)
-            .map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(first),
-                end_of_pass_write_index: Some(first + 1),
-            })
+        self.allocate(name).map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(first),
+            end_of_pass_write_index: Some(first + 1),
+        })
     }
 
     /// Timestamp writes for a compute pass called `name`.
     pub fn compute_pass(&mut self, name: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.allocate(name)
-            .map(|(query_set, first)| wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(first),
-                end_of_pass_write_index: Some(first + 1),
-            })
+        self.allocate(name).map(|(query_set, first)| wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(first),
+            end_of_pass_write_index: Some(first + 1),
+        })
     }
 
     /// Records the resolve of this frame's queries; call once, last, in the frame's final encoder.
@@ -141,12 +134,7 @@ impl PassTimer {
         if let Some(queries) = &self.queries
             && !self.scopes.is_empty()
         {
-            encoder.resolve_query_set(
-                &queries.query_set,
-                0..self.scopes.len() as u32 * 2,
-                &queries.resolve_buffer,
-                0,
-            );
+            encoder.resolve_query_set(&queries.query_set, 0..self.scopes.len() as u32 * 2, &queries.resolve_buffer, 0);
         }
     }
 
@@ -166,33 +154,16 @@ impl PassTimer {
         };
         let mut passes = Vec::with_capacity(self.scopes.len());
         if !self.scopes.is_empty() {
-            let bytes = read_buffer(
-                gpu,
-                &queries.resolve_buffer,
-                self.scopes.len() as u64 * 16,
-                "pass timestamps",
-            )?;
-            let stamps: &[u64] = bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Readback {
-                what: "pass timestamps".into(),
-                detail: e.to_string(),
-            })?;
+            let bytes = read_buffer(gpu, &queries.resolve_buffer, self.scopes.len() as u64 * 16, "pass timestamps")?;
+            let stamps: &[u64] =
+                bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Readback { what: "pass timestamps".into(), detail: e.to_string() })?;
             for ((name, light), pair) in self.scopes.iter().zip(stamps.chunks_exact(2)) {
                 // Some drivers return an end before the begin for empty passes: count those as zero.
                 let ticks = pair[1].saturating_sub(pair[0]);
-                passes.push(PassTiming {
-                    name: name.clone(),
-                    light: *light,
-                    ms: ticks as f64 * queries.period_ns * 1e-6,
-                });
+                passes.push(PassTiming { name: name.clone(), light: *light, ms: ticks as f64 * queries.period_ns * 1e-6 });
             }
         }
         let gpu_ms = Some(passes.iter().map(|p| p.ms).sum());
-        Ok(FrameTimings {
-            source: TimingSource::GpuTimestamps,
-            passes,
-            gpu_ms,
-            cpu_wall_ms,
-            untimed_passes: self.untimed,
-        })
+        Ok(FrameTimings { source: TimingSource::GpuTimestamps, passes, gpu_ms, cpu_wall_ms, untimed_passes: self.untimed })
     }
 }

@@ -50,10 +50,7 @@ impl Adjacency {
                 })
             })
             .collect();
-        let triangles: Vec<[u32; 3]> = mesh
-            .triangles()
-            .map(|t| t.map(|i| remap[i as usize]))
-            .collect();
+        let triangles: Vec<[u32; 3]> = mesh.triangles().map(|t| t.map(|i| remap[i as usize])).collect();
 
         let mut edges: Vec<Edge> = Vec::new();
         let mut by_key: HashMap<(u32, u32), usize> = HashMap::new();
@@ -74,20 +71,12 @@ impl Adjacency {
                     }
                     None => {
                         by_key.insert(key, edges.len());
-                        edges.push(Edge {
-                            vertices: [a, b],
-                            faces: [face as u32, NO_FACE],
-                            face_count: 1,
-                        });
+                        edges.push(Edge { vertices: [a, b], faces: [face as u32, NO_FACE], face_count: 1 });
                     }
                 }
             }
         }
-        Self {
-            welded_positions,
-            triangles,
-            edges,
-        }
+        Self { welded_positions, triangles, edges }
     }
 
     /// Edges used by one face only: holes and borders.
@@ -126,11 +115,7 @@ mod tests {
         let ball = Adjacency::of(&sphere("s", 1.0, 12, 6));
         assert!(ball.is_closed_manifold());
         // Euler: V - E + F = 2 for a sphere.
-        assert_eq!(
-            ball.welded_positions.len() as i64 - ball.edges.len() as i64
-                + ball.triangles.len() as i64,
-            2
-        );
+        assert_eq!(ball.welded_positions.len() as i64 - ball.edges.len() as i64 + ball.triangles.len() as i64, 2);
     }
 
     #[test]

@@ -41,12 +41,7 @@ impl Camera {
     /// # Errors
     /// [`SceneError::InvalidCamera`] naming `file` and the problem.
     pub fn validate(&self, file: &Path) -> Result<()> {
-        let fail = |problem: String| {
-            Err(SceneError::InvalidCamera {
-                file: file.into(),
-                problem,
-            })
-        };
+        let fail = |problem: String| Err(SceneError::InvalidCamera { file: file.into(), problem });
         if !(self.position.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return fail("position, target or up is not finite".into());
         }
@@ -57,16 +52,10 @@ impl Camera {
             return fail(format!("up {} is parallel to the view direction", self.up));
         }
         if !(self.fov_y > 0.0 && self.fov_y < std::f32::consts::PI) {
-            return fail(format!(
-                "vertical field of view {}° is outside (0°, 180°)",
-                self.fov_y.to_degrees()
-            ));
+            return fail(format!("vertical field of view {}° is outside (0°, 180°)", self.fov_y.to_degrees()));
         }
         if !(self.near > 0.0 && self.far > self.near && self.far.is_finite()) {
-            return fail(format!(
-                "near {} and far {} must satisfy 0 < near < far < ∞",
-                self.near, self.far
-            ));
+            return fail(format!("near {} and far {} must satisfy 0 < near < far < ∞", self.near, self.far));
         }
         Ok(())
     }

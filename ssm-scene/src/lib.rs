@@ -28,9 +28,7 @@ pub use camera::Camera;
 pub use error::{Result, SceneError};
 pub use light::RectLight;
 pub use loaders::{LoadedModel, Placement, load_model};
-pub use manifest::{
-    CameraSpec, LightSpec, Manifest, ObjectSpec, Scale, framing_camera, stage_model,
-};
+pub use manifest::{CameraSpec, LightSpec, Manifest, ObjectSpec, Scale, framing_camera, stage_model};
 pub use mesh::{Mesh, fan_to_list, generate_normals, strip_to_list};
 pub use scene::{Aabb, Instance, Role, Scene, WorldTriangle, normal_matrix};
 
@@ -55,30 +53,19 @@ impl Scene {
             return Ok((builtin.build(), SceneSource::Builtin(builtin)));
         }
         let path = Path::new(spec);
-        let extension = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or_default()
-            .to_ascii_lowercase();
+        let extension = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         let base_dir = path.parent().unwrap_or_else(|| Path::new("."));
         match extension.as_str() {
-            "toml" => Ok((
-                Manifest::read(path)?.build(path, base_dir)?,
-                SceneSource::Manifest,
-            )),
+            "toml" => Ok((Manifest::read(path)?.build(path, base_dir)?, SceneSource::Manifest)),
             "gltf" | "glb" | "obj" | "ply" => {
                 let manifest = stage_model(path)?;
                 let scene = manifest.build(path, base_dir)?;
                 Ok((scene, SceneSource::StagedModel(manifest)))
             }
-            "" if !path.exists() => Err(builtin::builtin(spec).err().unwrap_or(SceneError::Io {
-                file: path.into(),
-                source: std::io::ErrorKind::NotFound.into(),
-            })),
-            _ => Err(SceneError::UnsupportedFormat {
-                file: path.into(),
-                extension,
-            }),
+            "" if !path.exists() => Err(builtin::builtin(spec)
+                .err()
+                .unwrap_or(SceneError::Io { file: path.into(), source: std::io::ErrorKind::NotFound.into() })),
+            _ => Err(SceneError::UnsupportedFormat { file: path.into(), extension }),
         }
     }
 }

@@ -32,24 +32,12 @@ impl RectLight {
     /// light's plane. Returns `None` when `normal` is zero or non-finite or
     /// `u_hint` is parallel to it.
     #[must_use]
-    pub fn try_facing(
-        centre: Vec3,
-        normal: Vec3,
-        u_hint: Vec3,
-        size: Vec2,
-        intensity: f32,
-    ) -> Option<Self> {
+    pub fn try_facing(centre: Vec3, normal: Vec3, u_hint: Vec3, size: Vec2, intensity: f32) -> Option<Self> {
         let normal = normal.try_normalize()?;
         let u_axis = (u_hint - normal * u_hint.dot(normal)).try_normalize()?;
         // u × v = normal, so v = normal × u.
         let v_axis = normal.cross(u_axis);
-        Some(Self {
-            centre,
-            u_axis,
-            v_axis,
-            half_size: size * 0.5,
-            intensity,
-        })
+        Some(Self { centre, u_axis, v_axis, half_size: size * 0.5, intensity })
     }
 
     /// The direction the light emits towards.
@@ -81,46 +69,25 @@ impl RectLight {
     /// # Errors
     /// [`SceneError::InvalidLight`] naming `file`, the light's `index` and the problem.
     pub fn validate(&self, file: &Path, index: usize) -> Result<()> {
-        let fail = |problem: String| {
-            Err(SceneError::InvalidLight {
-                file: file.into(),
-                index,
-                problem,
-            })
-        };
+        let fail = |problem: String| Err(SceneError::InvalidLight { file: file.into(), index, problem });
         if !(self.centre.is_finite() && self.u_axis.is_finite() && self.v_axis.is_finite()) {
-            return fail(format!(
-                "centre or axes are not finite (centre {}, u {}, v {})",
-                self.centre, self.u_axis, self.v_axis
-            ));
+            return fail(format!("centre or axes are not finite (centre {}, u {}, v {})", self.centre, self.u_axis, self.v_axis));
         }
         if !self.half_size.is_finite() || self.half_size.min_element() < 0.0 {
-            return fail(format!(
-                "size must be finite and non-negative, got {}",
-                self.half_size * 2.0
-            ));
+            return fail(format!("size must be finite and non-negative, got {}", self.half_size * 2.0));
         }
         // One zero side and one non-zero side is a line light, which none of the techniques model.
         if (self.half_size.x == 0.0) != (self.half_size.y == 0.0) {
-            return fail(format!(
-                "size {} is a line, not a rectangle; use [0, 0] for a point light",
-                self.half_size * 2.0
-            ));
+            return fail(format!("size {} is a line, not a rectangle; use [0, 0] for a point light", self.half_size * 2.0));
         }
         if !self.intensity.is_finite() || self.intensity < 0.0 {
-            return fail(format!(
-                "intensity must be finite and non-negative, got {}",
-                self.intensity
-            ));
+            return fail(format!("intensity must be finite and non-negative, got {}", self.intensity));
         }
         let orthonormal = (self.u_axis.length() - 1.0).abs() < 1e-4
             && (self.v_axis.length() - 1.0).abs() < 1e-4
             && self.u_axis.dot(self.v_axis).abs() < 1e-4;
         if !orthonormal {
-            return fail(format!(
-                "axes u {} and v {} are not orthonormal",
-                self.u_axis, self.v_axis
-            ));
+            return fail(format!("axes u {} and v {} are not orthonormal", self.u_axis, self.v_axis));
         }
         Ok(())
     }
@@ -132,9 +99,7 @@ mod tests {
 
     #[test]
     fn facing_down_gives_right_handed_axes() {
-        let light =
-            RectLight::try_facing(Vec3::new(0.0, 4.0, 0.0), -Vec3::Y, Vec3::X, Vec2::ONE, 1.0)
-                .unwrap();
+        let light = RectLight::try_facing(Vec3::new(0.0, 4.0, 0.0), -Vec3::Y, Vec3::X, Vec2::ONE, 1.0).unwrap();
         assert!((light.normal() + Vec3::Y).length() < 1e-6);
         assert!((light.u_axis - Vec3::X).length() < 1e-6);
         assert_eq!(light.area(), 1.0);
@@ -143,15 +108,8 @@ mod tests {
 
     #[test]
     fn rejects_line_lights_and_nan() {
-        let mut light =
-            RectLight::try_facing(Vec3::ZERO, -Vec3::Y, Vec3::X, Vec2::new(1.0, 0.0), 1.0).unwrap();
-        assert!(
-            light
-                .validate(Path::new("x"), 3)
-                .unwrap_err()
-                .to_string()
-                .contains("light 3")
-        );
+        let mut light = RectLight::try_facing(Vec3::ZERO, -Vec3::Y, Vec3::X, Vec2::new(1.0, 0.0), 1.0).unwrap();
+        assert!(light.validate(Path::new("x"), 3).unwrap_err().to_string().contains("light 3"));
         light.half_size = Vec2::ONE;
         light.centre.y = f32::NAN;
         assert!(light.validate(Path::new("x"), 0).is_err());

@@ -162,11 +162,7 @@ impl Manifest {
     /// # Errors
     /// [`SceneError::Malformed`] with the TOML parser's line and column.
     pub fn parse(text: &str, file: &Path) -> Result<Self> {
-        toml::from_str(text).map_err(|e| SceneError::Malformed {
-            file: file.into(),
-            format: "manifest",
-            message: e.to_string(),
-        })
+        toml::from_str(text).map_err(|e| SceneError::Malformed { file: file.into(), format: "manifest", message: e.to_string() })
     }
 
     /// Reads and parses a manifest file.
@@ -174,10 +170,7 @@ impl Manifest {
     /// # Errors
     /// As [`Manifest::parse`], plus [`SceneError::Io`].
     pub fn read(file: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(file).map_err(|source| SceneError::Io {
-            file: file.into(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(file).map_err(|source| SceneError::Io { file: file.into(), source })?;
         Self::parse(&text, file)
     }
 
@@ -194,46 +187,26 @@ impl Manifest {
     /// # Errors
     /// Any loader or validation error, naming the manifest or the model file and the element.
     pub fn build(&self, origin: &Path, base_dir: &Path) -> Result<Scene> {
-        let invalid = |element: String, problem: String| SceneError::InvalidManifest {
-            file: origin.into(),
-            element,
-            problem,
-        };
+        let invalid = |element: String, problem: String| SceneError::InvalidManifest { file: origin.into(), element, problem };
         if self.objects.is_empty() {
-            return Err(SceneError::EmptyScene {
-                file: origin.into(),
-                what: "the manifest has no [[object]]",
-            });
+            return Err(SceneError::EmptyScene { file: origin.into(), what: "the manifest has no [[object]]" });
         }
         if self.lights.is_empty() {
-            return Err(SceneError::EmptyScene {
-                file: origin.into(),
-                what: "the manifest has no [[light]]",
-            });
+            return Err(SceneError::EmptyScene { file: origin.into(), what: "the manifest has no [[light]]" });
         }
         let mut scene = Scene {
             origin: origin.into(),
             meshes: Vec::new(),
             instances: Vec::new(),
             lights: Vec::new(),
-            camera: Camera {
-                position: Vec3::Z,
-                target: Vec3::ZERO,
-                up: Vec3::Y,
-                fov_y: 1.0,
-                near: 0.1,
-                far: 10.0,
-            },
+            camera: Camera { position: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y: 1.0, near: 0.1, far: 10.0 },
         };
         let mut file_camera = None;
         for (index, object) in self.objects.iter().enumerate() {
             let element = format!("object {index}");
             let transform = object.transform();
             if !transform.is_finite() {
-                return Err(invalid(
-                    element,
-                    "translate, rotate_degrees or scale is not finite".into(),
-                ));
+                return Err(invalid(element, "translate, rotate_degrees or scale is not finite".into()));
             }
             match (&object.model, &object.primitive) {
                 (Some(model), None) => {
@@ -241,29 +214,16 @@ impl Manifest {
                     let loaded = load_model(&path)?;
                     file_camera = file_camera.or_else(|| loaded.cameras.first().copied());
                     for name in object.roles.keys() {
-                        let known = loaded
-                            .placements
-                            .iter()
-                            .any(|p| &p.node_name == name || &loaded.meshes[p.mesh].name == name);
+                        let known = loaded.placements.iter().any(|p| &p.node_name == name || &loaded.meshes[p.mesh].name == name);
                         if !known {
-                            return Err(invalid(
-                                element,
-                                format!(
-                                    "roles: `{name}` names no node or mesh in {}",
-                                    path.display()
-                                ),
-                            ));
+                            return Err(invalid(element, format!("roles: `{name}` names no node or mesh in {}", path.display())));
                         }
                     }
                     let first_mesh = scene.meshes.len();
                     for placement in &loaded.placements {
                         let mesh_name = &loaded.meshes[placement.mesh].name;
-                        let role = object
-                            .roles
-                            .get(&placement.node_name)
-                            .or_else(|| object.roles.get(mesh_name))
-                            .copied()
-                            .unwrap_or(object.role);
+                        let role =
+                            object.roles.get(&placement.node_name).or_else(|| object.roles.get(mesh_name)).copied().unwrap_or(object.role);
                         scene.instances.push(Instance {
                             name: placement.node_name.clone(),
                             mesh: first_mesh + placement.mesh,
@@ -274,8 +234,7 @@ impl Manifest {
                     scene.meshes.extend(loaded.meshes);
                 }
                 (None, Some(kind)) => {
-                    let mesh = primitive(kind, &object.size)
-                        .map_err(|problem| invalid(element.clone(), problem))?;
+                    let mesh = primitive(kind, &object.size).map_err(|problem| invalid(element.clone(), problem))?;
                     scene.meshes.push(mesh);
                     scene.instances.push(Instance {
                         name: format!("{kind}-{index}"),
@@ -285,34 +244,21 @@ impl Manifest {
                     });
                 }
                 _ => {
-                    return Err(invalid(
-                        element,
-                        "give exactly one of `model` and `primitive`".into(),
-                    ));
+                    return Err(invalid(element, "give exactly one of `model` and `primitive`".into()));
                 }
             }
         }
         for (index, light) in self.lights.iter().enumerate() {
             let normal = Vec3::from_array(light.normal);
-            let u_hint = light.u_axis.map(Vec3::from_array).unwrap_or(
-                if normal.normalize_or_zero().x.abs() > 0.9 {
-                    Vec3::Z
-                } else {
-                    Vec3::X
-                },
-            );
-            let built = RectLight::try_facing(
-                Vec3::from_array(light.centre),
-                normal,
-                u_hint,
-                Vec2::from_array(light.size),
-                light.intensity,
-            )
-            .ok_or_else(|| SceneError::InvalidLight {
-                file: origin.into(),
-                index,
-                problem: "normal is zero or not finite, or u_axis is parallel to it".into(),
-            })?;
+            let u_hint =
+                light.u_axis.map(Vec3::from_array).unwrap_or(if normal.normalize_or_zero().x.abs() > 0.9 { Vec3::Z } else { Vec3::X });
+            let built =
+                RectLight::try_facing(Vec3::from_array(light.centre), normal, u_hint, Vec2::from_array(light.size), light.intensity)
+                    .ok_or_else(|| SceneError::InvalidLight {
+                        file: origin.into(),
+                        index,
+                        problem: "normal is zero or not finite, or u_axis is parallel to it".into(),
+                    })?;
             scene.lights.push(built);
         }
         for mesh in &scene.meshes {
@@ -328,10 +274,7 @@ impl Manifest {
                     up: Vec3::from_array(spec.up),
                     fov_y: spec.fov_y_degrees.to_radians(),
                     near: spec.near.unwrap_or(framed.near),
-                    far: spec.far.unwrap_or(framed.far.max(distance_to_far_corner(
-                        &bounds,
-                        Vec3::from_array(spec.position),
-                    ))),
+                    far: spec.far.unwrap_or(framed.far.max(distance_to_far_corner(&bounds, Vec3::from_array(spec.position)))),
                 }
             }
             (None, Some(camera)) => camera,
@@ -361,12 +304,7 @@ fn primitive(kind: &str, size: &[f32]) -> std::result::Result<crate::mesh::Mesh,
 }
 
 fn distance_to_far_corner(bounds: &Aabb, from: Vec3) -> f32 {
-    bounds
-        .corners()
-        .iter()
-        .map(|c| c.distance(from))
-        .fold(0.0, f32::max)
-        * 1.5
+    bounds.corners().iter().map(|c| c.distance(from)).fold(0.0, f32::max) * 1.5
 }
 
 /// A camera looking at the bounds from the front and above, with the whole box in view.
@@ -376,14 +314,7 @@ pub fn framing_camera(bounds: &Aabb, fov_y: f32) -> Camera {
     let distance = radius / (fov_y * 0.5).sin() * 1.05;
     let direction = Vec3::new(0.0, 0.6, 1.0).normalize();
     let target = bounds.centre();
-    Camera {
-        position: target + direction * distance,
-        target,
-        up: Vec3::Y,
-        fov_y,
-        near: distance * 0.01,
-        far: distance + radius * 3.0,
-    }
+    Camera { position: target + direction * distance, target, up: Vec3::Y, fov_y, near: distance * 0.01, far: distance + radius * 3.0 }
 }
 
 /// Stages a bare model: the model as a `both` object, a receiver plane under
@@ -405,41 +336,20 @@ pub fn stage_model(model: &Path) -> Result<Manifest> {
         }
     }
     if bounds.is_empty() || !bounds.size().is_finite() {
-        return Err(SceneError::EmptyScene {
-            file: model.into(),
-            what: "the model has no placed geometry",
-        });
+        return Err(SceneError::EmptyScene { file: model.into(), what: "the model has no placed geometry" });
     }
     let extent = bounds.size().max_element().max(1e-3);
     let centre = bounds.centre();
-    let light_centre = Vec3::new(
-        centre.x + 0.6 * extent,
-        bounds.max.y + 1.5 * extent,
-        centre.z + 0.4 * extent,
-    );
+    let light_centre = Vec3::new(centre.x + 0.6 * extent, bounds.max.y + 1.5 * extent, centre.z + 0.4 * extent);
     // The light faces the model's centre.
     let light_normal = (centre - light_centre).normalize();
     // Frame the model with half its size of ground on every side.
     let mut view = bounds;
-    view.extend(Vec3::new(
-        bounds.min.x - 0.5 * extent,
-        bounds.min.y,
-        bounds.min.z - 0.5 * extent,
-    ));
-    view.extend(Vec3::new(
-        bounds.max.x + 0.5 * extent,
-        bounds.min.y,
-        bounds.max.z + 0.5 * extent,
-    ));
+    view.extend(Vec3::new(bounds.min.x - 0.5 * extent, bounds.min.y, bounds.min.z - 0.5 * extent));
+    view.extend(Vec3::new(bounds.max.x + 0.5 * extent, bounds.min.y, bounds.max.z + 0.5 * extent));
     let camera = framing_camera(&view, 45f32.to_radians());
-    let file_name = model
-        .file_name()
-        .map_or_else(|| model.to_path_buf(), PathBuf::from);
-    let object = |model: Option<PathBuf>,
-                  primitive: Option<String>,
-                  size: Vec<f32>,
-                  role: Role,
-                  translate: [f32; 3]| ObjectSpec {
+    let file_name = model.file_name().map_or_else(|| model.to_path_buf(), PathBuf::from);
+    let object = |model: Option<PathBuf>, primitive: Option<String>, size: Vec<f32>, role: Role, translate: [f32; 3]| ObjectSpec {
         model,
         primitive,
         size,
@@ -520,69 +430,31 @@ role = "occluder"
         let occluder = scene.bounds_where(|r| r == Role::Occluder);
         assert!((occluder.centre() - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-5);
         // The box is 1 wide, scaled by 0.5 and turned 45° about Y: its half-diagonal is 0.5·√2/2.
-        assert!(
-            (occluder.max.x - 0.25 * std::f32::consts::SQRT_2).abs() < 1e-4,
-            "{}",
-            occluder.max.x
-        );
+        assert!((occluder.max.x - 0.25 * std::f32::consts::SQRT_2).abs() < 1e-4, "{}", occluder.max.x);
     }
 
     #[test]
     fn manifest_errors_name_the_element() {
         let bad = EXAMPLE.replace("primitive = \"box\"", "primitive = \"cone\"");
-        let err = Manifest::parse(&bad, Path::new("m.toml"))
-            .unwrap()
-            .build(Path::new("m.toml"), Path::new("."))
-            .unwrap_err();
-        assert!(
-            err.to_string().contains("m.toml")
-                && err.to_string().contains("object 1")
-                && err.to_string().contains("cone"),
-            "{err}"
-        );
+        let err = Manifest::parse(&bad, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
+        assert!(err.to_string().contains("m.toml") && err.to_string().contains("object 1") && err.to_string().contains("cone"), "{err}");
 
         let err = Manifest::parse("[[light]]\ncentre = [0, 1]\n", Path::new("m.toml")).unwrap_err();
-        assert!(
-            matches!(
-                err,
-                SceneError::Malformed {
-                    format: "manifest",
-                    ..
-                }
-            ),
-            "{err}"
-        );
+        assert!(matches!(err, SceneError::Malformed { format: "manifest", .. }), "{err}");
 
-        let err = Manifest::parse(
-            "[[object]]\nprimitive = \"plane\"\nsize=[1,1]\ncolour = 3\n",
-            Path::new("m.toml"),
-        )
-        .unwrap_err();
+        let err = Manifest::parse("[[object]]\nprimitive = \"plane\"\nsize=[1,1]\ncolour = 3\n", Path::new("m.toml")).unwrap_err();
         assert!(err.to_string().contains("colour"), "{err}");
 
-        let no_light = EXAMPLE.split("[[light]]").next().unwrap().to_owned()
-            + "[[object]]\nprimitive = \"plane\"\nsize = [1.0, 1.0]\n";
-        let err = Manifest::parse(&no_light, Path::new("m.toml"))
-            .unwrap()
-            .build(Path::new("m.toml"), Path::new("."))
-            .unwrap_err();
+        let no_light = EXAMPLE.split("[[light]]").next().unwrap().to_owned() + "[[object]]\nprimitive = \"plane\"\nsize = [1.0, 1.0]\n";
+        let err = Manifest::parse(&no_light, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
         assert!(matches!(err, SceneError::EmptyScene { .. }), "{err}");
 
         let zero_normal = EXAMPLE.replace("normal = [0.0, -1.0, 0.0]", "normal = [0.0, 0.0, 0.0]");
-        let err = Manifest::parse(&zero_normal, Path::new("m.toml"))
-            .unwrap()
-            .build(Path::new("m.toml"), Path::new("."))
-            .unwrap_err();
-        assert!(
-            matches!(err, SceneError::InvalidLight { index: 0, .. }),
-            "{err}"
-        );
+        let err = Manifest::parse(&zero_normal, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
+        assert!(matches!(err, SceneError::InvalidLight { index: 0, .. }), "{err}");
 
         let nan_light = EXAMPLE.replace("size = [1.0, 1.0]", "size = [nan, 1.0]");
-        let err = Manifest::parse(&nan_light, Path::new("m.toml"))
-            .unwrap()
-            .build(Path::new("m.toml"), Path::new("."))
-            .unwrap_err();
+        let err = Manifest::parse(&nan_light, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
         assert!(matches!(err, SceneError::InvalidLight { .. }), "{err}");
     }
 }

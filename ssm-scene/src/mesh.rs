@@ -26,18 +26,9 @@ pub struct Mesh {
 impl Mesh {
     /// A mesh from positions and triangles, with angle-weighted smooth normals.
     #[must_use]
-    pub fn with_generated_normals(
-        name: impl Into<String>,
-        positions: Vec<Vec3>,
-        indices: Vec<u32>,
-    ) -> Self {
+    pub fn with_generated_normals(name: impl Into<String>, positions: Vec<Vec3>, indices: Vec<u32>) -> Self {
         let normals = generate_normals(&positions, &indices);
-        Self {
-            name: name.into(),
-            positions,
-            normals,
-            indices,
-        }
+        Self { name: name.into(), positions, normals, indices }
     }
 
     /// Number of triangles.
@@ -57,11 +48,7 @@ impl Mesh {
     /// The first violated invariant, as a typed [`SceneError`].
     pub fn validate(&self, file: &Path) -> Result<()> {
         if !self.indices.len().is_multiple_of(3) {
-            return Err(SceneError::PartialTriangle {
-                file: file.into(),
-                mesh: self.name.clone(),
-                count: self.indices.len(),
-            });
+            return Err(SceneError::PartialTriangle { file: file.into(), mesh: self.name.clone(), count: self.indices.len() });
         }
         if self.normals.len() != self.positions.len() {
             return Err(SceneError::NormalCountMismatch {
@@ -82,31 +69,15 @@ impl Mesh {
                 });
             }
         }
-        check_indices(
-            file,
-            &self.name,
-            self.indices.iter().map(|&i| u64::from(i)),
-            self.positions.len(),
-        )
+        check_indices(file, &self.name, self.indices.iter().map(|&i| u64::from(i)), self.positions.len())
     }
 }
 
 /// Fails on the first index `>= count`: loaders call it before they build a [`Mesh`].
-pub(crate) fn check_indices(
-    file: &Path,
-    mesh: &str,
-    indices: impl Iterator<Item = u64>,
-    count: usize,
-) -> Result<()> {
+pub(crate) fn check_indices(file: &Path, mesh: &str, indices: impl Iterator<Item = u64>, count: usize) -> Result<()> {
     for (position, index) in indices.enumerate() {
         if index >= count as u64 {
-            return Err(SceneError::InvalidIndex {
-                file: file.into(),
-                mesh: mesh.into(),
-                index,
-                position,
-                count,
-            });
+            return Err(SceneError::InvalidIndex { file: file.into(), mesh: mesh.into(), index, position, count });
         }
     }
     Ok(())
@@ -137,10 +108,7 @@ pub fn generate_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
             }
         }
     }
-    normals
-        .iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
-        .collect()
+    normals.iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect()
 }
 
 /// Turns a triangle strip into a triangle list, keeping every triangle's winding.
@@ -181,8 +149,7 @@ mod tests {
 
     #[test]
     fn generated_normals_point_out_of_a_ccw_triangle() {
-        let mesh =
-            Mesh::with_generated_normals("t", vec![Vec3::ZERO, Vec3::X, Vec3::Z], vec![0, 2, 1]);
+        let mesh = Mesh::with_generated_normals("t", vec![Vec3::ZERO, Vec3::X, Vec3::Z], vec![0, 2, 1]);
         for n in &mesh.normals {
             assert!((*n - Vec3::Y).length() < 1e-6, "{n}");
         }
@@ -190,30 +157,15 @@ mod tests {
 
     #[test]
     fn validation_names_the_bad_index() {
-        let mesh = Mesh {
-            name: "m".into(),
-            positions: vec![Vec3::ZERO; 3],
-            normals: vec![Vec3::Y; 3],
-            indices: vec![0, 1, 7],
-        };
+        let mesh = Mesh { name: "m".into(), positions: vec![Vec3::ZERO; 3], normals: vec![Vec3::Y; 3], indices: vec![0, 1, 7] };
         let err = mesh.validate(Path::new("f.obj")).unwrap_err().to_string();
-        assert!(
-            err.contains("f.obj") && err.contains("index 7") && err.contains("3 vertices"),
-            "{err}"
-        );
+        assert!(err.contains("f.obj") && err.contains("index 7") && err.contains("3 vertices"), "{err}");
     }
 
     #[test]
     fn validation_rejects_nan() {
-        let mesh = Mesh {
-            name: "m".into(),
-            positions: vec![Vec3::ZERO, Vec3::NAN, Vec3::X],
-            normals: vec![Vec3::Y; 3],
-            indices: vec![0, 1, 2],
-        };
-        assert!(matches!(
-            mesh.validate(Path::new("f")),
-            Err(SceneError::NonFiniteVertex { vertex: 1, .. })
-        ));
+        let mesh =
+            Mesh { name: "m".into(), positions: vec![Vec3::ZERO, Vec3::NAN, Vec3::X], normals: vec![Vec3::Y; 3], indices: vec![0, 1, 2] };
+        assert!(matches!(mesh.validate(Path::new("f")), Err(SceneError::NonFiniteVertex { vertex: 1, .. })));
     }
 }

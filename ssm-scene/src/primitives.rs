@@ -8,20 +8,10 @@ use crate::mesh::Mesh;
 #[must_use]
 pub fn plane(name: &str, size: Vec2) -> Mesh {
     let (hx, hz) = (size.x * 0.5, size.y * 0.5);
-    let positions = vec![
-        Vec3::new(-hx, 0.0, -hz),
-        Vec3::new(hx, 0.0, -hz),
-        Vec3::new(hx, 0.0, hz),
-        Vec3::new(-hx, 0.0, hz),
-    ];
+    let positions = vec![Vec3::new(-hx, 0.0, -hz), Vec3::new(hx, 0.0, -hz), Vec3::new(hx, 0.0, hz), Vec3::new(-hx, 0.0, hz)];
     // Counter-clockwise seen from +Y.
     let indices = vec![0, 2, 1, 0, 3, 2];
-    Mesh {
-        name: name.into(),
-        normals: vec![Vec3::Y; 4],
-        positions,
-        indices,
-    }
+    Mesh { name: name.into(), normals: vec![Vec3::Y; 4], positions, indices }
 }
 
 /// An axis-aligned box of edge lengths `size` centred on the origin, flat-shaded (24 vertices).
@@ -36,9 +26,7 @@ pub fn cuboid(name: &str, size: Vec3) -> Mesh {
             let mut normal = Vec3::ZERO;
             normal[axis] = sign;
             // Two tangents with tangent_a × tangent_b = normal, so the quad winds counter-clockwise outside.
-            let tangent_a = Vec3::from_array(std::array::from_fn(|k| {
-                if k == (axis + 1) % 3 { 1.0 } else { 0.0 }
-            }));
+            let tangent_a = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
             let tangent_b = normal.cross(tangent_a);
             let base = positions.len() as u32;
             for (s, t) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
@@ -48,12 +36,7 @@ pub fn cuboid(name: &str, size: Vec3) -> Mesh {
             indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
         }
     }
-    Mesh {
-        name: name.into(),
-        positions,
-        normals,
-        indices,
-    }
+    Mesh { name: name.into(), positions, normals, indices }
 }
 
 /// A closed UV sphere of `radius` centred on the origin, smooth normals.
@@ -68,11 +51,7 @@ pub fn sphere(name: &str, radius: f32, segments: u32, rings: u32) -> Mesh {
         let theta = std::f32::consts::PI * ring as f32 / rings as f32;
         for segment in 0..segments {
             let phi = std::f32::consts::TAU * segment as f32 / segments as f32;
-            positions.push(Vec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                -theta.sin() * phi.sin(),
-            ));
+            positions.push(Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin()));
         }
     }
     positions.push(-Vec3::Y);
@@ -94,12 +73,7 @@ pub fn sphere(name: &str, radius: f32, segments: u32, rings: u32) -> Mesh {
         }
     }
     let normals = positions.clone();
-    Mesh {
-        name: name.into(),
-        positions: positions.into_iter().map(|p| p * radius).collect(),
-        normals,
-        indices,
-    }
+    Mesh { name: name.into(), positions: positions.into_iter().map(|p| p * radius).collect(), normals, indices }
 }
 
 #[cfg(test)]

@@ -65,10 +65,7 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box: extending it by a point gives that point.
-    pub const EMPTY: Self = Self {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
-    };
+    pub const EMPTY: Self = Self { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
 
     /// Grows the box to contain `p`.
     pub fn extend(&mut self, p: Vec3) {
@@ -150,26 +147,17 @@ impl Scene {
             validate_instance(file, instance, self.meshes.len())?;
         }
         if self.triangle_count() == 0 {
-            return Err(SceneError::EmptyScene {
-                file: file.into(),
-                what: "no triangles",
-            });
+            return Err(SceneError::EmptyScene { file: file.into(), what: "no triangles" });
         }
         if self.lights.is_empty() {
-            return Err(SceneError::EmptyScene {
-                file: file.into(),
-                what: "no lights",
-            });
+            return Err(SceneError::EmptyScene { file: file.into(), what: "no lights" });
         }
         for (index, light) in self.lights.iter().enumerate() {
             light.validate(file, index)?;
         }
         self.camera.validate(file)?;
         if !self.bounds().size().is_finite() {
-            return Err(SceneError::EmptyScene {
-                file: file.into(),
-                what: "geometry transforms to non-finite world coordinates",
-            });
+            return Err(SceneError::EmptyScene { file: file.into(), what: "geometry transforms to non-finite world coordinates" });
         }
         Ok(())
     }
@@ -177,11 +165,7 @@ impl Scene {
     /// Number of triangles over all instances.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
-        self.instances
-            .iter()
-            .filter_map(|i| self.meshes.get(i.mesh))
-            .map(Mesh::triangle_count)
-            .sum()
+        self.instances.iter().filter_map(|i| self.meshes.get(i.mesh)).map(Mesh::triangle_count).sum()
     }
 
     /// World-space bounds of every instance.
@@ -206,27 +190,18 @@ impl Scene {
 
     /// Every triangle in world space, instance by instance.
     pub fn world_triangles(&self) -> impl Iterator<Item = WorldTriangle> + '_ {
-        self.instances
-            .iter()
-            .filter_map(|i| self.meshes.get(i.mesh).map(|m| (i, m)))
-            .flat_map(|(instance, mesh)| {
-                let normal_matrix = normal_matrix(instance.transform);
-                mesh.triangles().map(move |t| {
-                    let corner = |k: usize| {
-                        instance
-                            .transform
-                            .transform_point3(mesh.positions[t[k] as usize])
-                    };
-                    let normal = |k: usize| {
-                        (normal_matrix * mesh.normals[t[k] as usize]).normalize_or(Vec3::Y)
-                    };
-                    WorldTriangle {
-                        corners: [corner(0), corner(1), corner(2)],
-                        normals: [normal(0), normal(1), normal(2)],
-                        role: instance.role,
-                    }
-                })
+        self.instances.iter().filter_map(|i| self.meshes.get(i.mesh).map(|m| (i, m))).flat_map(|(instance, mesh)| {
+            let normal_matrix = normal_matrix(instance.transform);
+            mesh.triangles().map(move |t| {
+                let corner = |k: usize| instance.transform.transform_point3(mesh.positions[t[k] as usize]);
+                let normal = |k: usize| (normal_matrix * mesh.normals[t[k] as usize]).normalize_or(Vec3::Y);
+                WorldTriangle {
+                    corners: [corner(0), corner(1), corner(2)],
+                    normals: [normal(0), normal(1), normal(2)],
+                    role: instance.role,
+                }
             })
+        })
     }
 }
 
@@ -238,27 +213,14 @@ pub fn normal_matrix(transform: Mat4) -> Mat3 {
 
 fn validate_instance(file: &Path, instance: &Instance, mesh_count: usize) -> Result<()> {
     if instance.mesh >= mesh_count {
-        return Err(SceneError::MissingMesh {
-            file: file.into(),
-            instance: instance.name.clone(),
-            mesh: instance.mesh,
-            count: mesh_count,
-        });
+        return Err(SceneError::MissingMesh { file: file.into(), instance: instance.name.clone(), mesh: instance.mesh, count: mesh_count });
     }
     if !instance.transform.is_finite() {
-        return Err(SceneError::InvalidTransform {
-            file: file.into(),
-            instance: instance.name.clone(),
-            problem: "not finite",
-        });
+        return Err(SceneError::InvalidTransform { file: file.into(), instance: instance.name.clone(), problem: "not finite" });
     }
     let det = Mat3::from_mat4(instance.transform).determinant();
     if !(det.abs() > 1e-12 && det.is_finite()) {
-        return Err(SceneError::InvalidTransform {
-            file: file.into(),
-            instance: instance.name.clone(),
-            problem: "singular",
-        });
+        return Err(SceneError::InvalidTransform { file: file.into(), instance: instance.name.clone(), problem: "singular" });
     }
     Ok(())
 }

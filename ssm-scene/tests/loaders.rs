@@ -70,20 +70,11 @@ fn obj_bad_input() {
     assert!(names_file(&e, &out_of_range), "{e}");
     let nan = write(&dir, "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
     let e = load_model(&nan).unwrap_err();
-    assert!(
-        matches!(e, SceneError::NonFiniteVertex { vertex: 1, .. }),
-        "{e}"
-    );
+    assert!(matches!(e, SceneError::NonFiniteVertex { vertex: 1, .. }), "{e}");
     let inf = write(&dir, "inf.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n");
-    assert!(matches!(
-        load_model(&inf).unwrap_err(),
-        SceneError::NonFiniteVertex { .. }
-    ));
+    assert!(matches!(load_model(&inf).unwrap_err(), SceneError::NonFiniteVertex { .. }));
     let empty = write(&dir, "empty.obj", "# nothing\n");
-    assert!(matches!(
-        load_model(&empty).unwrap_err(),
-        SceneError::EmptyScene { .. }
-    ));
+    assert!(matches!(load_model(&empty).unwrap_err(), SceneError::EmptyScene { .. }));
     let garbage = write(&dir, "garbage.obj", "v a b c\nf 1 2 3\n");
     let e = load_model(&garbage).unwrap_err();
     assert!(names_file(&e, &garbage), "{e}");
@@ -134,29 +125,14 @@ fn binary_ply(vertices: &[[f32; 3]], faces: &[&[i32]], truncate: usize) -> Vec<u
 fn ply_ascii_and_binary_load_the_same_mesh() {
     let dir = scratch("ply");
     let ascii = load_model(&write(&dir, "tetra.ply", TETRA_ASCII_PLY)).unwrap();
-    let vertices = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-    ];
+    let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let faces: [&[i32]; 4] = [&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]];
-    let binary = load_model(&write(
-        &dir,
-        "tetra-bin.ply",
-        binary_ply(&vertices, &faces, 0),
-    ))
-    .unwrap();
+    let binary = load_model(&write(&dir, "tetra-bin.ply", binary_ply(&vertices, &faces, 0))).unwrap();
     assert_eq!(ascii.meshes[0].positions, binary.meshes[0].positions);
     assert_eq!(ascii.meshes[0].indices, binary.meshes[0].indices);
     assert_eq!(ascii.meshes[0].triangle_count(), 4);
     // A quad face is split into two triangles.
-    let quad = load_model(&write(
-        &dir,
-        "quad.ply",
-        binary_ply(&vertices, &[&[0, 1, 2, 3]], 0),
-    ))
-    .unwrap();
+    let quad = load_model(&write(&dir, "quad.ply", binary_ply(&vertices, &[&[0, 1, 2, 3]], 0))).unwrap();
     assert_eq!(quad.meshes[0].indices, vec![0, 1, 2, 0, 2, 3]);
 }
 
@@ -164,76 +140,26 @@ fn ply_ascii_and_binary_load_the_same_mesh() {
 fn ply_bad_input() {
     let dir = scratch("ply-bad");
     let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let truncated = write(
-        &dir,
-        "truncated.ply",
-        binary_ply(&vertices, &[&[0, 1, 2]], 5),
-    );
+    let truncated = write(&dir, "truncated.ply", binary_ply(&vertices, &[&[0, 1, 2]], 5));
     let e = load_model(&truncated).unwrap_err();
-    assert!(
-        matches!(e, SceneError::Malformed { format: "PLY", .. }) && names_file(&e, &truncated),
-        "{e}"
-    );
+    assert!(matches!(e, SceneError::Malformed { format: "PLY", .. }) && names_file(&e, &truncated), "{e}");
     let range = write(&dir, "range.ply", binary_ply(&vertices, &[&[0, 1, 7]], 0));
-    assert!(matches!(
-        load_model(&range).unwrap_err(),
-        SceneError::InvalidIndex {
-            index: 7,
-            count: 3,
-            ..
-        }
-    ));
-    let negative = write(
-        &dir,
-        "negative.ply",
-        binary_ply(&vertices, &[&[0, 1, -1]], 0),
-    );
-    assert!(matches!(
-        load_model(&negative).unwrap_err(),
-        SceneError::InvalidIndex { .. }
-    ));
-    let nan = write(
-        &dir,
-        "nan.ply",
-        binary_ply(
-            &[[0.0, f32::NAN, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-            &[&[0, 1, 2]],
-            0,
-        ),
-    );
-    assert!(matches!(
-        load_model(&nan).unwrap_err(),
-        SceneError::NonFiniteVertex { vertex: 0, .. }
-    ));
+    assert!(matches!(load_model(&range).unwrap_err(), SceneError::InvalidIndex { index: 7, count: 3, .. }));
+    let negative = write(&dir, "negative.ply", binary_ply(&vertices, &[&[0, 1, -1]], 0));
+    assert!(matches!(load_model(&negative).unwrap_err(), SceneError::InvalidIndex { .. }));
+    let nan = write(&dir, "nan.ply", binary_ply(&[[0.0, f32::NAN, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[&[0, 1, 2]], 0));
+    assert!(matches!(load_model(&nan).unwrap_err(), SceneError::NonFiniteVertex { vertex: 0, .. }));
     let points = write(
         &dir,
         "points.ply",
         "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n",
     );
-    assert!(
-        load_model(&points)
-            .unwrap_err()
-            .to_string()
-            .contains("face")
-    );
-    let wrong_type = write(
-        &dir,
-        "type.ply",
-        TETRA_ASCII_PLY.replace(
-            "property list uchar int vertex_indices",
-            "property float vertex_indices",
-        ),
-    );
-    assert!(names_file(
-        &load_model(&wrong_type).unwrap_err(),
-        &wrong_type
-    ));
+    assert!(load_model(&points).unwrap_err().to_string().contains("face"));
+    let wrong_type =
+        write(&dir, "type.ply", TETRA_ASCII_PLY.replace("property list uchar int vertex_indices", "property float vertex_indices"));
+    assert!(names_file(&load_model(&wrong_type).unwrap_err(), &wrong_type));
     // A header that promises 4 billion vertices: a clean error, not an allocation abort.
-    let huge = write(
-        &dir,
-        "huge.ply",
-        TETRA_ASCII_PLY.replace("element vertex 4", "element vertex 4000000000"),
-    );
+    let huge = write(&dir, "huge.ply", TETRA_ASCII_PLY.replace("element vertex 4", "element vertex 4000000000"));
     assert!(load_model(&huge).is_err());
 }
 
@@ -242,9 +168,7 @@ fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {
-        let n = (u32::from(chunk[0]) << 16)
-            | (u32::from(*chunk.get(1).unwrap_or(&0)) << 8)
-            | u32::from(*chunk.get(2).unwrap_or(&0));
+        let n = (u32::from(chunk[0]) << 16) | (u32::from(*chunk.get(1).unwrap_or(&0)) << 8) | u32::from(*chunk.get(2).unwrap_or(&0));
         for k in 0..4 {
             if k <= chunk.len() {
                 out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
@@ -259,12 +183,7 @@ fn base64(bytes: &[u8]) -> String {
 /// Four vertices of a unit square in XZ and the given u32 indices, as one buffer.
 fn square_buffer(indices: &[u32]) -> Vec<u8> {
     let mut bytes = Vec::new();
-    for p in [
-        [0.0f32, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 0.0, 1.0],
-        [0.0, 0.0, 1.0],
-    ] {
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 0.0, 1.0]] {
         for c in p {
             bytes.extend_from_slice(&c.to_le_bytes());
         }
@@ -277,16 +196,8 @@ fn square_buffer(indices: &[u32]) -> Vec<u8> {
 
 /// A glTF document: one mesh of one primitive in `mode` over [`square_buffer`], placed by a
 /// parent node (translated by +2 in y) with a child (scaled by 3), plus a camera node.
-fn gltf_json(
-    buffer_uri: Option<&str>,
-    byte_length: usize,
-    index_count: usize,
-    mode: u32,
-    position_type: &str,
-) -> String {
-    let uri = buffer_uri
-        .map(|u| format!(r#""uri": "{u}","#))
-        .unwrap_or_default();
+fn gltf_json(buffer_uri: Option<&str>, byte_length: usize, index_count: usize, mode: u32, position_type: &str) -> String {
+    let uri = buffer_uri.map(|u| format!(r#""uri": "{u}","#)).unwrap_or_default();
     format!(
         r#"{{
   "asset": {{"version": "2.0"}},
@@ -343,14 +254,7 @@ fn check_square_model(model: &ssm_scene::LoadedModel, triangles: usize) {
     let placement = &model.placements[0];
     assert_eq!(placement.node_name, "leaf");
     // Parent translation then child scale: (1, 0, 1) lands at (3, 2, 3).
-    assert!(
-        (placement
-            .transform
-            .transform_point3(Vec3::new(1.0, 0.0, 1.0))
-            - Vec3::new(3.0, 2.0, 3.0))
-        .length()
-            < 1e-6
-    );
+    assert!((placement.transform.transform_point3(Vec3::new(1.0, 0.0, 1.0)) - Vec3::new(3.0, 2.0, 3.0)).length() < 1e-6);
     assert_eq!(model.cameras.len(), 1);
     assert!((model.cameras[0].position - Vec3::new(0.0, 1.0, 10.0)).length() < 1e-6);
     assert!((model.cameras[0].fov_y - 0.8).abs() < 1e-6);
@@ -362,24 +266,12 @@ fn gltf_embedded_external_and_binary_agree() {
     let indices = [0, 2, 1, 0, 3, 2];
     let buffer = square_buffer(&indices);
     let data_uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
-    let embedded = write(
-        &dir,
-        "embedded.gltf",
-        gltf_json(Some(&data_uri), buffer.len(), 6, 4, "VEC3"),
-    );
+    let embedded = write(&dir, "embedded.gltf", gltf_json(Some(&data_uri), buffer.len(), 6, 4, "VEC3"));
     check_square_model(&load_model(&embedded).unwrap(), 2);
     write(&dir, "square.bin", &buffer);
-    let external = write(
-        &dir,
-        "external.gltf",
-        gltf_json(Some("square.bin"), buffer.len(), 6, 4, "VEC3"),
-    );
+    let external = write(&dir, "external.gltf", gltf_json(Some("square.bin"), buffer.len(), 6, 4, "VEC3"));
     check_square_model(&load_model(&external).unwrap(), 2);
-    let binary = write(
-        &dir,
-        "binary.glb",
-        glb(&gltf_json(None, buffer.len(), 6, 4, "VEC3"), &buffer),
-    );
+    let binary = write(&dir, "binary.glb", glb(&gltf_json(None, buffer.len(), 6, 4, "VEC3"), &buffer));
     check_square_model(&load_model(&binary).unwrap(), 2);
 }
 
@@ -388,21 +280,11 @@ fn gltf_strips_and_fans_become_lists() {
     let dir = scratch("gltf-modes");
     let strip = square_buffer(&[0, 1, 3, 2]);
     write(&dir, "strip.bin", &strip);
-    let model = load_model(&write(
-        &dir,
-        "strip.gltf",
-        gltf_json(Some("strip.bin"), strip.len(), 4, 5, "VEC3"),
-    ))
-    .unwrap();
+    let model = load_model(&write(&dir, "strip.gltf", gltf_json(Some("strip.bin"), strip.len(), 4, 5, "VEC3"))).unwrap();
     assert_eq!(model.meshes[0].indices, vec![0, 1, 3, 3, 1, 2]);
     let fan = square_buffer(&[0, 1, 2, 3]);
     write(&dir, "fan.bin", &fan);
-    let model = load_model(&write(
-        &dir,
-        "fan.gltf",
-        gltf_json(Some("fan.bin"), fan.len(), 4, 6, "VEC3"),
-    ))
-    .unwrap();
+    let model = load_model(&write(&dir, "fan.gltf", gltf_json(Some("fan.bin"), fan.len(), 4, 6, "VEC3"))).unwrap();
     assert_eq!(model.meshes[0].indices, vec![0, 1, 2, 0, 2, 3]);
 }
 
@@ -412,46 +294,24 @@ fn gltf_bad_input() {
     let buffer = square_buffer(&[0, 2, 1, 0, 3, 9]);
     // Index out of range.
     write(&dir, "range.bin", &buffer);
-    let range = write(
-        &dir,
-        "range.gltf",
-        gltf_json(Some("range.bin"), buffer.len(), 6, 4, "VEC3"),
-    );
+    let range = write(&dir, "range.gltf", gltf_json(Some("range.bin"), buffer.len(), 6, 4, "VEC3"));
     let e = load_model(&range).unwrap_err();
-    assert!(
-        matches!(e, SceneError::InvalidIndex { index: 9, .. }) && names_file(&e, &range),
-        "{e}"
-    );
+    assert!(matches!(e, SceneError::InvalidIndex { index: 9, .. }) && names_file(&e, &range), "{e}");
     // Missing external buffer.
-    let missing = write(
-        &dir,
-        "missing.gltf",
-        gltf_json(Some("nowhere.bin"), buffer.len(), 6, 4, "VEC3"),
-    );
+    let missing = write(&dir, "missing.gltf", gltf_json(Some("nowhere.bin"), buffer.len(), 6, 4, "VEC3"));
     let e = load_model(&missing).unwrap_err();
     assert!(names_file(&e, &missing), "{e}");
     // Buffer shorter than declared.
     write(&dir, "short.bin", &buffer[..40]);
-    let short = write(
-        &dir,
-        "short.gltf",
-        gltf_json(Some("short.bin"), buffer.len(), 6, 4, "VEC3"),
-    );
+    let short = write(&dir, "short.gltf", gltf_json(Some("short.bin"), buffer.len(), 6, 4, "VEC3"));
     assert!(names_file(&load_model(&short).unwrap_err(), &short));
     // Wrong accessor type for POSITION.
-    let typed = write(
-        &dir,
-        "type.gltf",
-        gltf_json(Some("range.bin"), buffer.len(), 6, 4, "VEC2"),
-    );
+    let typed = write(&dir, "type.gltf", gltf_json(Some("range.bin"), buffer.len(), 6, 4, "VEC2"));
     assert!(names_file(&load_model(&typed).unwrap_err(), &typed));
     // Truncated JSON and truncated GLB.
     let text = gltf_json(Some("range.bin"), buffer.len(), 6, 4, "VEC3");
     let cut = write(&dir, "cut.gltf", &text[..text.len() / 2]);
-    assert!(matches!(
-        load_model(&cut).unwrap_err(),
-        SceneError::Malformed { format: "glTF", .. }
-    ));
+    assert!(matches!(load_model(&cut).unwrap_err(), SceneError::Malformed { format: "glTF", .. }));
     let good = square_buffer(&[0, 2, 1, 0, 3, 2]);
     let mut binary = glb(&gltf_json(None, good.len(), 6, 4, "VEC3"), &good);
     binary.truncate(binary.len() - 10);
@@ -463,17 +323,13 @@ fn gltf_bad_input() {
     assert!(names_file(&load_model(&lying).unwrap_err(), &lying));
     // A node that is its own grandchild: an error, not a hang.
     write(&dir, "good.bin", &good);
-    let cyclic_text = gltf_json(Some("good.bin"), good.len(), 6, 4, "VEC3").replace(
-        r#""mesh": 0, "scale": [3, 3, 3]"#,
-        r#""mesh": 0, "scale": [3, 3, 3], "children": [0]"#,
-    );
+    let cyclic_text = gltf_json(Some("good.bin"), good.len(), 6, 4, "VEC3")
+        .replace(r#""mesh": 0, "scale": [3, 3, 3]"#, r#""mesh": 0, "scale": [3, 3, 3], "children": [0]"#);
     let cyclic = write(&dir, "cycle.gltf", cyclic_text);
     assert!(names_file(&load_model(&cyclic).unwrap_err(), &cyclic));
     // NaN in a node transform reaches the scene as a non-finite transform: rejected on validation.
-    let nan_text = gltf_json(Some("good.bin"), good.len(), 6, 4, "VEC3").replace(
-        r#""translation": [0, 2, 0]"#,
-        r#""translation": [0, 1e39, 0]"#,
-    );
+    let nan_text =
+        gltf_json(Some("good.bin"), good.len(), 6, 4, "VEC3").replace(r#""translation": [0, 2, 0]"#, r#""translation": [0, 1e39, 0]"#);
     let nan = write(&dir, "nan.gltf", nan_text);
     if let Ok(model) = load_model(&nan) {
         let manifest = format!(
@@ -490,27 +346,15 @@ fn gltf_bad_input() {
 fn unsupported_and_missing_files() {
     let dir = scratch("misc");
     let stl = write(&dir, "model.stl", "solid");
-    assert!(matches!(
-        load_model(&stl).unwrap_err(),
-        SceneError::UnsupportedFormat { .. }
-    ));
+    assert!(matches!(load_model(&stl).unwrap_err(), SceneError::UnsupportedFormat { .. }));
     let missing = dir.join("absent.obj");
     let e = load_model(&missing).unwrap_err();
-    assert!(
-        matches!(e, SceneError::Io { .. }) && names_file(&e, &missing),
-        "{e}"
-    );
+    assert!(matches!(e, SceneError::Io { .. }) && names_file(&e, &missing), "{e}");
     let e = Scene::load("no-such-scene").unwrap_err();
-    assert!(
-        e.to_string().contains("parallel-square"),
-        "unknown names list the built-ins: {e}"
-    );
+    assert!(e.to_string().contains("parallel-square"), "unknown names list the built-ins: {e}");
     // A manifest pointing at a missing model names the model.
-    let manifest = write(
-        &dir,
-        "scene.toml",
-        "[[light]]\ncentre = [0, 4, 0]\nnormal = [0, -1, 0]\nsize = [1, 1]\n[[object]]\nmodel = \"gone.ply\"\n",
-    );
+    let manifest =
+        write(&dir, "scene.toml", "[[light]]\ncentre = [0, 4, 0]\nnormal = [0, -1, 0]\nsize = [1, 1]\n[[object]]\nmodel = \"gone.ply\"\n");
     let e = Scene::load(manifest.to_str().unwrap()).unwrap_err();
     assert!(e.to_string().contains("gone.ply"), "{e}");
     // An unknown role override is a typo, not a silent no-op.
@@ -538,12 +382,7 @@ fn a_bare_model_is_staged_and_the_staging_round_trips() {
     assert!(ground.max.y <= -1.0 + 1e-3 && ground.size().x >= 6.0);
     assert!(scene.lights[0].centre.y > 1.0 && scene.lights[0].normal().y < -0.5);
     // It faces the model's centre.
-    assert!(
-        scene.lights[0]
-            .normal()
-            .dot((Vec3::ZERO - scene.lights[0].centre).normalize())
-            > 0.999
-    );
+    assert!(scene.lights[0].normal().dot((Vec3::ZERO - scene.lights[0].centre).normalize()) > 0.999);
     let to_model = (Vec3::ZERO - scene.camera.position).normalize();
     assert!(to_model.dot((scene.camera.target - scene.camera.position).normalize()) > 0.99);
     // Saved beside the model, the printed manifest builds the same scene.

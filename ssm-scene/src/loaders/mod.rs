@@ -45,34 +45,21 @@ pub struct Placement {
 /// when the file cannot be read, and a typed error naming the file and the
 /// element for anything malformed.
 pub fn load_model(path: &Path) -> Result<LoadedModel> {
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or_default()
-        .to_ascii_lowercase();
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        file: path.into(),
-        source,
-    })?;
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { file: path.into(), source })?;
     let model = match extension.as_str() {
         "gltf" | "glb" => guard(path, "glTF", || gltf::load(path, &bytes))?,
         "obj" => guard(path, "OBJ", || obj::load(path, &bytes))?,
         "ply" => guard(path, "PLY", || ply::load(path, &bytes))?,
         _ => {
-            return Err(SceneError::UnsupportedFormat {
-                file: path.into(),
-                extension,
-            });
+            return Err(SceneError::UnsupportedFormat { file: path.into(), extension });
         }
     };
     for mesh in &model.meshes {
         mesh.validate(path)?;
     }
     if model.meshes.iter().all(|m| m.indices.is_empty()) {
-        return Err(SceneError::EmptyScene {
-            file: path.into(),
-            what: "the file has no triangles",
-        });
+        return Err(SceneError::EmptyScene { file: path.into(), what: "the file has no triangles" });
     }
     Ok(model)
 }
@@ -82,25 +69,12 @@ pub fn load_model(path: &Path) -> Result<LoadedModel> {
 /// Our own checks come first (sizes, indices, finiteness), but a hostile file
 /// may still reach an arithmetic overflow inside a dependency; the user must
 /// get a message naming the file, never an abort.
-fn guard(
-    path: &Path,
-    format: &'static str,
-    parse: impl FnOnce() -> Result<LoadedModel>,
-) -> Result<LoadedModel> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {
-        Err(SceneError::Malformed {
-            file: path.into(),
-            format,
-            message: "the parser failed on malformed data".into(),
-        })
-    })
+fn guard(path: &Path, format: &'static str, parse: impl FnOnce() -> Result<LoadedModel>) -> Result<LoadedModel> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse))
+        .unwrap_or_else(|_| Err(SceneError::Malformed { file: path.into(), format, message: "the parser failed on malformed data".into() }))
 }
 
 /// A malformed-file error for `path` in `format`.
 fn malformed(path: &Path, format: &'static str, message: impl std::fmt::Display) -> SceneError {
-    SceneError::Malformed {
-        file: path.into(),
-        format,
-        message: message.to_string(),
-    }
+    SceneError::Malformed { file: path.into(), format, message: message.to_string() }
 }

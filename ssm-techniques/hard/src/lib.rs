@@ -10,9 +10,8 @@ use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
-    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT,
-    register_technique,
+    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -23,11 +22,7 @@ pub const NAME: &str = "hard";
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "shadow_map_size",
-        kind: ParamKind::Int {
-            default: 2048,
-            min: 16,
-            max: 16384,
-        },
+        kind: ParamKind::Int { default: 2048, min: 16, max: 16384 },
         doc: "side of the square shadow map, texels",
     },
     ShadowMapSettings::BIAS_PARAMS[0],
@@ -59,10 +54,7 @@ impl HardShadowMapping {
         let settings = ShadowMapSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
         let depth_map = settings.depth_map(setup, "hard_shadow_map")?;
-        let uniform = HardSettingsUniform {
-            normal_offset: settings.normal_offset,
-            padding: [0.0; 3],
-        };
+        let uniform = HardSettingsUniform { normal_offset: settings.normal_offset, padding: [0.0; 3] };
         let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("hard_settings_uniform"),
             contents: bytemuck::bytes_of(&uniform),
@@ -76,47 +68,20 @@ impl HardShadowMapping {
             label: Some("hard_map_bind_group"),
             layout: &map_layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: settings_buffer.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
+                wgpu::BindGroupEntry { binding: 1, resource: settings_buffer.as_entire_binding() },
             ],
         });
-        let module = create_shader(
-            setup.gpu,
-            "hard_lookup_shader",
-            include_str!("../../../shaders/hard/hard.wgsl"),
-        )?;
-        let lookup = ScreenPass::new(
-            setup,
-            NAME,
-            "hard_lookup",
-            (&module, "hard_lookup"),
-            Some(&map_layout),
-            VISIBILITY_FORMAT.into(),
-        )?;
-        Ok(Self {
-            depth_map,
-            lookup,
-            map_bind_group,
-        })
+        let module = create_shader(setup.gpu, "hard_lookup_shader", include_str!("../../../shaders/hard/hard.wgsl"))?;
+        let lookup = ScreenPass::new(setup, NAME, "hard_lookup", (&module, "hard_lookup"), Some(&map_layout), VISIBILITY_FORMAT.into())?;
+        Ok(Self { depth_map, lookup, map_bind_group })
     }
 }
 
 impl ShadowTechnique for HardShadowMapping {
-    fn render(
-        &mut self,
-        frame: &mut Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         self.depth_map.encode(frame, light);
-        self.lookup
-            .encode(frame, light, output, Some(&self.map_bind_group), None);
+        self.lookup.encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
     }
 }

@@ -8,15 +8,12 @@ use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec2;
-use ssm_core::passes::{
-    color_attachment, compute_pipeline, texture_entry, uniform_entry, visibility_storage_entry,
-};
+use ssm_core::passes::{color_attachment, compute_pipeline, texture_entry, uniform_entry, visibility_storage_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::ssm_scene::RectLight;
 use ssm_core::{
-    Error, Frame, LightDepthMap, LightFrame, LightFrameUniform, ParamKind, ParamSpec, Result,
-    ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup,
-    register_technique,
+    Error, Frame, LightDepthMap, LightFrame, LightFrameUniform, ParamKind, ParamSpec, Result, ShadowMapSettings, ShadowTechnique,
+    TechniqueInfo, TechniqueKind, TechniqueSetup, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -27,20 +24,12 @@ pub const NAME: &str = "multi-sm";
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "samples",
-        kind: ParamKind::Int {
-            default: 16,
-            min: 1,
-            max: 1024,
-        },
+        kind: ParamKind::Int { default: 16, min: 1, max: 1024 },
         doc: "K, the number of shadow maps: a perfect square, one per stratum of a √K×√K grid on the light",
     },
     ParamSpec {
         name: "shadow_map_size",
-        kind: ParamKind::Int {
-            default: 1024,
-            min: 16,
-            max: 16384,
-        },
+        kind: ParamKind::Int { default: 1024, min: 16, max: 16384 },
         doc: "side of each square shadow map, texels",
     },
     ShadowMapSettings::BIAS_PARAMS[0],
@@ -61,9 +50,7 @@ struct MultiSmSettingsUniform {
 #[must_use]
 pub fn stratum_centres(per_axis: u32) -> Vec<Vec2> {
     let n = per_axis.max(1);
-    (0..n * n)
-        .map(|k| (Vec2::new((k % n) as f32, (k / n) as f32) + 0.5) / n as f32 * 2.0 - Vec2::ONE)
-        .collect()
+    (0..n * n).map(|k| (Vec2::new((k % n) as f32, (k / n) as f32) + 0.5) / n as f32 * 2.0 - Vec2::ONE).collect()
 }
 
 /// K hard shadow maps from stratified points on the light, averaged.
@@ -94,9 +81,7 @@ impl MultiShadowMaps {
         if per_axis * per_axis != samples {
             return Err(Error::Technique {
                 technique: NAME.into(),
-                message: format!(
-                    "samples = {samples} is not a perfect square (1, 4, 9, 16, ...): the strata form a √K×√K grid"
-                ),
+                message: format!("samples = {samples} is not a perfect square (1, 4, 9, 16, ...): the strata form a √K×√K grid"),
             });
         }
         let map_settings = ShadowMapSettings::from_params(params)?;
@@ -115,37 +100,24 @@ impl MultiShadowMaps {
                     .enumerate()
                     .map(|(k, s)| {
                         let light = frame.light;
-                        let point_light = RectLight {
-                            centre: light.point(s.x, s.y),
-                            half_size: Vec2::ZERO,
-                            ..light
-                        };
-                        let uniform =
-                            LightFrameUniform::from(&LightFrame::fit(&point_light, &bounds));
+                        let point_light = RectLight { centre: light.point(s.x, s.y), half_size: Vec2::ZERO, ..light };
+                        let uniform = LightFrameUniform::from(&LightFrame::fit(&point_light, &bounds));
                         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                             label: Some(&format!("multi_sm_sample_frame_{light_index}_{k}")),
                             contents: bytemuck::bytes_of(&uniform),
                             usage: wgpu::BufferUsages::UNIFORM,
                         });
                         device.create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some(&format!(
-                                "multi_sm_sample_frame_bind_group_{light_index}_{k}"
-                            )),
+                            label: Some(&format!("multi_sm_sample_frame_bind_group_{light_index}_{k}")),
                             layout: &setup.scene.uniform_layout,
-                            entries: &[wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: buffer.as_entire_binding(),
-                            }],
+                            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
                         })
                     })
                     .collect()
             })
             .collect();
-        let settings = MultiSmSettingsUniform {
-            weight: 1.0 / samples as f32,
-            normal_offset: map_settings.normal_offset,
-            padding: [0.0; 2],
-        };
+        let settings =
+            MultiSmSettingsUniform { weight: 1.0 / samples as f32, normal_offset: map_settings.normal_offset, padding: [0.0; 2] };
         let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("multi_sm_settings_uniform"),
             contents: bytemuck::bytes_of(&settings),
@@ -153,17 +125,9 @@ impl MultiShadowMaps {
         });
         let own_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("multi_sm_own_layout"),
-            entries: &[
-                texture_entry(0),
-                uniform_entry(1),
-                visibility_storage_entry(2),
-            ],
+            entries: &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2)],
         });
-        let module = create_shader(
-            setup.gpu,
-            "multi_sm_shader",
-            include_str!("../../../shaders/multi-sm/multi_sm.wgsl"),
-        )?;
+        let module = create_shader(setup.gpu, "multi_sm_shader", include_str!("../../../shaders/multi-sm/multi_sm.wgsl"))?;
         let accumulate = compute_pipeline(
             device,
             "multi_sm_accumulate_pipeline",
@@ -187,46 +151,25 @@ impl MultiShadowMaps {
 }
 
 impl ShadowTechnique for MultiShadowMaps {
-    fn render(
-        &mut self,
-        frame: &mut Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         let device = &frame.gpu.device;
         let own_group = self.own_groups.entry(light).or_insert_with(|| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(&format!("multi_sm_own_bind_group_{light}")),
                 layout: &self.own_layout,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&self.map_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: self.settings_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(output),
-                    },
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&self.map_view) },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.settings_buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(output) },
                 ],
             })
         });
         // The sum starts at 0, not at the framework's 1.
-        drop(frame.render_pass(
-            "multi_sm_clear",
-            &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))],
-            None,
-        ));
+        drop(frame.render_pass("multi_sm_clear", &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))], None));
         let frames = self
             .sample_frames
             .get(light)
-            .ok_or_else(|| Error::Technique {
-                technique: NAME.into(),
-                message: format!("no light {light}"),
-            })?;
+            .ok_or_else(|| Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
         for sample_frame in frames {
             self.depth_map.encode_with(frame, sample_frame);
             let mut pass = frame.compute_pass("multi_sm_accumulate");
@@ -265,20 +208,9 @@ mod tests {
     fn strata_centres_tile_the_light() {
         assert_eq!(stratum_centres(1), vec![Vec2::ZERO]);
         let four = stratum_centres(2);
-        assert_eq!(
-            four,
-            vec![
-                Vec2::new(-0.5, -0.5),
-                Vec2::new(0.5, -0.5),
-                Vec2::new(-0.5, 0.5),
-                Vec2::new(0.5, 0.5)
-            ]
-        );
+        assert_eq!(four, vec![Vec2::new(-0.5, -0.5), Vec2::new(0.5, -0.5), Vec2::new(-0.5, 0.5), Vec2::new(0.5, 0.5)]);
         let sixteen = stratum_centres(4);
         assert_eq!(sixteen.len(), 16);
-        assert!(
-            sixteen.iter().sum::<Vec2>().length() < 1e-5,
-            "centred on the light"
-        );
+        assert!(sixteen.iter().sum::<Vec2>().length() < 1e-5, "centred on the light");
     }
 }

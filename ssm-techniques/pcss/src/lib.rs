@@ -13,9 +13,8 @@ use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings,
-    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT,
-    register_technique,
+    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -26,29 +25,17 @@ pub const NAME: &str = "pcss";
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "shadow_map_size",
-        kind: ParamKind::Int {
-            default: 1024,
-            min: 16,
-            max: 16384,
-        },
+        kind: ParamKind::Int { default: 1024, min: 16, max: 16384 },
         doc: "side of the square shadow map, texels",
     },
     ParamSpec {
         name: "blocker_kernel",
-        kind: ParamKind::Int {
-            default: 7,
-            min: 1,
-            max: 64,
-        },
+        kind: ParamKind::Int { default: 7, min: 1, max: 64 },
         doc: "samples per axis of the blocker search (n; n² taps per pixel)",
     },
     ParamSpec {
         name: "pcf_kernel",
-        kind: ParamKind::Int {
-            default: 15,
-            min: 1,
-            max: 128,
-        },
+        kind: ParamKind::Int { default: 15, min: 1, max: 128 },
         doc: "samples per axis of the PCF filter (m; m² taps per pixel)",
     },
     ParamSpec {
@@ -108,21 +95,11 @@ impl Pcss {
             label: Some("pcss_map_bind_group"),
             layout: &map_layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: settings_buffer.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
+                wgpu::BindGroupEntry { binding: 1, resource: settings_buffer.as_entire_binding() },
             ],
         });
-        let module = create_shader(
-            setup.gpu,
-            "pcss_filter_shader",
-            include_str!("../../../shaders/pcss/pcss.wgsl"),
-        )?;
+        let module = create_shader(setup.gpu, "pcss_filter_shader", include_str!("../../../shaders/pcss/pcss.wgsl"))?;
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
         let search_and_filter = ScreenPass::new(
             setup,
@@ -132,24 +109,14 @@ impl Pcss {
             Some(&map_layout),
             VISIBILITY_FORMAT.into(),
         )?;
-        Ok(Self {
-            depth_map,
-            search_and_filter,
-            map_bind_group,
-        })
+        Ok(Self { depth_map, search_and_filter, map_bind_group })
     }
 }
 
 impl ShadowTechnique for Pcss {
-    fn render(
-        &mut self,
-        frame: &mut Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         self.depth_map.encode(frame, light);
-        self.search_and_filter
-            .encode(frame, light, output, Some(&self.map_bind_group), None);
+        self.search_and_filter.encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
     }
 }

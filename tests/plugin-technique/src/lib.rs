@@ -7,8 +7,8 @@
 
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, ParamSpec, Requirements, Result, ScreenPass, ShadowTechnique, TechniqueInfo,
-    TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    Frame, ParamSpec, Requirements, Result, ScreenPass, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT,
+    register_technique,
 };
 
 /// The registered name.
@@ -34,12 +34,7 @@ struct FrontOfLight {
 }
 
 impl ShadowTechnique for FrontOfLight {
-    fn render(
-        &mut self,
-        frame: &mut Frame<'_>,
-        light: usize,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         self.pass.encode(frame, light, output, None, None);
         Ok(())
     }
@@ -47,14 +42,7 @@ impl ShadowTechnique for FrontOfLight {
 
 fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     let module = create_shader(setup.gpu, "front_of_light_shader", SHADER)?;
-    let pass = ScreenPass::new(
-        setup,
-        NAME,
-        "front_of_light_test",
-        (&module, "front_of_light"),
-        None,
-        VISIBILITY_FORMAT.into(),
-    )?;
+    let pass = ScreenPass::new(setup, NAME, "front_of_light_test", (&module, "front_of_light"), None, VISIBILITY_FORMAT.into())?;
     Ok(Box::new(FrontOfLight { pass }))
 }
 
@@ -66,9 +54,6 @@ register_technique!(TechniqueInfo {
     paper: "none (plug-in test)",
     kind: TechniqueKind::Realtime,
     params: PARAMS,
-    requirements: |_| Ok(Requirements {
-        gbuffer: true,
-        ..Requirements::NONE
-    }),
+    requirements: |_| Ok(Requirements { gbuffer: true, ..Requirements::NONE }),
     create,
 });
