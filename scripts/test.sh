@@ -14,4 +14,5 @@ export SSM_CACHE_DIR="${SSM_CACHE_DIR:-$(mktemp -d)}"
 
 cargo fmt --all --check
 cargo clippy --workspace --all-targets --locked -- -D warnings
-cargo test --workspace --locked
+# --all-targets also runs the criterion benches once each, in their test mode.
+cargo test --workspace --all-targets --locked
