@@ -31,7 +31,8 @@ pub struct LightDepthMapDesc<'a> {
     pub cull_mode: Option<wgpu::Face>,
     /// Bias added to every stored depth, world units.
     pub constant_bias: f32,
-    /// Bias per unit of depth change across one texel (slope-scaled bias).
+    /// Bias per unit of depth change across one texel (slope-scaled bias); the
+    /// depth change is clamped to 4 texels' worth of world distance.
     pub slope_bias: f32,
 }
 
@@ -77,7 +78,7 @@ impl LightDepthMap {
             wgpu::TextureFormat::Depth32Float,
             wgpu::TextureUsages::empty(),
         );
-        let bias = DepthBiasUniform { values: [desc.constant_bias, desc.slope_bias, 0.0, 0.0] };
+        let bias = DepthBiasUniform { values: [desc.constant_bias, desc.slope_bias, desc.width as f32, desc.height as f32] };
         let bias_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&format!("{label}_bias_uniform")),
             contents: bytemuck::bytes_of(&bias),
@@ -191,12 +192,12 @@ impl ShadowMapSettings {
         },
         ParamSpec {
             name: "slope_bias",
-            kind: ParamKind::Float { default: 1.5, min: 0.0, max: 16.0 },
-            doc: "slope-scaled bias: multiples of the depth change across one texel",
+            kind: ParamKind::Float { default: 0.0, min: 0.0, max: 16.0 },
+            doc: "slope-scaled bias: multiples of the depth change across one texel (clamped to 4 texels; normal offset usually makes it unnecessary)",
         },
         ParamSpec {
             name: "normal_offset",
-            kind: ParamKind::Float { default: 1.0, min: 0.0, max: 8.0 },
+            kind: ParamKind::Float { default: 0.5, min: 0.0, max: 8.0 },
             doc: "lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011)",
         },
     ];
