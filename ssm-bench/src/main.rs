@@ -305,12 +305,14 @@ fn compare(args: &CompareArgs) -> Result<()> {
 
     let adapter = gpu.describe();
     let reference_text = reference_params.to_string();
+    let reference_cost = report::reference_cost(&reference.diagnostics);
     let context = report::ReportContext {
         scene: &args.scene,
         adapter: &adapter,
         size: (args.width, args.height),
         frames: args.frames,
         reference_params: &reference_text,
+        reference_cost: &reference_cost,
         skipped: &skipped,
     };
     let write = |name: &str, text: String| {

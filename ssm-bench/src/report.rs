@@ -314,6 +314,8 @@ pub struct ReportContext<'a> {
     pub frames: u32,
     /// The reference's parameters.
     pub reference_params: &'a str,
+    /// What the reference's tracing cost (or that it came from the cache).
+    pub reference_cost: &'a str,
     /// Techniques not run, with the reason.
     pub skipped: &'a [(String, String)],
 }
@@ -322,8 +324,8 @@ pub struct ReportContext<'a> {
 #[must_use]
 pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     let mut out = format!(
-        "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]. Errors are against it, on the same pixels; GPU time is the sum of each technique's timed passes.\n\n",
-        context.scene, context.size.0, context.size.1, context.frames, context.adapter, context.reference_params
+        "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]: {}. Errors are against it, on the same pixels; GPU time is the sum of each technique's timed passes.\n\n",
+        context.scene, context.size.0, context.size.1, context.frames, context.adapter, context.reference_params, context.reference_cost
     );
     out += &markdown_table(rows);
     for (name, why) in context.skipped {
@@ -347,14 +349,15 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     );
     let _ = writeln!(
         out,
-        "<h1>ssm compare: <code>{}</code></h1>\n<p>{}×{}, median of {} frames after one warm-up, on {}. Ground truth: <code>{}</code> [{}].</p>",
+        "<h1>ssm compare: <code>{}</code></h1>\n<p>{}×{}, median of {} frames after one warm-up, on {}. Ground truth: <code>{}</code> [{}]: {}.</p>",
         escape(context.scene),
         context.size.0,
         context.size.1,
         context.frames,
         escape(context.adapter),
         escape(reference_name),
-        escape(context.reference_params)
+        escape(context.reference_params),
+        escape(context.reference_cost)
     );
     out += "<table>\n<tr><th>technique</th><th>params</th><th>GPU ms (median)</th><th>GPU ms (min)</th><th>MAE penumbra</th><th>RMSE</th><th>max</th><th>PSNR dB</th><th>SSIM</th><th>&gt; 0.05</th><th>FLIP</th></tr>\n";
     for r in rows {
@@ -415,5 +418,17 @@ mod tests {
             CSV_COLUMNS[..15].join(","),
             "scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"
         );
+    }
+}
+
+/// A sentence on what tracing the ground truth cost, from its diagnostics.
+#[must_use]
+pub fn reference_cost(diagnostics: &[(String, f64)]) -> String {
+    let get = |key: &str| diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v);
+    match (get("reference_rays"), get("reference_trace_ms"), get("reference_rays_per_second")) {
+        (Some(rays), Some(ms), Some(rate)) if rays > 0.0 => {
+            format!("{:.1} M shadow rays traced on the CPU in {:.0} ms ({:.1} M rays/s)", rays / 1e6, ms, rate / 1e6)
+        }
+        _ => "read from the cache".into(),
     }
 }
