@@ -399,6 +399,18 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     out
 }
 
+/// A sentence on what tracing the ground truth cost, from its diagnostics.
+#[must_use]
+pub fn reference_cost(diagnostics: &[(String, f64)]) -> String {
+    let get = |key: &str| diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v);
+    match (get("reference_rays"), get("reference_trace_ms"), get("reference_rays_per_second")) {
+        (Some(rays), Some(ms), Some(rate)) if rays > 0.0 => {
+            format!("{:.1} M shadow rays traced on the CPU in {:.0} ms ({:.1} M rays/s)", rays / 1e6, ms, rate / 1e6)
+        }
+        _ => "read from the cache".into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -418,17 +430,5 @@ mod tests {
             CSV_COLUMNS[..15].join(","),
             "scene,technique,params,width,height,gpu_ms_median,gpu_ms_min,cpu_ms,mae_penumbra,rmse,max_abs,psnr,ssim,frac_over_0_05,adapter"
         );
-    }
-}
-
-/// A sentence on what tracing the ground truth cost, from its diagnostics.
-#[must_use]
-pub fn reference_cost(diagnostics: &[(String, f64)]) -> String {
-    let get = |key: &str| diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v);
-    match (get("reference_rays"), get("reference_trace_ms"), get("reference_rays_per_second")) {
-        (Some(rays), Some(ms), Some(rate)) if rays > 0.0 => {
-            format!("{:.1} M shadow rays traced on the CPU in {:.0} ms ({:.1} M rays/s)", rays / 1e6, ms, rate / 1e6)
-        }
-        _ => "read from the cache".into(),
     }
 }
