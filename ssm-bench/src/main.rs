@@ -222,6 +222,10 @@ fn render(args: &RenderArgs) -> Result<()> {
         };
         progress.suspend(|| -> Result<()> {
             say!("{:<8} {time}  [{}]  -> {}", info.name, params, dir.display());
+            if !run.diagnostics.is_empty() {
+                let text: Vec<String> = run.diagnostics.iter().map(|(k, v)| format!("{k}={v:.4}")).collect();
+                say!("{:<8} {}", "", text.join("  "));
+            }
             Ok(())
         })?;
         progress.inc(1);
