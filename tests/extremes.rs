@@ -82,6 +82,12 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
         ("occluder behind the light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 5.0), Expect::AllLit),
     ];
 
+    // Far to the side, just below the light's plane: past the frame's widest angle (MAX_HALF_ANGLE_TANGENT), so outside every map.
+    let mut scene = builtin("parallel-square").unwrap().build();
+    let occluder = scene.instances.iter_mut().find(|i| i.role == Role::Occluder).unwrap();
+    occluder.transform = Mat4::from_translation(Vec3::new(30.0, 3.99, 0.0));
+    scenes.push(("occluder outside the light frustum", scene, Expect::InRange));
+
     scenes.push((
         "no occluder at all",
         from_manifest(
@@ -189,7 +195,7 @@ fn every_technique_survives_every_extreme() {
             }
         }
     }
-    assert!(runs >= 2 * 14, "only {runs} technique/scene pairs ran");
+    assert!(runs >= 2 * 15, "only {runs} technique/scene pairs ran");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -9,6 +9,7 @@ use ssm_scene::Scene;
 /// Keeps every technique crate linked into the test binaries, so that their registrations are present.
 pub fn link_techniques() {
     ssm_core::reference::link();
+    ssm_atty::link();
     ssm_hard::link();
     ssm_multi_sm::link();
     ssm_pcss::link();

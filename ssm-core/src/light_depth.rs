@@ -29,6 +29,9 @@ pub struct LightDepthMapDesc<'a> {
     pub geometry: Geometry,
     /// Faces to cull (`Some(Face::Back)` keeps faces turned to the light), or none.
     pub cull_mode: Option<wgpu::Face>,
+    /// Keep the farthest surface per texel instead of the nearest (the
+    /// back-face occluder map of Atty et al., Sec. 3.5).
+    pub farthest: bool,
     /// Bias added to every stored depth, world units.
     pub constant_bias: f32,
     /// Bias per unit of depth change across one texel (slope-scaled bias); the
@@ -55,6 +58,7 @@ pub struct LightDepthMap {
     bias_bind_group: wgpu::BindGroup,
     label: String,
     geometry: Geometry,
+    farthest: bool,
 }
 
 impl LightDepthMap {
@@ -112,7 +116,7 @@ impl LightDepthMap {
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
+                depth_compare: Some(if desc.farthest { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Less }),
                 stencil: wgpu::StencilState::default(),
                 bias: wgpu::DepthBiasState::default(),
             }),
@@ -134,6 +138,7 @@ impl LightDepthMap {
             bias_bind_group,
             label: label.to_owned(),
             geometry: desc.geometry,
+            farthest: desc.farthest,
         })
     }
 
@@ -154,7 +159,10 @@ impl LightDepthMap {
             &[color_attachment(&self.linear_depth_view, Some(wgpu::Color { r: f64::from(NO_SURFACE), g: 0.0, b: 0.0, a: 0.0 }))],
             Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(if self.farthest { 0.0 } else { 1.0 }),
+                    store: wgpu::StoreOp::Discard,
+                }),
                 stencil_ops: None,
             }),
         );
@@ -240,6 +248,7 @@ impl ShadowMapSettings {
                 height: self.size,
                 geometry: Geometry::All,
                 cull_mode: None,
+                farthest: false,
                 constant_bias: self.constant_bias * diagonal,
                 slope_bias: self.slope_bias,
             },

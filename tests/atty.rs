@@ -1,0 +1,131 @@
+//! Atty et al. 2006 (`atty`) against the exact answer and against its own
+//! paper's claims: the discretisation bound of Sec. 5.1.1, Appendix A's FP16
+//! failure, the two-sided variant of Sec. 3.5, and a point light.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use glam::{Vec2, Vec3};
+use ssm_core::LightFrame;
+use ssm_core::metrics::compare;
+use ssm_core::reference::parallel_rectangle_visibility;
+use ssm_integration_tests::{gpu, render};
+use ssm_scene::{Scene, builtin};
+
+const SIZE: (u32, u32) = (160, 120);
+
+/// Penumbra MAE of `atty` with `settings` on parallel-square, against the exact
+/// visibility at the same G-buffer points.
+fn parallel_square_error(settings: &[(&str, &str)]) -> f64 {
+    let scene = builtin("parallel-square").unwrap().build();
+    let rendered = render(&gpu(), &scene, "atty", settings, SIZE.0, SIZE.1).unwrap();
+    let positions = rendered.renderer.read_positions().unwrap();
+    let light = &scene.lights[0];
+    let exact: Vec<f32> = positions
+        .iter()
+        .map(|p| {
+            if p[3] > 0.5 {
+                parallel_rectangle_visibility(light, Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5), Vec3::new(p[0], p[1], p[2]))
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let covered: Vec<bool> = positions.iter().map(|p| p[3] > 0.5).collect();
+    compare(&exact, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae_penumbra
+}
+
+/// The shared light frame's half-angle tangent on parallel-square (the same along u and v).
+fn parallel_square_tan_half() -> f32 {
+    let scene = builtin("parallel-square").unwrap().build();
+    LightFrame::fit(&scene.lights[0], &scene.bounds()).tan_half.x
+}
+
+/// Penumbra MAE of `technique` against a 16×16-sample ground truth on `scene`.
+fn error_against_reference(scene: &Scene, technique: &str, settings: &[(&str, &str)]) -> f64 {
+    let gpu = gpu();
+    let reference = render(&gpu, scene, "reference", &[("samples", "16"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+    let rendered = render(&gpu, scene, technique, settings, SIZE.0, SIZE.1).unwrap();
+    let covered: Vec<bool> = rendered.renderer.read_positions().unwrap().iter().map(|p| p[3] > 0.5).collect();
+    compare(&reference.visibility, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae_penumbra
+}
+
+/// Sec. 5.1.1: each micro-patch over- or under-estimates the occluder by at most half a texel.
+/// On parallel-square (occluder at depth z_O = 2, receiver at z_R = 4, unit light) an edge off by
+/// δ = z_O·tan/N moves its back-projection on the light by δ·z_R/(z_R − z_O) = 2δ, so the visible
+/// fraction is off by at most 4·tan/N. The SSM is read with bilinear interpolation: at the kinks of
+/// the piecewise-linear penumbra (slope 1 per world unit here) that adds at most half an SSM texel
+/// at z_R, 4·tan/S. Overlaps between patches (Sec. 5.1.2) vanish: every patch has the same depth.
+/// Power-of-two sizes put the square's edges at the same fraction of a texel (the paper's own
+/// remark, Sec. 5.2.3), so the sizes here are not powers of two.
+#[test]
+fn parallel_square_error_is_within_the_discretisation_bound_and_falls_with_the_map_size() {
+    let tan = parallel_square_tan_half();
+    let ssm = 512.0;
+    let mut errors = Vec::new();
+    for n in [33u32, 63, 127, 255] {
+        let error = parallel_square_error(&[("occluder_map_size", &n.to_string()), ("ssm_size", "512")]);
+        let bound = f64::from(4.0 * tan / n as f32 + 4.0 * tan / ssm);
+        println!("occluder map {n}²: penumbra MAE {error:.4} (bound {bound:.4})");
+        assert!(error <= bound, "N = {n}: {error} above the discretisation bound {bound}");
+        errors.push(error);
+    }
+    for pair in errors.windows(2) {
+        assert!(pair[1] < pair[0], "the error falls as the occluder map grows: {errors:?}");
+    }
+    assert!(errors[3] < errors[0] / 5.0, "{errors:?}");
+}
+
+/// Appendix A, Eq. 4: FP16 has a 10-bit mantissa, so patches hiding less than 2⁻¹⁰ of the light
+/// are lost once the sum nears 1. On parallel-square a patch hides (2·z_O·tan/N · 2)² of the unit
+/// light: above 2⁻¹⁰ at N = 128, far below at N = 1024. FP32 (23 bits) is safe at both.
+#[test]
+fn fp16_accumulation_fails_at_high_resolution_and_fp32_does_not() {
+    let tan = parallel_square_tan_half();
+    let hidden_by_one_patch = |n: f32| (2.0 * 2.0 * tan / n * 2.0).powi(2);
+    assert!(
+        hidden_by_one_patch(128.0) > 2f32.powi(-10) && hidden_by_one_patch(1024.0) < 2f32.powi(-10),
+        "the paper's condition separates the two sizes"
+    );
+    let error = |n: &str, accumulation: &str| {
+        parallel_square_error(&[("occluder_map_size", n), ("accumulation", accumulation), ("ssm_size", "128")])
+    };
+    let (f16_low, f16_high) = (error("128", "f16"), error("1024", "f16"));
+    let (f32_low, f32_high) = (error("128", "f32"), error("1024", "f32"));
+    println!("penumbra MAE: f16 at 128² {f16_low:.4}, at 1024² {f16_high:.4}; f32 at 128² {f32_low:.4}, at 1024² {f32_high:.4}");
+    assert!(f16_high > 10.0 * f16_low, "FP16 at 1024² ({f16_high}) must be far worse than at 128² ({f16_low})");
+    assert!(f16_high > 0.1, "{f16_high}");
+    assert!(f32_low < 0.03 && f32_high < 0.03, "FP32 stays accurate: {f32_low}, {f32_high}");
+}
+
+/// Sec. 3.5 and Fig. 17: the two-sided variant is at least as accurate on a thick occluder, and
+/// identical on the square, which has no thickness.
+#[test]
+fn two_sided_is_at_least_as_accurate_and_equal_without_thickness() {
+    let sphere = builtin("floating-sphere").unwrap().build();
+    let one = error_against_reference(&sphere, "atty", &[]);
+    let two = error_against_reference(&sphere, "atty", &[("two_sided", "true")]);
+    println!("floating-sphere penumbra MAE: one-sided {one:.4}, two-sided {two:.4}");
+    assert!(two <= one, "two-sided {two} vs one-sided {one}");
+    let (one, two) = (parallel_square_error(&[]), parallel_square_error(&[("two_sided", "true")]));
+    assert!((one - two).abs() < 1e-6, "parallel-square: one-sided {one}, two-sided {two}");
+}
+
+/// A point light: every micro-patch hides all or nothing, and the result is the hard shadow of
+/// the discretised occluder (Sec. 5.2.4).
+#[test]
+fn a_point_light_gives_the_hard_shadow() {
+    let mut scene = builtin("floating-sphere").unwrap().build();
+    scene.lights[0].half_size = Vec2::ZERO;
+    let gpu = gpu();
+    let atty = render(&gpu, &scene, "atty", &[("occluder_map_size", "512"), ("ssm_size", "1024")], SIZE.0, SIZE.1).unwrap();
+    let exact = render(&gpu, &scene, "reference", &[("samples", "1"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+    let receives: Vec<bool> = atty.renderer.read_normals().unwrap().iter().map(|n| n[3] > 0.5).collect();
+    let compared: Vec<(f32, f32)> =
+        atty.visibility.iter().zip(&exact.visibility).zip(&receives).filter(|(_, r)| **r).map(|((a, e), _)| (*a, *e)).collect();
+    let penumbra = compared.iter().filter(|(a, _)| *a > 0.02 && *a < 0.98).count() as f32 / compared.len() as f32;
+    let wrong = compared.iter().filter(|(a, e)| (a - e).abs() > 0.5).count() as f32 / compared.len() as f32;
+    println!("point light: {:.2}% of receiver pixels in a penumbra, {:.2}% on the wrong side", penumbra * 100.0, wrong * 100.0);
+    assert!(penumbra < 0.01, "a point light casts no penumbra: {penumbra}");
+    assert!(wrong < 0.01, "{wrong} of pixels disagree with the exact hard shadow");
+}
