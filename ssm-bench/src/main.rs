@@ -37,7 +37,8 @@ struct SweepArgs {
     /// A built-in scene name, a scene manifest (.toml) or a model file.
     #[arg(long, required_unless_present = "list_presets")]
     scene: Option<String>,
-    /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step); repeatable.
+    /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step);
+    /// `scene.light_scale` and `scene.occluder_lift` vary the scene; repeatable.
     #[arg(long = "vary", value_name = "TECHNIQUE.PARAM=V1,V2,...")]
     varies: Vec<String>,
     /// A named set of --vary axes (see `ssm sweep --list-presets`).
@@ -49,9 +50,12 @@ struct SweepArgs {
     /// Fixed parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
-    /// The error measure plotted against time.
+    /// The measure on the y axis (`time` for the papers' timing figures).
     #[arg(long, value_enum, default_value = "mae-penumbra")]
     error: sweep::ErrorAxis,
+    /// The x axis: `time`, or a varied parameter as `<technique>.<param>` (`scene.light_scale`); default: the preset's, else time.
+    #[arg(long)]
+    x: Option<String>,
     /// Image width in pixels.
     #[arg(long, default_value_t = 640)]
     width: u32,
@@ -61,6 +65,9 @@ struct SweepArgs {
     /// Frames timed per point after one warm-up.
     #[arg(long, default_value_t = 3)]
     frames: u32,
+    /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1).
+    #[arg(long, value_enum, default_value = "all")]
+    pixels: report::PixelSet,
     /// Output directory: sweep.csv, sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
@@ -86,6 +93,9 @@ struct CompareArgs {
     /// Frames timed per technique after one warm-up; GPU time is their median.
     #[arg(long, default_value_t = 5)]
     frames: u32,
+    /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1).
+    #[arg(long, value_enum, default_value = "all")]
+    pixels: report::PixelSet,
     /// Output directory: results.csv, report.md, index.html and one folder of images per technique.
     #[arg(long)]
     out: PathBuf,
@@ -295,7 +305,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
     report::write_images(&args.out.join(reference_info.name), &reference, args.width, args.height, None)?;
-    let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
+    let covered = report::pixel_mask(&renderer, args.pixels)?;
     progress.inc(1);
     let mut rows = Vec::new();
     for (info, params) in &runs {
@@ -331,33 +341,57 @@ fn compare(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+/// One technique point of a sweep: the technique, its parameters, and its varied values (`<technique>.<param>`, value).
+type SweepPoint = (&'static TechniqueInfo, ParamValues, Vec<(String, String)>);
+
 fn sweep_command(args: &SweepArgs) -> Result<()> {
     if args.list_presets {
         for preset in sweep::PRESETS {
-            say!("{:<18} {}\n{:<18} --vary {}", preset.name, preset.summary, "", preset.varies.join(" --vary "));
+            say!(
+                "{:<22} {}\n{:<22} --vary {}  (x axis: {})",
+                preset.name,
+                preset.summary,
+                "",
+                preset.varies.join(" --vary "),
+                preset.x_axis
+            );
         }
         return Ok(());
     }
     let (Some(scene_spec), Some(out)) = (&args.scene, &args.out) else { bail!("--scene and --out are required") };
     let registry = registry()?;
     let mut specs: Vec<String> = args.varies.clone();
+    let mut x_axis = args.x.clone();
     if let Some(name) = &args.preset {
-        specs.extend(sweep::preset(name)?.varies.iter().map(|v| (*v).to_owned()));
+        let preset = sweep::preset(name)?;
+        specs.extend(preset.varies.iter().map(|v| (*v).to_owned()));
+        x_axis = x_axis.or_else(|| Some(preset.x_axis.to_owned()));
     }
+    let x_axis = x_axis.unwrap_or_else(|| "time".to_owned());
     if specs.is_empty() {
         bail!("nothing to sweep: give --vary or --preset (see --list-presets)");
     }
     let varies: Vec<sweep::Vary> = specs.iter().map(|s| sweep::Vary::parse(s)).collect::<Result<_>>()?;
+    if x_axis != "time" && !varies.iter().any(|v| v.params.iter().any(|n| format!("{}.{n}", v.technique) == x_axis)) {
+        bail!("--x {x_axis}: not a varied parameter (give `time` or one of the --vary parameters as <technique>.<param>)");
+    }
+    let scene_axes: Vec<&sweep::Vary> = varies.iter().filter(|v| v.technique == sweep::SCENE_AXIS).collect();
     let mut techniques: Vec<&'static TechniqueInfo> = Vec::new();
-    for vary in &varies {
+    for vary in varies.iter().filter(|v| v.technique != sweep::SCENE_AXIS) {
         let info = registry.get(&vary.technique)?;
         if !techniques.iter().any(|t| t.name == info.name) {
             techniques.push(info);
         }
     }
+    if techniques.is_empty() {
+        bail!("no technique is varied: add a --vary <technique>.<param>=... (scene parameters alone compare nothing)");
+    }
     let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
-    // Every grid point's parameters, resolved before the GPU is touched: a bad value fails fast.
-    let mut points: Vec<(&'static TechniqueInfo, ParamValues, String)> = Vec::new();
+    // Every grid point resolved before the GPU is touched: a bad value fails fast.
+    let scene_points: Vec<Vec<(String, String)>> = sweep::grid(&scene_axes);
+    let scene_overrides: Vec<sweep::SceneOverrides> =
+        scene_points.iter().map(|p| sweep::SceneOverrides::from_point(p)).collect::<Result<_>>()?;
+    let mut points: Vec<SweepPoint> = Vec::new();
     for info in &techniques {
         let axes: Vec<&sweep::Vary> = varies.iter().filter(|v| v.technique == info.name).collect();
         for point in sweep::grid(&axes) {
@@ -365,10 +399,11 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
             for (name, value) in &point {
                 params.set(name, value)?;
             }
-            points.push((info, params, sweep::point_label(&point)));
+            let qualified = point.into_iter().map(|(name, value)| (format!("{}.{name}", info.name), value)).collect();
+            points.push((info, params, qualified));
         }
     }
-    let scene = load_scene(scene_spec)?;
+    let base_scene = load_scene(scene_spec)?;
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
     let reference_params = params_for(reference_info, &settings)?;
@@ -377,43 +412,81 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         needs = needs.union((info.requirements)(params)?);
     }
     let gpu = GpuContext::new()?;
-    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let progress = ProgressBar::new(points.len() as u64 + 1);
+    let progress = ProgressBar::new(((points.len() + 1) * scene_points.len()) as u64);
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
-    progress.set_message("reference");
-    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
-    let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
-    progress.inc(1);
-    let (mut rows, mut labels) = (Vec::new(), Vec::new());
-    for (info, params, label) in &points {
-        progress.set_message(format!("{} {label}", info.name));
-        let measured = report::measure(&mut renderer, info, params, args.frames)?;
-        rows.push(report::row(scene_spec, &renderer, &measured, &reference, &covered));
-        labels.push(label.clone());
+    let (mut rows, mut varied) = (Vec::new(), Vec::new());
+    for (scene_point, overrides) in scene_points.iter().zip(&scene_overrides) {
+        // Each scene gets its own renderer and ground truth.
+        let scene = overrides.apply(&base_scene).with_context(|| format!("scene {scene_spec} with {scene_point:?}"))?;
+        let scene_name = if scene_point.is_empty() {
+            scene_spec.clone()
+        } else {
+            format!("{scene_spec}[{}]", scene_point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";"))
+        };
+        let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+        progress.set_message(format!("reference {scene_name}"));
+        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
+        let covered = report::pixel_mask(&renderer, args.pixels)?;
         progress.inc(1);
+        for (info, params, technique_point) in &points {
+            progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
+            let measured = report::measure(&mut renderer, info, params, args.frames)?;
+            rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
+            let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
+            all.extend(technique_point.iter().cloned());
+            varied.push(all);
+            progress.inc(1);
+        }
     }
     progress.finish_and_clear();
     std::fs::write(out.join("sweep.csv"), report::csv(&rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
+
+    // One series per technique and combination of the varied values that are not on the x axis.
+    let plot_points: Vec<sweep::PlotPoint> = rows
+        .iter()
+        .zip(&varied)
+        .map(|(row, values)| {
+            let prefix = format!("{}.", row.technique);
+            let others: Vec<String> =
+                values.iter().filter(|(k, _)| *k != x_axis).map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k))).collect();
+            let x = if x_axis == "time" {
+                sweep::time_of(row)
+            } else {
+                values.iter().find(|(k, _)| *k == x_axis).and_then(|(_, v)| v.parse().ok()).unwrap_or(f64::NAN)
+            };
+            let series = if x_axis == "time" {
+                row.technique.clone()
+            } else {
+                std::iter::once(row.technique.clone()).chain(others.iter().cloned()).collect::<Vec<_>>().join(" ")
+            };
+            let label = if x_axis == "time" { sweep::point_label(values) } else { String::new() };
+            sweep::PlotPoint { series, x, y: args.error.of(row), label }
+        })
+        .collect();
+    let axes = sweep::PlotAxes {
+        x_label: if x_axis == "time" { "time per frame, ms (log)".to_owned() } else { x_axis.clone() },
+        y_label: format!("{} (log)", args.error.label()),
+        log_x: x_axis == "time",
+        pareto: x_axis == "time" && args.error != sweep::ErrorAxis::Time,
+    };
     let title = format!("{} at {}x{} on {}", scene_spec, args.width, args.height, gpu.info.name);
-    sweep::plot(&rows, &labels, args.error, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
-    let front = sweep::pareto_front(&rows.iter().map(|r| (sweep::time_of(r), args.error.of(r))).collect::<Vec<_>>());
-    for (index, (row, label)) in rows.iter().zip(&labels).enumerate() {
+    sweep::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
+    let front = if axes.pareto { sweep::pareto_front(&plot_points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>()) } else { Vec::new() };
+    for (index, (row, values)) in rows.iter().zip(&varied).enumerate() {
         let mark = if front.contains(&index) { "*" } else { " " };
         say!(
-            "{mark} {:<10} {:<14} {:>9.3} ms  {} {:.4}",
+            "{mark} {:<10} {:<40} {:>9.3} ms  {} {:.4}",
             row.technique,
-            label,
+            sweep::point_label(values),
             sweep::time_of(row),
             args.error.label(),
             args.error.of(row)
         );
     }
-    say!(
-        "(* on the Pareto front)\nwrote {}, {} and {}",
-        out.join("sweep.csv").display(),
-        out.join("sweep.png").display(),
-        out.join("sweep.svg").display()
-    );
+    if axes.pareto {
+        say!("(* on the Pareto front)");
+    }
+    say!("wrote {}, {} and {}", out.join("sweep.csv").display(), out.join("sweep.png").display(), out.join("sweep.svg").display());
     Ok(())
 }

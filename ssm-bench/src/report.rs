@@ -110,6 +110,27 @@ pub fn write_images(dir: &Path, measured: &Measured, width: u32, height: u32, re
     Ok(())
 }
 
+/// Which pixels the error metrics cover.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PixelSet {
+    /// Every pixel a surface covers.
+    All,
+    /// Only pixels of receivers (role `receiver` or `both`): what techniques that split roles shadow.
+    Receivers,
+}
+
+/// The pixels `set` selects, from the renderer's G-buffer.
+///
+/// # Errors
+/// A readback error.
+pub fn pixel_mask(renderer: &Renderer, set: PixelSet) -> Result<Vec<bool>> {
+    let positions = renderer.read_positions()?;
+    Ok(match set {
+        PixelSet::All => positions.iter().map(|p| p[3] > 0.5).collect(),
+        PixelSet::Receivers => positions.iter().zip(renderer.read_normals()?).map(|(p, n)| p[3] > 0.5 && n[3] > 0.5).collect(),
+    })
+}
+
 /// One row of `results.csv` / `sweep.csv`.
 #[derive(Clone, Debug)]
 pub struct Row {

@@ -50,6 +50,8 @@ pub struct Preset {
     pub summary: &'static str,
     /// `--vary` specifications.
     pub varies: &'static [&'static str],
+    /// The plot's x axis unless `--x` says otherwise: `time` or a varied parameter.
+    pub x_axis: &'static str,
 }
 
 /// The built-in presets.
@@ -62,23 +64,103 @@ pub const PRESETS: &[Preset] = &[
             "multi-sm.samples=1,4,16,64",
             "hard.shadow_map_size=512,1024,2048,4096",
         ],
+        x_axis: "time",
     },
     Preset {
         name: "pcss-kernels",
         summary: "PCSS with the kernel pairs of Buades et al., Table 4 (7/15, 11/21, 29/41)",
         varies: &["pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41"],
+        x_axis: "time",
     },
     Preset {
         name: "multi-sm-samples",
         summary: "multi-sm with K = 1, 4, 16, 64, 256 shadow maps",
         varies: &["multi-sm.samples=1,4,16,64,256"],
+        x_axis: "time",
     },
     Preset {
         name: "shadow-map-size",
         summary: "hard and PCSS against shadow-map resolution",
         varies: &["hard.shadow_map_size=256,512,1024,2048,4096", "pcss.shadow_map_size=256,512,1024,2048,4096"],
+        x_axis: "time",
+    },
+    Preset {
+        name: "atty-map-size",
+        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided",
+        varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
+        x_axis: "atty.occluder_map_size",
+    },
+    Preset {
+        name: "atty-light-size",
+        summary: "Atty et al., Fig. 18 and Fig. 24 (error, or time with --error time) against the light's size for 63², 127², 255² maps (not powers of two, as the paper notes in Sec. 5.2.3; use a thick occluder such as floating-sphere)",
+        varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255"],
+        x_axis: "scene.light_scale",
+    },
+    Preset {
+        name: "atty-occluder-height",
+        summary: "Atty et al., Fig. 20: error as the occluders move from the receiver towards the light (on floating-sphere: from 0.05 above the ground to 0.05 below the light)",
+        varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
+        x_axis: "scene.occluder_lift",
     },
 ];
+
+/// The pseudo-technique whose varies change the scene instead of a technique.
+pub const SCENE_AXIS: &str = "scene";
+
+/// Changes to the scene a sweep can vary, by name after `scene.`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneOverrides {
+    /// Every light's size is multiplied by this (`scene.light_scale`).
+    pub light_scale: f32,
+    /// Occluder-only instances move this far towards the first light, along its normal, world units (`scene.occluder_lift`).
+    pub occluder_lift: f32,
+}
+
+impl Default for SceneOverrides {
+    fn default() -> Self {
+        Self { light_scale: 1.0, occluder_lift: 0.0 }
+    }
+}
+
+impl SceneOverrides {
+    /// The overrides of one grid point.
+    ///
+    /// # Errors
+    /// An unknown scene parameter or a non-numeric value.
+    pub fn from_point(point: &[(String, String)]) -> Result<Self> {
+        let mut overrides = Self::default();
+        for (name, value) in point {
+            let number: f32 =
+                value.parse().ok().filter(|v: &f32| v.is_finite()).with_context(|| format!("scene.{name}={value}: not a finite number"))?;
+            match name.as_str() {
+                "light_scale" if number >= 0.0 => overrides.light_scale = number,
+                "light_scale" => bail!("scene.light_scale={value}: must be non-negative"),
+                "occluder_lift" => overrides.occluder_lift = number,
+                other => bail!("unknown scene parameter `scene.{other}`; scene parameters: light_scale, occluder_lift"),
+            }
+        }
+        Ok(overrides)
+    }
+
+    /// The scene with the overrides applied (and validated).
+    ///
+    /// # Errors
+    /// The modified scene is invalid (an occluder lifted to a non-finite place, say).
+    pub fn apply(&self, scene: &ssm_scene::Scene) -> Result<ssm_scene::Scene> {
+        let mut scene = scene.clone();
+        for light in &mut scene.lights {
+            light.half_size *= self.light_scale;
+        }
+        if let Some(first) = scene.lights.first() {
+            let lift = glam::Mat4::from_translation(-first.normal() * self.occluder_lift);
+            for instance in scene.instances.iter_mut().filter(|i| i.role == ssm_scene::Role::Occluder) {
+                instance.transform = lift * instance.transform;
+            }
+        }
+        scene.validate()?;
+        Ok(scene)
+    }
+}
 
 /// The preset called `name`.
 ///
@@ -121,6 +203,8 @@ pub enum ErrorAxis {
     OneMinusSsim,
     /// Mean FLIP of the shaded images.
     Flip,
+    /// GPU time per frame (or CPU wall time without timestamps), for the paper's timing figures.
+    Time,
 }
 
 impl ErrorAxis {
@@ -132,6 +216,7 @@ impl ErrorAxis {
             Self::Rmse => row.metrics.rmse,
             Self::OneMinusSsim => 1.0 - row.metrics.ssim,
             Self::Flip => row.flip,
+            Self::Time => time_of(row),
         }
     }
 
@@ -143,6 +228,7 @@ impl ErrorAxis {
             Self::Rmse => "RMSE",
             Self::OneMinusSsim => "1 - SSIM",
             Self::Flip => "mean FLIP (shaded)",
+            Self::Time => "time per frame, ms",
         }
     }
 }
@@ -173,97 +259,146 @@ pub fn point_label(varied: &[(String, String)]) -> String {
     varied.iter().map(|(_, v)| v.as_str()).collect::<Vec<_>>().join("/")
 }
 
-/// Draws time (log) against error (log), one series per technique, the Pareto
-/// front as a dashed line, into `png` and `svg`.
+/// One point of a plot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlotPoint {
+    /// The series it belongs to (its technique and the varied values not on the x axis).
+    pub series: String,
+    /// Position.
+    pub x: f64,
+    /// Position.
+    pub y: f64,
+    /// A short label drawn beside it.
+    pub label: String,
+}
+
+/// What the plot's axes show.
+#[derive(Clone, Debug)]
+pub struct PlotAxes {
+    /// x axis caption.
+    pub x_label: String,
+    /// y axis caption.
+    pub y_label: String,
+    /// Logarithmic x.
+    pub log_x: bool,
+    /// Mark the Pareto front of (x, y), both to be minimised (time against error).
+    pub pareto: bool,
+}
+
+/// Draws the points, one line per series, y logarithmic, the Pareto front as a
+/// dashed line when asked, into `png` and `svg`.
 ///
 /// # Errors
-/// Drawing or file errors.
-pub fn plot(rows: &[Row], labels: &[String], axis: ErrorAxis, title: &str, png: &std::path::Path, svg: &std::path::Path) -> Result<()> {
+/// Drawing or file errors, or no finite point.
+pub fn plot(points: &[PlotPoint], axes: &PlotAxes, title: &str, png: &std::path::Path, svg: &std::path::Path) -> Result<()> {
     // The font for PNG text; SVG text is drawn by whatever opens the file.
     static FONT: std::sync::Once = std::sync::Once::new();
     FONT.call_once(|| {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
     });
-    draw(&BitMapBackend::new(png, (1000, 700)).into_drawing_area(), rows, labels, axis, title)
+    draw(&BitMapBackend::new(png, (1000, 700)).into_drawing_area(), points, axes, title)
         .with_context(|| format!("drawing {}", png.display()))?;
-    draw(&SVGBackend::new(svg, (1000, 700)).into_drawing_area(), rows, labels, axis, title)
+    draw(&SVGBackend::new(svg, (1000, 700)).into_drawing_area(), points, axes, title)
         .with_context(|| format!("drawing {}", svg.display()))?;
     Ok(())
 }
 
+fn chart_error(e: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{e}")
+}
+
 fn draw<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
-    rows: &[Row],
-    labels: &[String],
-    axis: ErrorAxis,
+    points: &[PlotPoint],
+    axes: &PlotAxes,
     title: &str,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let points: Vec<(f64, f64)> = rows.iter().map(|r| (time_of(r), axis.of(r).max(1e-6))).collect();
-    let finite: Vec<&(f64, f64)> = points.iter().filter(|(t, e)| t.is_finite() && e.is_finite() && *t > 0.0).collect();
-    if finite.is_empty() {
-        bail!("no finite (time, error) point to plot");
+    let usable: Vec<&PlotPoint> =
+        points.iter().filter(|p| p.x.is_finite() && p.y.is_finite() && p.y > 0.0 && (!axes.log_x || p.x > 0.0)).collect();
+    if usable.is_empty() {
+        bail!("no finite point to plot");
     }
-    let (t_min, t_max) = finite.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), (t, _)| (lo.min(*t), hi.max(*t)));
-    let (e_min, e_max) = finite.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), (_, e)| (lo.min(*e), hi.max(*e)));
-    area.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 24))
-        .margin(20)
-        .x_label_area_size(50)
-        .y_label_area_size(70)
-        .build_cartesian_2d((t_min / 1.5..t_max * 1.5).log_scale(), (e_min / 1.5..e_max * 1.5).log_scale())
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (x_min, x_max) = usable.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
+    let (y_min, y_max) = usable.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    area.fill(&WHITE).map_err(chart_error)?;
+    let mut builder = ChartBuilder::on(area);
+    builder.caption(title, ("sans-serif", 24)).margin(20).x_label_area_size(50).y_label_area_size(70);
+    let y_range = (y_min / 1.5..y_max * 1.5).log_scale();
+    if axes.log_x {
+        let chart = builder.build_cartesian_2d((x_min / 1.5..x_max * 1.5).log_scale(), y_range).map_err(chart_error)?;
+        draw_series(chart, &usable, axes)
+    } else {
+        let pad = ((x_max - x_min) * 0.08).max(1e-6);
+        let chart = builder.build_cartesian_2d(x_min - pad..x_max + pad, y_range).map_err(chart_error)?;
+        draw_series(chart, &usable, axes)
+    }
+}
+
+fn draw_series<'a, DB, X>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<X, plotters::coord::combinators::LogCoord<f64>>>,
+    points: &[&PlotPoint],
+    axes: &PlotAxes,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+{
     chart
         .configure_mesh()
-        .x_desc(format!("{} per frame, ms (log)", if rows.iter().all(|r| r.gpu_ms_median.is_some()) { "GPU time" } else { "time" }))
-        .y_desc(format!("{} (log)", axis.label()))
+        .x_desc(axes.x_label.as_str())
+        .y_desc(axes.y_label.as_str())
         .label_style(("sans-serif", 15))
         .x_label_formatter(&|v| format!("{v:.3}"))
         .y_label_formatter(&|v| format!("{v:.3}"))
         .draw()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut techniques: Vec<&str> = Vec::new();
-    for row in rows {
-        if !techniques.contains(&row.technique.as_str()) {
-            techniques.push(&row.technique);
+        .map_err(chart_error)?;
+    let mut series_names: Vec<&str> = Vec::new();
+    for p in points {
+        if !series_names.contains(&p.series.as_str()) {
+            series_names.push(&p.series);
         }
     }
-    for (index, technique) in techniques.iter().enumerate() {
+    for (index, name) in series_names.iter().enumerate() {
         let colour = Palette99::pick(index).mix(0.9);
-        let series: Vec<(usize, (f64, f64))> =
-            rows.iter().enumerate().filter(|(_, r)| r.technique == *technique).map(|(i, _)| (i, points[i])).collect();
+        let mut series: Vec<&PlotPoint> = points.iter().copied().filter(|p| p.series == *name).collect();
+        if !axes.pareto {
+            series.sort_by(|a, b| a.x.total_cmp(&b.x));
+        }
         chart
-            .draw_series(LineSeries::new(series.iter().map(|(_, p)| *p), colour.stroke_width(2)))
-            .map_err(|e| anyhow::anyhow!("{e}"))?
-            .label(technique.to_string())
+            .draw_series(LineSeries::new(series.iter().map(|p| (p.x, p.y)), colour.stroke_width(2)))
+            .map_err(chart_error)?
+            .label(name.to_string())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(3)));
-        chart.draw_series(series.iter().map(|(_, p)| Circle::new(*p, 5, colour.filled()))).map_err(|e| anyhow::anyhow!("{e}"))?;
+        chart.draw_series(series.iter().map(|p| Circle::new((p.x, p.y), 5, colour.filled()))).map_err(chart_error)?;
         chart
             .draw_series(
-                series.iter().map(|(i, p)| {
-                    EmptyElement::at(*p) + Text::new(labels[*i].clone(), (8, -16), ("sans-serif", 13).into_font().color(&BLACK))
+                series.iter().map(|p| {
+                    EmptyElement::at((p.x, p.y)) + Text::new(p.label.clone(), (8, -16), ("sans-serif", 13).into_font().color(&BLACK))
                 }),
             )
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(chart_error)?;
     }
-    let front = pareto_front(&points);
-    chart
-        .draw_series(DashedLineSeries::new(front.iter().map(|&i| points[i]), 6, 4, BLACK.stroke_width(1)))
-        .map_err(|e| anyhow::anyhow!("{e}"))?
-        .label("Pareto front")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
-    chart.draw_series(front.iter().map(|&i| Circle::new(points[i], 9, BLACK.stroke_width(2)))).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if axes.pareto {
+        let coordinates: Vec<(f64, f64)> = points.iter().map(|p| (p.x, p.y)).collect();
+        let front = pareto_front(&coordinates);
+        chart
+            .draw_series(DashedLineSeries::new(front.iter().map(|&i| coordinates[i]), 6, 4, BLACK.stroke_width(1)))
+            .map_err(chart_error)?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
+        chart.draw_series(front.iter().map(|&i| Circle::new(coordinates[i], 9, BLACK.stroke_width(2)))).map_err(chart_error)?;
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 15))
         .draw()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    area.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+        .map_err(chart_error)?;
     Ok(())
 }
 
@@ -289,11 +424,25 @@ mod tests {
         assert!(Vary::parse("pcss=1").is_err());
         assert!(Vary::parse("pcss.a=").is_err());
         for p in PRESETS {
-            for v in p.varies {
-                Vary::parse(v).unwrap();
-            }
+            let varies: Vec<Vary> = p.varies.iter().map(|v| Vary::parse(v).unwrap()).collect();
+            let on_an_axis =
+                p.x_axis == "time" || varies.iter().any(|v| v.params.iter().any(|n| format!("{}.{n}", v.technique) == p.x_axis));
+            assert!(on_an_axis, "preset {}: x axis {} is not varied", p.name, p.x_axis);
         }
         assert!(preset("nope").unwrap_err().to_string().contains("trade"));
+    }
+
+    #[test]
+    fn scene_overrides_scale_lights_and_lift_occluders() {
+        let scene = ssm_scene::builtin("parallel-square").unwrap().build();
+        let point = vec![("light_scale".to_owned(), "0.5".to_owned()), ("occluder_lift".to_owned(), "1".to_owned())];
+        let changed = SceneOverrides::from_point(&point).unwrap().apply(&scene).unwrap();
+        assert_eq!(changed.lights[0].half_size, scene.lights[0].half_size * 0.5);
+        let occluder = changed.bounds_where(|r| r == ssm_scene::Role::Occluder);
+        assert!((occluder.min.y - 3.0).abs() < 1e-5, "lifted towards the light: {}", occluder.min.y);
+        assert_eq!(changed.bounds_where(|r| r == ssm_scene::Role::Receiver), scene.bounds_where(|r| r == ssm_scene::Role::Receiver));
+        assert!(SceneOverrides::from_point(&[("size".into(), "1".into())]).is_err());
+        assert!(SceneOverrides::from_point(&[("light_scale".into(), "-1".into())]).is_err());
     }
 
     #[test]

@@ -190,3 +190,61 @@ fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }
+
+#[test]
+fn sweep_varies_the_scene_and_plots_against_a_parameter() {
+    let out = scratch("sweep-scene");
+    let cache = scratch("sweep-scene-cache");
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .env("SSM_CACHE_DIR", &cache)
+        .args([
+            "sweep",
+            "--scene",
+            "parallel-square",
+            "--vary",
+            "scene.light_scale=0.5,2",
+            "--vary",
+            "pcss.pcf_kernel=9",
+            "--x",
+            "scene.light_scale",
+            "--pixels",
+            "receivers",
+            "--set",
+            "reference.samples=6",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--frames",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(split_csv).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert_eq!(rows[0][0], "parallel-square[light_scale=0.5]");
+    assert_eq!(rows[1][0], "parallel-square[light_scale=2]");
+    // A larger light, a wider penumbra: more penumbra pixels (column 17).
+    let penumbra: Vec<u64> = rows.iter().map(|r| r[17].parse().unwrap()).collect();
+    assert!(penumbra[1] > penumbra[0], "{penumbra:?}");
+    let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
+    assert!(svg.contains("scene.light_scale") && !svg.contains("Pareto front"), "parameter axis, no Pareto front");
+    let bad = ssm(&[
+        "sweep",
+        "--scene",
+        "parallel-square",
+        "--vary",
+        "scene.colour=1",
+        "--vary",
+        "hard.slope_bias=0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown scene parameter"));
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&cache);
+}

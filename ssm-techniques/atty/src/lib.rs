@@ -57,8 +57,8 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "self_shadow_tolerance",
-        kind: ParamKind::Float { default: 2.0, min: 0.0, max: 16.0 },
-        doc: "a micro-patch less than this many of its widths in front of a receiver hides nothing (objects with role `both` would otherwise shadow themselves)",
+        kind: ParamKind::Float { default: 0.0, min: 0.0, max: 16.0 },
+        doc: "a micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper)",
     },
 ];
 
