@@ -335,3 +335,20 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 };
 
 register_technique!(INFO);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f32_accumulation_declares_float32_blendable_and_f16_does_not() {
+        let mut params = INFO.default_params();
+        params.set("accumulation", "f32").unwrap();
+        let f32_needs = requirements(&params).unwrap();
+        assert!(f32_needs.features.contains(wgpu::Features::FLOAT32_BLENDABLE) && f32_needs.roles && f32_needs.gbuffer);
+        params.set("accumulation", "f16").unwrap();
+        assert!(requirements(&params).unwrap().features.is_empty(), "f16 blends on any device");
+        params.set("occluder_map_size", "2048").unwrap();
+        assert_eq!(requirements(&params).unwrap().max_texture_size, 2048);
+    }
+}
