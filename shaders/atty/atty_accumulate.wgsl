@@ -8,23 +8,7 @@
 
 // #import common/light_frame.wgsl
 // #import common/shadow_map.wgsl
-
-struct AttySettings {
-    // Side of the occluder map (N) and of the soft shadow map (and receiver map), texels.
-    occluder_map_size: f32,
-    soft_shadow_map_size: f32,
-    // Normal offset of the projection's lookup point, in receiver-map texels.
-    normal_offset: f32,
-    // Hidden-receiver test tolerance, in receiver-map texels.
-    receiver_tolerance: f32,
-    // A micro-patch less than this many of its own widths in front of a receiver counts as the
-    // receiver's own surface and hides nothing (objects with the role `both` are in both maps).
-    self_shadow_tolerance: f32,
-    // Constant depth tolerance of the hidden-receiver test, world units (as the baselines' constant bias).
-    receiver_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
-};
+// #import atty/atty_settings.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var occluder_map: texture_2d<f32>;

@@ -5,18 +5,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
-
-struct AttySettings {
-    occluder_map_size: f32,
-    soft_shadow_map_size: f32,
-    normal_offset: f32,
-    receiver_tolerance: f32,
-    self_shadow_tolerance: f32,
-    // Constant depth tolerance of the hidden-receiver test, world units (as the baselines' constant bias).
-    receiver_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
-};
+// #import atty/atty_settings.wgsl
 
 @group(2) @binding(0) var soft_shadow_front: texture_2d<f32>;
 @group(2) @binding(1) var soft_shadow_back: texture_2d<f32>;

@@ -295,30 +295,36 @@ pub fn csv(rows: &[Row]) -> String {
     out
 }
 
+/// The columns of the report tables (Markdown and HTML).
+const TABLE_HEADER: [&str; 11] =
+    ["technique", "params", "GPU ms (median)", "GPU ms (min)", "MAE penumbra", "RMSE", "max", "PSNR dB", "SSIM", "> 0.05", "FLIP"];
+
+/// One row of the report tables, as text (the technique name without markup).
+fn table_cells(r: &Row) -> [String; 11] {
+    let m = &r.metrics;
+    [
+        r.technique.clone(),
+        r.params.replace(';', "; "),
+        number(r.gpu_ms_median, 3),
+        number(r.gpu_ms_min, 3),
+        format!("{:.4}", m.mae_penumbra),
+        format!("{:.4}", m.rmse),
+        format!("{:.3}", m.max_abs),
+        number(Some(m.psnr), 2),
+        format!("{:.4}", m.ssim),
+        format!("{:.2}%", m.frac_over_0_05 * 100.0),
+        format!("{:.4}", r.flip),
+    ]
+}
+
 /// The Markdown table of `rows`.
 #[must_use]
 pub fn markdown_table(rows: &[Row]) -> String {
-    let mut out = String::from(
-        "| technique | params | GPU ms (median) | GPU ms (min) | MAE penumbra | RMSE | max | PSNR dB | SSIM | > 0.05 | FLIP |\n",
-    );
-    out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    let mut out = format!("| {} |\n|---|---|{}\n", TABLE_HEADER.join(" | "), "---:|".repeat(TABLE_HEADER.len() - 2));
     for r in rows {
-        let m = &r.metrics;
-        let _ = writeln!(
-            out,
-            "| `{}` | {} | {} | {} | {:.4} | {:.4} | {:.3} | {} | {:.4} | {:.2}% | {:.4} |",
-            r.technique,
-            r.params.replace(';', "; "),
-            number(r.gpu_ms_median, 3),
-            number(r.gpu_ms_min, 3),
-            m.mae_penumbra,
-            m.rmse,
-            m.max_abs,
-            number(Some(m.psnr), 2),
-            m.ssim,
-            m.frac_over_0_05 * 100.0,
-            r.flip
-        );
+        let mut cells = table_cells(r);
+        cells[0] = format!("`{}`", cells[0]);
+        let _ = writeln!(out, "| {} |", cells.join(" | "));
     }
     out
 }
@@ -380,24 +386,18 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
         escape(context.reference_params),
         escape(context.reference_cost)
     );
-    out += "<table>\n<tr><th>technique</th><th>params</th><th>GPU ms (median)</th><th>GPU ms (min)</th><th>MAE penumbra</th><th>RMSE</th><th>max</th><th>PSNR dB</th><th>SSIM</th><th>&gt; 0.05</th><th>FLIP</th></tr>\n";
+    out += "<table>\n<tr>";
+    for header in TABLE_HEADER {
+        let _ = write!(out, "<th>{}</th>", escape(header));
+    }
+    out += "</tr>\n";
     for r in rows {
-        let m = &r.metrics;
-        let _ = writeln!(
-            out,
-            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.3}</td><td>{}</td><td>{:.4}</td><td>{:.2}%</td><td>{:.4}</td></tr>",
-            escape(&r.technique),
-            escape(&r.params.replace(';', "; ")),
-            number(r.gpu_ms_median, 3),
-            number(r.gpu_ms_min, 3),
-            m.mae_penumbra,
-            m.rmse,
-            m.max_abs,
-            number(Some(m.psnr), 2),
-            m.ssim,
-            m.frac_over_0_05 * 100.0,
-            r.flip
-        );
+        let cells = table_cells(r);
+        let _ = write!(out, "<tr><td><code>{}</code></td>", escape(&cells[0]));
+        for cell in &cells[1..] {
+            let _ = write!(out, "<td>{}</td>", escape(cell));
+        }
+        out += "</tr>\n";
     }
     out += "</table>\n";
     for (name, why) in context.skipped {

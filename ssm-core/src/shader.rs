@@ -80,7 +80,17 @@ pub fn compose(label: &str, source: &str) -> Result<String> {
 /// # Errors
 /// [`Error::Shader`] for a bad import, [`Error::Gpu`] when wgpu rejects the WGSL.
 pub fn create_shader(gpu: &GpuContext, label: &str, source: &str) -> Result<wgpu::ShaderModule> {
-    let code = compose(label, source)?;
+    create_shader_with_imports(gpu, label, source, &[])
+}
+
+/// As [`create_shader`], with a technique's own importable files besides
+/// [`COMMON_SHADERS`], as `(path under shaders/, text)`: `("atty/settings.wgsl", include_str!(...))`.
+///
+/// # Errors
+/// [`Error::Shader`] for a bad import, [`Error::Gpu`] when wgpu rejects the WGSL.
+pub fn create_shader_with_imports(gpu: &GpuContext, label: &str, source: &str, local: &[(&str, &str)]) -> Result<wgpu::ShaderModule> {
+    let lookup = |path: &str| COMMON_SHADERS.iter().chain(local).find(|(p, _)| *p == path).map(|(_, text)| (*text).to_owned());
+    let code = compose_with(source, &lookup).map_err(|problem| Error::Shader { shader: label.into(), problem })?;
     let module =
         gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(code.into()) });
     let messages = gpu.take_errors();

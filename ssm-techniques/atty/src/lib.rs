@@ -18,7 +18,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{color_attachment, labelled_view, render_texture, texture_entry, uniform_entry};
-use ssm_core::shader::create_shader;
+use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
     Error, Frame, Geometry, LightDepthMap, LightDepthMapDesc, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
     ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
@@ -62,7 +62,10 @@ pub const PARAMS: &[ParamSpec] = &[
     },
 ];
 
-/// The settings uniform both Atty shaders read.
+/// WGSL files the Atty shaders import besides `common/`.
+const LOCAL_SHADERS: &[(&str, &str)] = &[("atty/atty_settings.wgsl", include_str!("../../../shaders/atty/atty_settings.wgsl"))];
+
+/// The settings uniform both Atty shaders read (`shaders/atty/atty_settings.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct AttySettingsUniform {
@@ -203,8 +206,12 @@ impl SoftShadowMaps {
             accumulations.push(Accumulation { occluder_map, soft_shadow_map, bind_group, label: pass_label });
         }
 
-        let accumulate_module =
-            create_shader(setup.gpu, "atty_accumulate_shader", include_str!("../../../shaders/atty/atty_accumulate.wgsl"))?;
+        let accumulate_module = create_shader_with_imports(
+            setup.gpu,
+            "atty_accumulate_shader",
+            include_str!("../../../shaders/atty/atty_accumulate.wgsl"),
+            LOCAL_SHADERS,
+        )?;
         let accumulate_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("atty_accumulate_pipeline_layout"),
             bind_group_layouts: &[Some(&setup.scene.uniform_layout), Some(&accumulate_layout)],
@@ -259,7 +266,12 @@ impl SoftShadowMaps {
                 wgpu::BindGroupEntry { binding: 3, resource: settings_buffer.as_entire_binding() },
             ],
         });
-        let project_module = create_shader(setup.gpu, "atty_project_shader", include_str!("../../../shaders/atty/atty_project.wgsl"))?;
+        let project_module = create_shader_with_imports(
+            setup.gpu,
+            "atty_project_shader",
+            include_str!("../../../shaders/atty/atty_project.wgsl"),
+            LOCAL_SHADERS,
+        )?;
         let project = ScreenPass::new(
             setup,
             NAME,
