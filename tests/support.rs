@@ -13,6 +13,7 @@ pub fn link_techniques() {
     ssm_hard::link();
     ssm_multi_sm::link();
     ssm_pcss::link();
+    ssm_sssm::link();
     ssm_plugin_technique::link();
 }
 

@@ -29,3 +29,9 @@ fn normal_offset_position(frame: LightFrame, map: texture_2d<f32>, position: vec
     let towards_light = select(-normal, normal, dot(normal, frame.centre.xyz - position) >= 0.0);
     return position + towards_light * texels * shadow_texel_size(frame, map, light_depth(frame, position));
 }
+
+// Offset of sample `i` of `count` across [-1, 1], at the centres of equal cells (the regular
+// kernels of PCSS and SSSM).
+fn grid_offset(i: u32, count: u32) -> f32 {
+    return (f32(i) + 0.5) / f32(count) * 2.0 - 1.0;
+}

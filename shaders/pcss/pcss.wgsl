@@ -42,11 +42,6 @@ fn tap_receiver_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, rec
     return receiver_plane_depth(frame, position, normal, uv, receiver_depth);
 }
 
-// Offset of sample `i` of `count` across [-1, 1], at the centres of equal cells.
-fn grid_offset(i: u32, count: u32) -> f32 {
-    return (f32(i) + 0.5) / f32(count) * 2.0 - 1.0;
-}
-
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);

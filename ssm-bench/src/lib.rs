@@ -13,8 +13,8 @@ use ssm_core::{GpuContext, ParamValues, Registry, Renderer, Requirements, Techni
 /// Keeps every technique crate linked into the binary, so that their
 /// registrations reach the registry. A new technique crate adds one line here
 /// and one dependency in this crate's manifest.
-pub fn link_techniques() -> [&'static str; 5] {
-    [ssm_core::reference::link(), ssm_atty::link(), ssm_hard::link(), ssm_multi_sm::link(), ssm_pcss::link()]
+pub fn link_techniques() -> [&'static str; 6] {
+    [ssm_core::reference::link(), ssm_atty::link(), ssm_hard::link(), ssm_multi_sm::link(), ssm_pcss::link(), ssm_sssm::link()]
 }
 
 /// The registry, with every technique crate linked.

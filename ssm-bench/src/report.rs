@@ -25,6 +25,8 @@ pub struct Measured {
     pub visibility: Vec<Vec<f32>>,
     /// The shaded image, RGBA8 sRGB.
     pub shaded: Vec<u8>,
+    /// The technique's extra images.
+    pub extra_images: Vec<ssm_core::ExtraImage>,
 }
 
 impl Measured {
@@ -84,7 +86,9 @@ pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &P
     let visibility =
         (0..renderer.scene.light_count()).map(|light| renderer.read_visibility(light, info.name)).collect::<Result<Vec<_>>>()?;
     let shaded = renderer.shade()?;
-    Ok(Measured { info, params: params.clone(), frames: timings, diagnostics: technique.diagnostics(), visibility, shaded })
+    let diagnostics = technique.diagnostics(&renderer.gpu);
+    let extra_images = technique.extra_images(&renderer.gpu)?;
+    Ok(Measured { info, params: params.clone(), frames: timings, diagnostics, visibility, shaded, extra_images })
 }
 
 /// Writes a measured technique's images under `dir`: `visibility.exr`/`.png`
@@ -101,6 +105,10 @@ pub fn write_images(dir: &Path, measured: &Measured, width: u32, height: u32, re
         write_png_gray16(&dir.join(format!("{stem}.png")), width, height, visibility)?;
     }
     write_png_rgba8(&dir.join("shaded.png"), width, height, &measured.shaded)?;
+    for extra in &measured.extra_images {
+        write_exr_gray(&dir.join(format!("{}.exr", extra.name)), extra.width, extra.height, &extra.values)?;
+        write_png_gray16(&dir.join(format!("{}.png", extra.name)), extra.width, extra.height, &extra.values)?;
+    }
     if let Some((reference, covered)) = reference {
         let rgb = heat_map(&reference.visibility[0], &measured.visibility[0], covered, 0.5);
         let image = image::RgbImage::from_raw(width, height, rgb)

@@ -45,7 +45,7 @@ pub use params::{ParamError, ParamKind, ParamSpec, ParamValue, ParamValues};
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
-pub use technique::{Requirements, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup};
+pub use technique::{ExtraImage, Requirements, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup};
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 
 /// Re-exported so that technique crates can register without depending on it.

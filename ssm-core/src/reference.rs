@@ -425,7 +425,7 @@ impl crate::ShadowTechnique for ReferenceTechnique {
     }
 
     /// Totals over the lights traced so far: rays, trace time, rays per second, and how many came from the cache.
-    fn diagnostics(&self) -> Vec<(String, f64)> {
+    fn diagnostics(&mut self, _gpu: &crate::GpuContext) -> Vec<(String, f64)> {
         let images: Vec<&ReferenceImage> = self.traced_per_light.iter().flatten().collect();
         if images.is_empty() {
             return Vec::new();

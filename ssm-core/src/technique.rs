@@ -117,10 +117,34 @@ pub trait ShadowTechnique {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()>;
 
     /// Scalar diagnostics of the last frame, reported beside the error metrics
-    /// (SSSM's reuse share, PVSM's tile count...). Empty by default.
-    fn diagnostics(&self) -> Vec<(String, f64)> {
+    /// (SSSM's reuse share, PVSM's tile count...). Empty by default. May read
+    /// the GPU: it is called after the frame has finished.
+    fn diagnostics(&mut self, _gpu: &GpuContext) -> Vec<(String, f64)> {
         Vec::new()
     }
+
+    /// Extra per-pixel images of the last frame (SSSM's reuse share, say),
+    /// written beside the visibility by `ssm render` and `ssm compare`. Empty
+    /// by default.
+    ///
+    /// # Errors
+    /// A readback error.
+    fn extra_images(&mut self, _gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
+        Ok(Vec::new())
+    }
+}
+
+/// A named single-channel image a technique outputs besides its visibility.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtraImage {
+    /// File stem: `<name>.exr` and `<name>.png` are written.
+    pub name: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Values, row-major from the top-left; the PNG maps [0, 1] to black–white.
+    pub values: Vec<f32>,
 }
 
 /// What a registered technique is for the tools that compare them.

@@ -1,0 +1,82 @@
+// SSSM step 2 (Table 1): the blocker average over the n×n window, each of its n rows reused
+// from the pixel whose shadow-map position lies on that row when |d - d_t| < α (Sec. 4.1),
+// else read from the depth map; the penumbra size by Eq. 1; then the horizontal screen-space
+// blur of the hard shadow over m taps (Sec. 4.2).
+
+// #import sssm/sssm_common.wgsl
+
+@group(2) @binding(3) var horizontal_blocker: texture_2d<f32>;
+
+// (horizontally blurred visibility, blur half-width in pixels, blocker rows reused, 1 where computed).
+@fragment
+fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
+    let point = screen_point(in);
+    let own = textureLoad(horizontal_blocker, point.texel, 0);
+    let d = own.x;
+    if (d < 0.0) {
+        return vec4<f32>(own.w, 0.0, 0.0, 0.0);
+    }
+    let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
+    let search = light_half_extent_uv(frame, frame.projection.z, d);
+    let n = max(settings.blocker_kernel, 1u);
+    var sum = 0.0;
+    var count = 0.0;
+    var reused = 0.0;
+    for (var t = 0u; t < n; t++) {
+        let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(t, n) * search.y);
+        // The pixel that sees the point of this row at the same light depth d (Fig. 4).
+        let screen = screen_position(light_point(row_uv, d));
+        var reuse = false;
+        if (screen.z > 0.0 && on_screen(screen.xy)) {
+            let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
+            if (other.x >= 0.0 && abs(d - other.x) < settings.alpha) {
+                sum += other.y;
+                count += other.z;
+                reused += 1.0;
+                reuse = true;
+            }
+        }
+        if (!reuse) {
+            for (var i = 0u; i < n; i++) {
+                let depth = shadow_map_depth(shadow_map, row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0));
+                if (depth < d) {
+                    sum += depth;
+                    count += 1.0;
+                }
+            }
+        }
+    }
+    // No blocker: fully lit (Sec. 4.2).
+    if (count == 0.0) {
+        return vec4<f32>(1.0, 0.0, reused, 1.0);
+    }
+    let blocker = sum / count;
+    // Eq. 1: w_penumbra = w_light (z_receiver - z_avg) / z_avg, here as a half-width in world units,
+    // then in pixels at the point's distance from the eye.
+    let half_width = settings.light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6);
+    let radius = half_width / max(view_depth(point.position) * settings.pixel_scale, 1e-9);
+    // A penumbra under half a pixel keeps the hard value.
+    if (radius < 0.5) {
+        return vec4<f32>(own.w, 0.0, reused, 1.0);
+    }
+    let m = max(settings.blur_kernel, 1u);
+    var blurred = 0.0;
+    var total = 0.0;
+    let centre = in.clip.xy;
+    for (var j = 0u; j < m; j++) {
+        let tap = centre + vec2<f32>(grid_offset(j, m) * radius, 0.0);
+        var value: f32;
+        if (on_screen(tap)) {
+            value = textureLoad(horizontal_blocker, vec2<i32>(tap), 0).w;
+        } else {
+            // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.
+            let plane = tangent_plane_point(point.position, point.normal, tap);
+            value = select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
+        }
+        let weight = tap_weight(j, m);
+        blurred += weight * value;
+        total += weight;
+    }
+    return vec4<f32>(blurred / total, radius, reused, 1.0);
+}

@@ -1,0 +1,91 @@
+// Shared by the three passes of Buades et al. 2015, Separable Soft Shadow Mapping.
+
+// #import common/screen_pass.wgsl
+// #import common/shadow_map.wgsl
+// #import common/camera.wgsl
+
+struct SssmSettings {
+    // Samples per axis of the blocker search (n) and of the blur (m).
+    blocker_kernel: u32,
+    blur_kernel: u32,
+    // 1: Gaussian weights; 0: mean (Sec. 4.4).
+    gaussian: u32,
+    _pad0: u32,
+    // Reuse thresholds, world units: light-depth difference (α) and normal-adjusted camera-depth difference (β).
+    alpha: f32,
+    beta: f32,
+    // Standard deviation of the Gaussian, in units of the kernel's half-width.
+    sigma: f32,
+    // Normal offset of shadow-map lookups, texels.
+    normal_offset: f32,
+    // World size of one pixel per unit of distance from the eye: 2 tan(fov_y / 2) / height.
+    pixel_scale: f32,
+    // Light half-size used by Eq. 1 (the mean of the rectangle's two half-sides: the blur is isotropic).
+    light_half_size: f32,
+    _pad1: f32,
+    _pad2: f32,
+};
+
+@group(2) @binding(0) var<uniform> camera: Camera;
+@group(2) @binding(1) var<uniform> settings: SssmSettings;
+@group(2) @binding(2) var shadow_map: texture_2d<f32>;
+
+// The world point at shadow-map coordinates `uv` and linear light depth `depth` (inverse of light_uv_depth).
+fn light_point(uv: vec2<f32>, depth: f32) -> vec3<f32> {
+    let xy = (uv * 2.0 - 1.0) * depth * frame.projection.xy;
+    return frame.centre.xyz + xy.x * frame.u_axis.xyz + xy.y * frame.v_axis.xyz + depth * frame.normal.xyz;
+}
+
+// Pixel coordinates (x right, y down, pixel centres at .5) where the camera sees `world`; w < 0 when behind the eye.
+fn screen_position(world: vec3<f32>) -> vec3<f32> {
+    let clip = camera.view_proj * vec4<f32>(world, 1.0);
+    let ndc = clip.xy / clip.w;
+    return vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
+}
+
+// Where the camera ray through pixel position `pixel` meets the plane through `point` with
+// normal `normal`; w = 0 when the ray runs along the plane or meets it behind the eye.
+fn tangent_plane_point(point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> vec4<f32> {
+    let ndc = vec2<f32>(pixel.x / camera.viewport.x * 2.0 - 1.0, 1.0 - pixel.y / camera.viewport.y * 2.0);
+    let far = camera.inverse_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let eye = camera.position.xyz;
+    let direction = normalize(far.xyz / far.w - eye);
+    let denominator = dot(direction, normal);
+    if (abs(denominator) < 1e-6) {
+        return vec4<f32>(point, 0.0);
+    }
+    let t = dot(point - eye, normal) / denominator;
+    return vec4<f32>(eye + direction * t, select(0.0, 1.0, t > 0.0));
+}
+
+// Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
+fn hard_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
+    if (!in_front_of_light(frame, world)) {
+        return 0.0;
+    }
+    let lookup = normal_offset_position(frame, shadow_map, world, normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
+    return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+}
+
+// Weight of tap `i` of `count` (Sec. 4.4: Gaussian, or 1 for the mean filter).
+fn tap_weight(i: u32, count: u32) -> f32 {
+    if (settings.gaussian == 0u) {
+        return 1.0;
+    }
+    let x = grid_offset(i, count) / max(settings.sigma, 1e-3);
+    return exp(-0.5 * x * x);
+}
+
+// Whether a pixel position lies on the screen.
+fn on_screen(pixel: vec2<f32>) -> bool {
+    return all(pixel >= vec2<f32>(0.0)) && all(pixel < camera.viewport.xy);
+}
+
+// Depth of `world` along the camera's view direction: a pixel's footprint on a surface facing
+// the camera is this times `pixel_scale`.
+fn view_depth(world: vec3<f32>) -> f32 {
+    let far = camera.inverse_view_proj * vec4<f32>(0.0, 0.0, 1.0, 1.0);
+    let forward = normalize(far.xyz / far.w - camera.position.xyz);
+    return dot(world - camera.position.xyz, forward);
+}

@@ -1,0 +1,31 @@
+// SSSM step 1 (Table 1): per pixel, the hard shadow, its light depth d, and the horizontal
+// partial blocker sum and count over the n×1 row of the depth map through its shadow-map
+// position (Sec. 4.1): partial_blocker_sum(p) = Σ_x dm(x, 0) for dm < d.
+
+// #import sssm/sssm_common.wgsl
+
+// (d, partial sum, partial count, hard visibility); d = -1 where there is nothing to compute.
+@fragment
+fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
+    let point = screen_point(in);
+    let trivial = trivial_visibility(point);
+    if (trivial >= 0.0) {
+        return vec4<f32>(-1.0, 0.0, 0.0, trivial);
+    }
+    let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
+    let hard = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+    // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
+    let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
+    let n = max(settings.blocker_kernel, 1u);
+    var sum = 0.0;
+    var count = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let depth = shadow_map_depth(shadow_map, uvd.xy + vec2<f32>(grid_offset(i, n) * search.x, 0.0));
+        if (depth < uvd.z) {
+            sum += depth;
+            count += 1.0;
+        }
+    }
+    return vec4<f32>(uvd.z, sum, count, hard);
+}

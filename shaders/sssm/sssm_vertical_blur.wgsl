@@ -1,0 +1,68 @@
+// SSSM step 3 (Table 1): the vertical blur over m taps, reusing a tap pixel's horizontal result
+// when its camera depth differs from this pixel's tangent plane by less than β (Sec. 4.2: "the
+// distance is modified taking into account the normal"), else shadow-testing that row's points
+// of this pixel's tangent plane directly (which also covers taps past the screen's edges).
+// Also writes the share of reused rows of both steps (Fig. 10).
+
+// #import sssm/sssm_common.wgsl
+
+@group(2) @binding(3) var horizontal_blocker: texture_2d<f32>;
+@group(2) @binding(4) var horizontal_blur: texture_2d<f32>;
+@group(2) @binding(5) var reuse_share: texture_storage_2d<r32float, write>;
+
+@fragment
+fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
+    let point = screen_point(in);
+    let own = textureLoad(horizontal_blur, point.texel, 0);
+    if (own.w < 0.5) {
+        // Nothing computed here (background, behind the light): -1 keeps it out of the average.
+        textureStore(reuse_share, point.texel, vec4<f32>(-1.0));
+        return own.x;
+    }
+    let n = f32(max(settings.blocker_kernel, 1u));
+    let radius = own.y;
+    if (radius < 0.5) {
+        // No blur: only the blocker rows counted.
+        textureStore(reuse_share, point.texel, vec4<f32>(own.z / n));
+        return own.x;
+    }
+    let m = max(settings.blur_kernel, 1u);
+    let eye = camera.position.xyz;
+    var blurred = 0.0;
+    var total = 0.0;
+    var reused = 0.0;
+    for (var j = 0u; j < m; j++) {
+        let row = in.clip.xy + vec2<f32>(0.0, grid_offset(j, m) * radius);
+        var value = 0.0;
+        var reuse = false;
+        if (on_screen(row)) {
+            let texel = vec2<i32>(row);
+            let other = textureLoad(gbuffer_position, texel, 0);
+            let expected = tangent_plane_point(point.position, point.normal, row);
+            if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < settings.beta) {
+                value = textureLoad(horizontal_blur, texel, 0).x;
+                reuse = true;
+                reused += 1.0;
+            }
+        }
+        if (!reuse) {
+            // The row recomputed on this pixel's tangent plane, with this pixel's kernel.
+            var row_sum = 0.0;
+            var row_total = 0.0;
+            for (var i = 0u; i < m; i++) {
+                let tap = row + vec2<f32>(grid_offset(i, m) * radius, 0.0);
+                let plane = tangent_plane_point(point.position, point.normal, tap);
+                let visible = select(textureLoad(horizontal_blocker, point.texel, 0).w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
+                let weight = tap_weight(i, m);
+                row_sum += weight * visible;
+                row_total += weight;
+            }
+            value = row_sum / row_total;
+        }
+        let weight = tap_weight(j, m);
+        blurred += weight * value;
+        total += weight;
+    }
+    textureStore(reuse_share, point.texel, vec4<f32>((own.z + reused) / (n + f32(m))));
+    return clamp(blurred / total, 0.0, 1.0);
+}
