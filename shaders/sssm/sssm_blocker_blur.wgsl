@@ -23,10 +23,15 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     var sum = 0.0;
     var count = 0.0;
     var reused = 0.0;
+    // The rows' points at depth d lie on a line, and clip space is linear in them: project the two ends once.
+    let first_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y - search.y), d), 1.0);
+    let last_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y + search.y), d), 1.0);
     for (var t = 0u; t < n; t++) {
         let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(t, n) * search.y);
         // The pixel that sees the point of this row at the same light depth d (Fig. 4).
-        let screen = screen_position(light_point(row_uv, d));
+        let clip = mix(first_clip, last_clip, grid_offset(t, n) * 0.5 + 0.5);
+        let ndc = clip.xy / clip.w;
+        let screen = vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
         var reuse = false;
         if (screen.z > 0.0 && on_screen(screen.xy)) {
             let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
@@ -71,7 +76,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
             value = textureLoad(horizontal_blocker, vec2<i32>(tap), 0).w;
         } else {
             // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.
-            let plane = tangent_plane_point(point.position, point.normal, tap);
+            let plane = tangent_plane_point(camera_rays(), point.position, point.normal, tap);
             value = select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
         }
         let weight = tap_weight(j, m);

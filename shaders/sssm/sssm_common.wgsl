@@ -36,24 +36,39 @@ fn light_point(uv: vec2<f32>, depth: f32) -> vec3<f32> {
     return frame.centre.xyz + xy.x * frame.u_axis.xyz + xy.y * frame.v_axis.xyz + depth * frame.normal.xyz;
 }
 
-// Pixel coordinates (x right, y down, pixel centres at .5) where the camera sees `world`; w < 0 when behind the eye.
-fn screen_position(world: vec3<f32>) -> vec3<f32> {
-    let clip = camera.view_proj * vec4<f32>(world, 1.0);
-    let ndc = clip.xy / clip.w;
-    return vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
+
+// Camera rays, unnormalised, as an affine function of the pixel position: for a perspective
+// camera the far-plane points' homogeneous w is the same at every pixel, so the ray through pixel
+// (x, y) is base + x·per_x + y·per_y exactly. Built once per pixel, each tap then costs a few
+// multiply-adds instead of a matrix product and a normalisation.
+struct CameraRays {
+    base: vec3<f32>,
+    per_x: vec3<f32>,
+    per_y: vec3<f32>,
+};
+
+fn far_point(pixel: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>(pixel.x / camera.viewport.x * 2.0 - 1.0, 1.0 - pixel.y / camera.viewport.y * 2.0);
+    let far = camera.inverse_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    return far.xyz / far.w;
+}
+
+fn camera_rays() -> CameraRays {
+    let origin = far_point(vec2<f32>(0.0)) - camera.position.xyz;
+    let at_x = far_point(vec2<f32>(1.0, 0.0)) - camera.position.xyz;
+    let at_y = far_point(vec2<f32>(0.0, 1.0)) - camera.position.xyz;
+    return CameraRays(origin, at_x - origin, at_y - origin);
 }
 
 // Where the camera ray through pixel position `pixel` meets the plane through `point` with
 // normal `normal`; w = 0 when the ray runs along the plane or meets it behind the eye.
-fn tangent_plane_point(point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> vec4<f32> {
-    let ndc = vec2<f32>(pixel.x / camera.viewport.x * 2.0 - 1.0, 1.0 - pixel.y / camera.viewport.y * 2.0);
-    let far = camera.inverse_view_proj * vec4<f32>(ndc, 1.0, 1.0);
-    let eye = camera.position.xyz;
-    let direction = normalize(far.xyz / far.w - eye);
+fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> vec4<f32> {
+    let direction = rays.base + pixel.x * rays.per_x + pixel.y * rays.per_y;
     let denominator = dot(direction, normal);
-    if (abs(denominator) < 1e-6) {
+    if (abs(denominator) < 1e-12) {
         return vec4<f32>(point, 0.0);
     }
+    let eye = camera.position.xyz;
     let t = dot(point - eye, normal) / denominator;
     return vec4<f32>(eye + direction * t, select(0.0, 1.0, t > 0.0));
 }
@@ -65,6 +80,20 @@ fn hard_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
     }
     let lookup = normal_offset_position(frame, shadow_map, world, normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
+    return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+}
+
+// The normal offset of a pixel's lookups, computed once: every tap on its tangent plane shares it.
+fn lookup_offset(point: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    return normal_offset_position(frame, shadow_map, point, normal, settings.normal_offset) - point;
+}
+
+// Hard visibility of a tap on a pixel's tangent plane, with that pixel's lookup offset.
+fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
+    if (!in_front_of_light(frame, world)) {
+        return 0.0;
+    }
+    let uvd = light_uv_depth(frame, world + offset);
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
 }
 
@@ -85,7 +114,7 @@ fn on_screen(pixel: vec2<f32>) -> bool {
 // Depth of `world` along the camera's view direction: a pixel's footprint on a surface facing
 // the camera is this times `pixel_scale`.
 fn view_depth(world: vec3<f32>) -> f32 {
-    let far = camera.inverse_view_proj * vec4<f32>(0.0, 0.0, 1.0, 1.0);
-    let forward = normalize(far.xyz / far.w - camera.position.xyz);
+    let centre = far_point(camera.viewport.xy * 0.5);
+    let forward = normalize(centre - camera.position.xyz);
     return dot(world - camera.position.xyz, forward);
 }

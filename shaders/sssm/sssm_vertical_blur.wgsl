@@ -28,6 +28,9 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
     }
     let m = max(settings.blur_kernel, 1u);
     let eye = camera.position.xyz;
+    let rays = camera_rays();
+    let own_hard = textureLoad(horizontal_blocker, point.texel, 0).w;
+    let offset = lookup_offset(point.position, point.normal);
     var blurred = 0.0;
     var total = 0.0;
     var reused = 0.0;
@@ -38,7 +41,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
         if (on_screen(row)) {
             let texel = vec2<i32>(row);
             let other = textureLoad(gbuffer_position, texel, 0);
-            let expected = tangent_plane_point(point.position, point.normal, row);
+            let expected = tangent_plane_point(rays, point.position, point.normal, row);
             if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < settings.beta) {
                 value = textureLoad(horizontal_blur, texel, 0).x;
                 reuse = true;
@@ -51,8 +54,8 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
             var row_total = 0.0;
             for (var i = 0u; i < m; i++) {
                 let tap = row + vec2<f32>(grid_offset(i, m) * radius, 0.0);
-                let plane = tangent_plane_point(point.position, point.normal, tap);
-                let visible = select(textureLoad(horizontal_blocker, point.texel, 0).w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
+                let plane = tangent_plane_point(rays, point.position, point.normal, tap);
+                let visible = select(own_hard, tap_visibility(plane.xyz, offset), plane.w > 0.0);
                 let weight = tap_weight(i, m);
                 row_sum += weight * visible;
                 row_total += weight;
