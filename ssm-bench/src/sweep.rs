@@ -85,6 +85,16 @@ pub const PRESETS: &[Preset] = &[
         x_axis: "time",
     },
     Preset {
+        name: "sssm-table4",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse (use on leaves, the plant scene's nearest)",
+        varies: &[
+            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+            "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
+        ],
+        x_axis: "time",
+    },
+    Preset {
         name: "atty-map-size",
         summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided",
         varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
