@@ -95,3 +95,21 @@ fn on_a_parallel_receiver_sssm_with_the_mean_filter_equals_pcss() {
     assert!(exact < 0.01, "{exact}");
     assert!(reusing < 0.03, "{reusing}");
 }
+
+#[test]
+fn kernels_wider_than_the_screen_and_zero_penumbrae_stay_in_range() {
+    let gpu = gpu();
+    // A light 20 times the occluder on a 32×24 image: blocker windows and blurs far wider than the screen.
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.lights[0].half_size *= 20.0;
+    let wide =
+        render(&gpu, &scene, "sssm", &[("blocker_kernel", "64"), ("blur_kernel", "128"), ("alpha", "0.05"), ("beta", "0.05")], 32, 24)
+            .unwrap();
+    assert!(wide.visibility.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)));
+    // A point light: zero penumbra everywhere, so the hard value is kept.
+    scene.lights[0].half_size *= 0.0;
+    let hard = render(&gpu, &scene, "sssm", &[], 64, 48).unwrap();
+    let covered = hard.covered_visibility();
+    assert!(covered.iter().all(|v| *v == 0.0 || *v == 1.0), "a zero penumbra keeps the hard shadow");
+    assert!(covered.contains(&0.0) && covered.contains(&1.0));
+}
