@@ -210,6 +210,16 @@ impl ShadowMapSettings {
         },
     ];
 
+    /// The `shadow_map_size` parameter with a technique's own default.
+    #[must_use]
+    pub const fn size_param(default: i64) -> ParamSpec {
+        ParamSpec {
+            name: "shadow_map_size",
+            kind: ParamKind::Int { default, min: 16, max: 16384 },
+            doc: "side of the square shadow map, texels",
+        }
+    }
+
     /// Reads `shadow_map_size` and the [`ShadowMapSettings::BIAS_PARAMS`].
     ///
     /// # Errors

@@ -10,8 +10,8 @@ use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{texture_entry, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind,
-    TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    Frame, LightDepthMap, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup,
+    VISIBILITY_FORMAT, register_technique,
 };
 use wgpu::util::DeviceExt;
 
@@ -20,11 +20,7 @@ pub const NAME: &str = "hard";
 
 /// Parameters of [`HardShadowMapping`].
 pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "shadow_map_size",
-        kind: ParamKind::Int { default: 2048, min: 16, max: 16384 },
-        doc: "side of the square shadow map, texels",
-    },
+    ShadowMapSettings::size_param(2048),
     ShadowMapSettings::BIAS_PARAMS[0],
     ShadowMapSettings::BIAS_PARAMS[1],
     ShadowMapSettings::BIAS_PARAMS[2],

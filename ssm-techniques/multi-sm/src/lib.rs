@@ -27,11 +27,7 @@ pub const PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Int { default: 16, min: 1, max: 1024 },
         doc: "K, the number of shadow maps: a perfect square, one per stratum of a √K×√K grid on the light",
     },
-    ParamSpec {
-        name: "shadow_map_size",
-        kind: ParamKind::Int { default: 1024, min: 16, max: 16384 },
-        doc: "side of each square shadow map, texels",
-    },
+    ShadowMapSettings::size_param(1024),
     ShadowMapSettings::BIAS_PARAMS[0],
     ShadowMapSettings::BIAS_PARAMS[1],
     ShadowMapSettings::BIAS_PARAMS[2],

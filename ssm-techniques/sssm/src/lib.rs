@@ -25,11 +25,7 @@ pub const NAME: &str = "sssm";
 
 /// Parameters of [`SeparableSoftShadowMaps`].
 pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "shadow_map_size",
-        kind: ParamKind::Int { default: 1024, min: 16, max: 16384 },
-        doc: "side of the square shadow map, texels",
-    },
+    ShadowMapSettings::size_param(1024),
     ParamSpec {
         name: "blocker_kernel",
         kind: ParamKind::Int { default: 7, min: 1, max: 64 },
