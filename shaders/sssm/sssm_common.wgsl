@@ -75,12 +75,7 @@ fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pi
 
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
 fn hard_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
-    if (!in_front_of_light(frame, world)) {
-        return 0.0;
-    }
-    let lookup = normal_offset_position(frame, shadow_map, world, normal, settings.normal_offset);
-    let uvd = light_uv_depth(frame, lookup);
-    return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+    return tap_visibility(world, lookup_offset(world, normal));
 }
 
 // The normal offset of a pixel's lookups, computed once: every tap on its tangent plane shares it.

@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ssm_bench::{output_requirements, registry, render_technique, report, support_on, sweep, write_positions};
-use ssm_core::{GpuContext, ParamValues, Renderer, Requirements, TechniqueInfo, TechniqueKind};
+use ssm_core::{GpuContext, ParamValues, Renderer, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
 
 #[derive(Parser)]
@@ -215,7 +215,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         runs.push((info, params));
     }
     let gpu = GpuContext::new()?;
-    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &Requirements { ..needs })?;
+    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
