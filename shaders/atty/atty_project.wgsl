@@ -12,18 +12,32 @@
 @group(2) @binding(2) var receiver_map: texture_2d<f32>;
 @group(2) @binding(3) var<uniform> settings: AttySettings;
 
-// Bilinear interpolation of an unfilterable float texture (R32Float needs a feature to be filtered).
-fn bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+// Bilinear interpolation of an unfilterable float texture (R32Float needs a feature to be
+// filtered) that leaves out the texels whose receiver lies at another depth than the lookup's
+// (by more than `tolerance`): at a receiver depth edge the SSM holds the occlusion of two
+// different surfaces, and blending them would shade one with the other's shadow. When no
+// texel of the four qualifies, the nearest one is used.
+fn receiver_bilinear(map: texture_2d<f32>, uv: vec2<f32>, depth: f32, tolerance: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(map));
     let position = uv * size - 0.5;
     let base = floor(position);
     let t = position - base;
     let limit = vec2<i32>(size) - 1;
-    let p0 = clamp(vec2<i32>(base), vec2<i32>(0), limit);
-    let p1 = clamp(vec2<i32>(base) + 1, vec2<i32>(0), limit);
-    let top = mix(textureLoad(map, p0, 0).x, textureLoad(map, vec2<i32>(p1.x, p0.y), 0).x, t.x);
-    let bottom = mix(textureLoad(map, vec2<i32>(p0.x, p1.y), 0).x, textureLoad(map, p1, 0).x, t.x);
-    return mix(top, bottom, t.y);
+    var sum = 0.0;
+    var total = 0.0;
+    for (var corner = 0; corner < 4; corner++) {
+        let step = vec2<i32>(corner & 1, corner >> 1u);
+        let texel = clamp(vec2<i32>(base) + step, vec2<i32>(0), limit);
+        let weights = select(1.0 - t, t, vec2<bool>(step == vec2<i32>(1)));
+        let same_surface = abs(textureLoad(receiver_map, texel, 0).x - depth) <= tolerance;
+        let weight = select(0.0, weights.x * weights.y, same_surface);
+        sum += weight * textureLoad(map, texel, 0).x;
+        total += weight;
+    }
+    if (total <= 1e-6) {
+        return textureLoad(map, clamp(vec2<i32>(uv * size), vec2<i32>(0), limit), 0).x;
+    }
+    return sum / total;
 }
 
 @fragment
@@ -42,13 +56,16 @@ fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     if (any(uvd.xy < vec2<f32>(0.0)) || any(uvd.xy >= vec2<f32>(1.0))) {
         return 1.0;
     }
+    // Depths within this of the lookup's count as the same receiver: a constant bias plus
+    // `receiver_tolerance` texel footprints of the receiver map at this depth.
+    let tolerance = settings.receiver_bias + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);
     // The SSM holds the occlusion of the receiver nearest the light's centre in each texel. A point
     // behind it (an object with the role `both` between it and the light) has no value of its own:
     // count it as in umbra, as a hard shadow would.
     let nearest = shadow_map_depth(receiver_map, uvd.xy);
-    if (uvd.z > nearest + settings.receiver_bias + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z)) {
+    if (uvd.z > nearest + tolerance) {
         return 0.0;
     }
-    let occlusion = max(bilinear(soft_shadow_front, uvd.xy), bilinear(soft_shadow_back, uvd.xy));
+    let occlusion = max(receiver_bilinear(soft_shadow_front, uvd.xy, nearest, tolerance), receiver_bilinear(soft_shadow_back, uvd.xy, nearest, tolerance));
     return 1.0 - clamp(occlusion, 0.0, 1.0);
 }

@@ -6,7 +6,8 @@ struct AttySettings {
     soft_shadow_map_size: f32,
     // Normal offset of the projection's lookup point, in receiver-map texels.
     normal_offset: f32,
-    // Hidden-receiver test tolerance, in receiver-map texels.
+    // Depth tolerance, in receiver-map texel footprints, within which a receiver-map depth counts
+    // as the looked-up receiver (the hidden-receiver test and the SSM's depth-aware bilinear lookup).
     receiver_tolerance: f32,
     // A micro-patch less than this many of its own widths in front of a receiver counts as the
     // receiver's own surface and hides nothing (objects with the role `both` are in both maps).

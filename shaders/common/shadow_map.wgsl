@@ -35,3 +35,14 @@ fn normal_offset_position(frame: LightFrame, map: texture_2d<f32>, position: vec
 fn grid_offset(i: u32, count: u32) -> f32 {
     return (f32(i) + 0.5) / f32(count) * 2.0 - 1.0;
 }
+
+// The depth a shadow-map tap at `uv` is compared with, for a receiver at world `position` with
+// normal `normal` and light depth `receiver_depth`: with `plane`, the depth of the receiver's
+// tangent plane along that tap's ray, so that a wide kernel on a surface tilted to the light does
+// not find the surface itself (Isidoro 2006); without, the receiver's own depth (Fernando 2005).
+fn tap_receiver_depth(frame: LightFrame, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32, plane: bool) -> f32 {
+    if (!plane) {
+        return receiver_depth;
+    }
+    return receiver_plane_depth(frame, position, normal, uv, receiver_depth);
+}

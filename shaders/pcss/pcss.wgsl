@@ -34,12 +34,9 @@ struct PcssSettings {
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
 
-// The depth a tap at `uv` is compared with.
-fn tap_receiver_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
-    if (settings.receiver_plane == 0u) {
-        return receiver_depth;
-    }
-    return receiver_plane_depth(frame, position, normal, uv, receiver_depth);
+// The depth a tap at `uv` is compared with (common/shadow_map.wgsl).
+fn compared_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
+    return tap_receiver_depth(frame, position, normal, uv, receiver_depth, settings.receiver_plane != 0u);
 }
 
 @fragment
@@ -63,7 +60,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         for (var i = 0u; i < n; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
             let depth = shadow_map_depth(shadow_map, uv);
-            if (depth < tap_receiver_depth(lookup, normal, uv, receiver_depth)) {
+            if (depth < compared_depth(lookup, normal, uv, receiver_depth)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
             }
@@ -81,7 +78,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     for (var j = 0u; j < m; j++) {
         for (var i = 0u; i < m; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
-            lit += select(0.0, 1.0, tap_receiver_depth(lookup, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
+            lit += select(0.0, 1.0, compared_depth(lookup, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
         }
     }
     return lit / f32(m * m);

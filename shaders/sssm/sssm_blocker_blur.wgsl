@@ -7,14 +7,15 @@
 
 @group(2) @binding(3) var horizontal_blocker: texture_2d<f32>;
 
-// (horizontally blurred visibility, blur half-width in pixels, blocker rows reused, 1 where computed).
+// (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker rows
+// reused); w = -1 where nothing was computed (background, behind the light).
 @fragment
 fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
     let d = own.x;
     if (d < 0.0) {
-        return vec4<f32>(own.w, 0.0, 0.0, 0.0);
+        return vec4<f32>(own.w, 0.0, 0.0, -1.0);
     }
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
@@ -44,8 +45,9 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
         }
         if (!reuse) {
             for (var i = 0u; i < n; i++) {
-                let depth = shadow_map_depth(shadow_map, row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0));
-                if (depth < d) {
+                let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
+                let depth = shadow_map_depth(shadow_map, tap);
+                if (depth < compared_depth(lookup, point.normal, tap, d)) {
                     sum += depth;
                     count += 1.0;
                 }
@@ -54,34 +56,44 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     }
     // No blocker: fully lit (Sec. 4.2).
     if (count == 0.0) {
-        return vec4<f32>(1.0, 0.0, reused, 1.0);
+        return vec4<f32>(1.0, 0.0, 0.0, reused);
     }
     let blocker = sum / count;
-    // Eq. 1: w_penumbra = w_light (z_receiver - z_avg) / z_avg, here as a half-width in world units,
-    // then in pixels at the point's distance from the eye.
-    let half_width = settings.light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6);
-    let radius = half_width / max(view_depth(point.position) * settings.pixel_scale, 1e-9);
+    // Eq. 1: w_penumbra = w_light (z_receiver - z_avg) / z_avg, as the shadow-map half-extent of
+    // PCSS's filter (the same kernel pcss filters over), then laid on the receiver's tangent plane
+    // and measured along each screen axis.
+    let extent = light_half_extent_uv(frame, blocker, d);
+    var radii = kernel_screen_radii(point.position, point.normal, light_uv_depth(frame, point.position).xy, extent);
+    if (radii.x < 0.0) {
+        // The plane runs along the light's rays: the width on a surface facing the camera.
+        let half_width = settings.light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6);
+        radii = vec2<f32>(half_width / max(view_depth(point.position) * settings.pixel_scale, 1e-9));
+    }
     // A penumbra under half a pixel keeps the hard value.
-    if (radius < 0.5) {
-        return vec4<f32>(own.w, 0.0, reused, 1.0);
+    if (max(radii.x, radii.y) < 0.5) {
+        return vec4<f32>(own.w, 0.0, 0.0, reused);
     }
     let m = max(settings.blur_kernel, 1u);
+    let rays = camera_rays();
     var blurred = 0.0;
     var total = 0.0;
     let centre = in.clip.xy;
     for (var j = 0u; j < m; j++) {
-        let tap = centre + vec2<f32>(grid_offset(j, m) * radius, 0.0);
+        let tap = centre + vec2<f32>(grid_offset(j, m) * radii.x, 0.0);
         var value: f32;
+        var weight = tap_weight(j, m);
         if (on_screen(tap)) {
             value = textureLoad(horizontal_blocker, vec2<i32>(tap), 0).w;
+            weight *= bilateral_weight(rays, point.position, point.normal, tap);
         } else {
             // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.
-            let plane = tangent_plane_point(camera_rays(), point.position, point.normal, tap);
+            let plane = tangent_plane_point(rays, point.position, point.normal, tap);
             value = select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
         }
-        let weight = tap_weight(j, m);
         blurred += weight * value;
         total += weight;
     }
-    return vec4<f32>(blurred / total, radius, reused, 1.0);
+    // Every tap on other surfaces (an even m has no centre tap): keep the hard value.
+    let horizontal = select(own.w, blurred / total, total > 1e-6);
+    return vec4<f32>(horizontal, radii, reused);
 }

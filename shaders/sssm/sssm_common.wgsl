@@ -10,7 +10,8 @@ struct SssmSettings {
     blur_kernel: u32,
     // 1: Gaussian weights; 0: mean (Sec. 4.4).
     gaussian: u32,
-    _pad0: u32,
+    // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
+    receiver_plane: u32,
     // Reuse thresholds, world units: light-depth difference (α) and normal-adjusted camera-depth difference (β).
     alpha: f32,
     beta: f32,
@@ -20,10 +21,12 @@ struct SssmSettings {
     normal_offset: f32,
     // World size of one pixel per unit of distance from the eye: 2 tan(fov_y / 2) / height.
     pixel_scale: f32,
-    // Light half-size used by Eq. 1 (the mean of the rectangle's two half-sides: the blur is isotropic).
+    // Light half-size used where the kernel's screen footprint cannot be found (a tangent plane
+    // along the light's rays): the mean of the rectangle's two half-sides.
     light_half_size: f32,
-    _pad1: f32,
-    _pad2: f32,
+    // Depth tolerance of the blurs' bilateral weights, world units; 0: no bilateral weighting.
+    bilateral_depth: f32,
+    _pad: f32,
 };
 
 @group(2) @binding(0) var<uniform> camera: Camera;
@@ -112,4 +115,71 @@ fn view_depth(world: vec3<f32>) -> f32 {
     let centre = far_point(camera.viewport.xy * 0.5);
     let forward = normalize(centre - camera.position.xyz);
     return dot(world - camera.position.xyz, forward);
+}
+
+// Shadow-map taps compare with this depth (the receiver model shared with pcss).
+fn compared_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
+    return tap_receiver_depth(frame, position, normal, uv, receiver_depth, settings.receiver_plane != 0u);
+}
+
+// Pixel position of a world point, w = 0 behind the eye.
+fn screen_position(world: vec3<f32>) -> vec3<f32> {
+    let clip = camera.view_proj * vec4<f32>(world, 1.0);
+    if (clip.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let ndc = clip.xy / clip.w;
+    return vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, 1.0);
+}
+
+// Pixel position of the point of the tangent plane through `point` (normal `normal`) seen from the
+// light's centre at shadow-map coordinates `uv`; w = 0 where the ray misses the plane.
+fn plane_screen_position(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
+    let depth = receiver_plane_depth(frame, point, normal, uv, -1.0);
+    if (depth <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return screen_position(light_point(uv, depth));
+}
+
+// Half-widths in pixels, along the screen's x and y, of the blur that stands for the PCF kernel of
+// shadow-map half-extent `extent` around `uv` (the paper projects the penumbra into screen space,
+// Sec. 4.2). The kernel is laid on the receiver's tangent plane and projected: its two half-axes
+// become screen vectors a and b, and each separable pass takes the root-sum-square of their
+// components along its axis, the box with the projected parallelogram's second moments. On a
+// surface seen at an angle the vertical width shrinks with the foreshortening, as it must.
+// Returns a negative x where the plane runs along the light's rays or behind the eye.
+fn kernel_screen_radii(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, extent: vec2<f32>) -> vec2<f32> {
+    let right = plane_screen_position(point, normal, uv + vec2<f32>(extent.x, 0.0));
+    let left = plane_screen_position(point, normal, uv - vec2<f32>(extent.x, 0.0));
+    let down = plane_screen_position(point, normal, uv + vec2<f32>(0.0, extent.y));
+    let up = plane_screen_position(point, normal, uv - vec2<f32>(0.0, extent.y));
+    if (right.z * left.z * down.z * up.z == 0.0) {
+        return vec2<f32>(-1.0);
+    }
+    let a = 0.5 * (right.xy - left.xy);
+    let b = 0.5 * (down.xy - up.xy);
+    // Never wider than a few screens: a plane at a grazing angle to the light stretches without bound.
+    return min(sqrt(a * a + b * b), 4.0 * camera.viewport.xy);
+}
+
+// Bilateral weight of a blur tap at pixel `texel` for the pixel seen at `point` with normal
+// `normal`: how much the surface seen there looks like this pixel's tangent plane, by the
+// difference of camera distances (the distance of the vertical pass's β test) and of normals.
+// Taps on another object across a silhouette get no weight, so shadow does not leak over edges.
+fn bilateral_weight(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
+    if (settings.bilateral_depth <= 0.0) {
+        return 1.0;
+    }
+    let texel = vec2<i32>(pixel);
+    let other = textureLoad(gbuffer_position, texel, 0);
+    let expected = tangent_plane_point(rays, point, normal, pixel);
+    if (other.w < 0.5 || expected.w == 0.0) {
+        return 0.0;
+    }
+    let eye = camera.position.xyz;
+    let gap = (distance(other.xyz, eye) - distance(expected.xyz, eye)) / settings.bilateral_depth;
+    let turn = max(dot(normal, textureLoad(gbuffer_normal, texel, 0).xyz), 0.0);
+    // The normal term falls to 1/2 at about 23°.
+    return exp(-gap * gap) * pow(turn, 8.0);
 }

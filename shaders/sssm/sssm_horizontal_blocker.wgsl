@@ -1,6 +1,7 @@
 // SSSM step 1 (Table 1): per pixel, the hard shadow, its light depth d, and the horizontal
 // partial blocker sum and count over the n×1 row of the depth map through its shadow-map
-// position (Sec. 4.1): partial_blocker_sum(p) = Σ_x dm(x, 0) for dm < d.
+// position (Sec. 4.1): partial_blocker_sum(p) = Σ_x dm(x, 0) for dm < d (d, or the receiver's
+// tangent plane along each tap's ray with `receiver_plane`, as in pcss).
 
 // #import sssm/sssm_common.wgsl
 
@@ -21,8 +22,9 @@ fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
     var sum = 0.0;
     var count = 0.0;
     for (var i = 0u; i < n; i++) {
-        let depth = shadow_map_depth(shadow_map, uvd.xy + vec2<f32>(grid_offset(i, n) * search.x, 0.0));
-        if (depth < uvd.z) {
+        let tap = uvd.xy + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
+        let depth = shadow_map_depth(shadow_map, tap);
+        if (depth < compared_depth(lookup, point.normal, tap, uvd.z)) {
             sum += depth;
             count += 1.0;
         }

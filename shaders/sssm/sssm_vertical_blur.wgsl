@@ -13,17 +13,18 @@
 @fragment
 fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
+    // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
     let own = textureLoad(horizontal_blur, point.texel, 0);
-    if (own.w < 0.5) {
+    if (own.w < 0.0) {
         // Nothing computed here (background, behind the light): -1 keeps it out of the average.
         textureStore(reuse_share, point.texel, vec4<f32>(-1.0));
         return own.x;
     }
     let n = f32(max(settings.blocker_kernel, 1u));
-    let radius = own.y;
-    if (radius < 0.5) {
+    let radii = own.yz;
+    if (max(radii.x, radii.y) < 0.5) {
         // No blur: only the blocker rows counted.
-        textureStore(reuse_share, point.texel, vec4<f32>(own.z / n));
+        textureStore(reuse_share, point.texel, vec4<f32>(own.w / n));
         return own.x;
     }
     let m = max(settings.blur_kernel, 1u);
@@ -35,8 +36,9 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
     var total = 0.0;
     var reused = 0.0;
     for (var j = 0u; j < m; j++) {
-        let row = in.clip.xy + vec2<f32>(0.0, grid_offset(j, m) * radius);
+        let row = in.clip.xy + vec2<f32>(0.0, grid_offset(j, m) * radii.y);
         var value = 0.0;
+        var weight = tap_weight(j, m);
         var reuse = false;
         if (on_screen(row)) {
             let texel = vec2<i32>(row);
@@ -44,6 +46,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
             let expected = tangent_plane_point(rays, point.position, point.normal, row);
             if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < settings.beta) {
                 value = textureLoad(horizontal_blur, texel, 0).x;
+                weight *= bilateral_weight(rays, point.position, point.normal, row);
                 reuse = true;
                 reused += 1.0;
             }
@@ -53,19 +56,18 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
             var row_sum = 0.0;
             var row_total = 0.0;
             for (var i = 0u; i < m; i++) {
-                let tap = row + vec2<f32>(grid_offset(i, m) * radius, 0.0);
+                let tap = row + vec2<f32>(grid_offset(i, m) * radii.x, 0.0);
                 let plane = tangent_plane_point(rays, point.position, point.normal, tap);
                 let visible = select(own_hard, tap_visibility(plane.xyz, offset), plane.w > 0.0);
-                let weight = tap_weight(i, m);
-                row_sum += weight * visible;
-                row_total += weight;
+                let inner_weight = tap_weight(i, m);
+                row_sum += inner_weight * visible;
+                row_total += inner_weight;
             }
             value = row_sum / row_total;
         }
-        let weight = tap_weight(j, m);
         blurred += weight * value;
         total += weight;
     }
-    textureStore(reuse_share, point.texel, vec4<f32>((own.z + reused) / (n + f32(m))));
-    return clamp(blurred / total, 0.0, 1.0);
+    textureStore(reuse_share, point.texel, vec4<f32>((own.w + reused) / (n + f32(m))));
+    return clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
 }

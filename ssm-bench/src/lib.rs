@@ -7,7 +7,7 @@ pub mod sweep;
 use std::path::Path;
 
 use serde_json::json;
-use ssm_core::image_io::write_exr_rgb;
+use ssm_core::image_io::write_exr_positions;
 use ssm_core::{GpuContext, ParamValues, Registry, Renderer, Requirements, TechniqueInfo};
 
 /// Keeps every technique crate linked into the binary, so that their
@@ -59,7 +59,8 @@ pub fn render_technique(
     dir: &Path,
 ) -> ssm_core::Result<report::Measured> {
     let measured = report::measure(renderer, info, params, frames)?;
-    report::write_images(dir, &measured, renderer.width(), renderer.height(), None)?;
+    let coverage = report::pixel_mask(renderer, report::PixelSet::All)?;
+    report::write_images(dir, &measured, (renderer.width(), renderer.height()), &coverage, None)?;
     let report = json!({
         "technique": info.name,
         "params": params.to_string(),
@@ -81,14 +82,17 @@ pub fn render_technique(
     Ok(measured)
 }
 
-/// Writes the G-buffer's world positions (`position.exr`, RGB; background pixels are 0).
+/// Writes the G-buffer's world positions to `position.exr`: `R`, `G`, `B` the
+/// position (0 for background), `A` the coverage (1 where geometry covers the
+/// pixel, 0 for background; a surface at the origin is not background).
 ///
 /// # Errors
 /// GPU or file errors.
 pub fn write_positions(renderer: &Renderer, file: &Path) -> ssm_core::Result<()> {
     let positions = renderer.read_positions()?;
-    let rgb: Vec<[f32; 3]> = positions.iter().map(|p| if p[3] > 0.5 { [p[0], p[1], p[2]] } else { [0.0; 3] }).collect();
-    write_exr_rgb(file, renderer.width(), renderer.height(), &rgb)
+    let xyz: Vec<[f32; 3]> = positions.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let covered: Vec<bool> = positions.iter().map(|p| p[3] > 0.5).collect();
+    write_exr_positions(file, renderer.width(), renderer.height(), &xyz, &covered)
 }
 
 /// Whether `gpu` can run `info` at its default parameters, as a short phrase.

@@ -133,7 +133,25 @@ macro_rules! say {
     };
 }
 
+/// Without a Wayland session (no `XDG_RUNTIME_DIR`), Mesa's device-selection
+/// Vulkan layer still tries to connect to one when wgpu enables the Wayland
+/// surface extension, and libwayland prints `error: XDG_RUNTIME_DIR is invalid
+/// or not set` on a perfectly good offscreen run. ssm never presents to a
+/// window and picks its adapter itself, so the layer is switched off (its own
+/// documented switch) for this process.
+fn quiet_window_system_layers() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() && std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: called first thing in `main`, before any thread exists, so no
+        // other thread can read the environment while it changes.
+        #[allow(unsafe_code)]
+        unsafe {
+            std::env::set_var("NODEVICE_SELECT", "1");
+        }
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_window_system_layers();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::List => list(),
@@ -304,15 +322,17 @@ fn compare(args: &CompareArgs) -> Result<()> {
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
-    report::write_images(&args.out.join(reference_info.name), &reference, args.width, args.height, None)?;
+    let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
+    let size = (args.width, args.height);
+    report::write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;
     let covered = report::pixel_mask(&renderer, args.pixels)?;
     progress.inc(1);
     let mut rows = Vec::new();
     for (info, params) in &runs {
         progress.set_message(info.name);
         let measured = report::measure(&mut renderer, info, params, args.frames)?;
-        report::write_images(&args.out.join(info.name), &measured, args.width, args.height, Some((&reference, &covered)))?;
-        rows.push(report::row(&args.scene, &renderer, &measured, &reference, &covered));
+        report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
+        rows.extend(report::rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
         progress.inc(1);
     }
     progress.finish_and_clear();

@@ -36,6 +36,18 @@ impl Measured {
         median(&self.frames.iter().filter_map(|f| f.gpu_ms).collect::<Vec<_>>())
     }
 
+    /// Median over frames of the GPU time of the passes recorded for `light`.
+    #[must_use]
+    pub fn gpu_ms_median_for_light(&self, light: usize) -> Option<f64> {
+        let per_frame: Vec<f64> = self
+            .frames
+            .iter()
+            .filter(|f| f.gpu_ms.is_some())
+            .map(|f| f.passes.iter().filter(|p| p.light == light).map(|p| p.ms).sum())
+            .collect();
+        median(&per_frame)
+    }
+
     /// Smallest GPU time over frames.
     #[must_use]
     pub fn gpu_ms_min(&self) -> Option<f64> {
@@ -51,19 +63,27 @@ impl Measured {
     /// Median over frames of each pass's time, passes of one name summed within a frame, in first-seen order.
     #[must_use]
     pub fn pass_medians(&self) -> Vec<(String, f64)> {
+        self.pass_medians_where(|_| true)
+    }
+
+    /// As [`Measured::pass_medians`], over the passes recorded for `light` only.
+    #[must_use]
+    pub fn pass_medians_for_light(&self, light: usize) -> Vec<(String, f64)> {
+        self.pass_medians_where(|pass| pass.light == light)
+    }
+
+    fn pass_medians_where(&self, keep: impl Fn(&ssm_core::PassTiming) -> bool) -> Vec<(String, f64)> {
         let mut names: Vec<String> = Vec::new();
-        for frame in &self.frames {
-            for pass in &frame.passes {
-                if !names.contains(&pass.name) {
-                    names.push(pass.name.clone());
-                }
+        for pass in self.frames.iter().flat_map(|f| &f.passes).filter(|p| keep(p)) {
+            if !names.contains(&pass.name) {
+                names.push(pass.name.clone());
             }
         }
         names
             .into_iter()
             .map(|name| {
                 let per_frame: Vec<f64> =
-                    self.frames.iter().map(|f| f.passes.iter().filter(|p| p.name == name).map(|p| p.ms).sum()).collect();
+                    self.frames.iter().map(|f| f.passes.iter().filter(|p| p.name == name && keep(p)).map(|p| p.ms).sum()).collect();
                 let ms = median(&per_frame).unwrap_or(f64::NAN);
                 (name, ms)
             })
@@ -91,29 +111,47 @@ pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &P
     Ok(Measured { info, params: params.clone(), frames: timings, diagnostics, visibility, shaded, extra_images })
 }
 
+/// The stem of light `light`'s image files: `visibility` for light 0, `visibility-light<k>` for the others.
+#[must_use]
+pub fn visibility_stem(light: usize) -> String {
+    if light == 0 { "visibility".to_owned() } else { format!("visibility-light{light}") }
+}
+
 /// Writes a measured technique's images under `dir`: `visibility.exr`/`.png`
-/// (light 0; `visibility-light<k>.*` for the others) and `shaded.png`; with a
-/// reference, also `heatmap.png` (light 0).
+/// (light 0; `visibility-light<k>.*` for the others; the EXR's `A` channel is
+/// `coverage`) and `shaded.png`; with a reference, also `heatmap.png` (light
+/// 0; `heatmap-light<k>.png` for the others) over the pixels it marks.
 ///
 /// # Errors
 /// File errors.
-pub fn write_images(dir: &Path, measured: &Measured, width: u32, height: u32, reference: Option<(&Measured, &[bool])>) -> Result<()> {
+pub fn write_images(
+    dir: &Path,
+    measured: &Measured,
+    (width, height): (u32, u32),
+    coverage: &[bool],
+    reference: Option<(&Measured, &[bool])>,
+) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::Write { file: dir.into(), message: e.to_string() })?;
     for (light, visibility) in measured.visibility.iter().enumerate() {
-        let stem = if light == 0 { "visibility".to_owned() } else { format!("visibility-light{light}") };
-        write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, visibility)?;
+        let stem = visibility_stem(light);
+        write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, visibility, coverage)?;
         write_png_gray16(&dir.join(format!("{stem}.png")), width, height, visibility)?;
     }
     write_png_rgba8(&dir.join("shaded.png"), width, height, &measured.shaded)?;
     for extra in &measured.extra_images {
-        write_exr_gray(&dir.join(format!("{}.exr", extra.name)), extra.width, extra.height, &extra.values)?;
+        let extra_coverage: &[bool] =
+            if (extra.width, extra.height) == (width, height) { coverage } else { &vec![true; extra.values.len()] };
+        write_exr_gray(&dir.join(format!("{}.exr", extra.name)), extra.width, extra.height, &extra.values, extra_coverage)?;
         write_png_gray16(&dir.join(format!("{}.png", extra.name)), extra.width, extra.height, &extra.values)?;
     }
     if let Some((reference, covered)) = reference {
-        let rgb = heat_map(&reference.visibility[0], &measured.visibility[0], covered, 0.5);
-        let image = image::RgbImage::from_raw(width, height, rgb)
-            .ok_or_else(|| Error::Write { file: dir.join("heatmap.png"), message: "buffer size".into() })?;
-        image.save(dir.join("heatmap.png")).map_err(|e| Error::Write { file: dir.join("heatmap.png"), message: e.to_string() })?;
+        for (light, (truth, image)) in reference.visibility.iter().zip(&measured.visibility).enumerate() {
+            let file = dir.join(if light == 0 { "heatmap.png".to_owned() } else { format!("heatmap-light{light}.png") });
+            let rgb = heat_map(truth, image, covered, 0.5);
+            let picture = image::RgbImage::from_raw(width, height, rgb)
+                .ok_or_else(|| Error::Write { file: file.clone(), message: "buffer size".into() })?;
+            picture.save(&file).map_err(|e| Error::Write { file: file.clone(), message: e.to_string() })?;
+        }
     }
     Ok(())
 }
@@ -132,6 +170,7 @@ pub enum PixelSet {
 /// # Errors
 /// A readback error.
 pub fn pixel_mask(renderer: &Renderer, set: PixelSet) -> Result<Vec<bool>> {
+    // Coverage is the position's w channel: 1 where geometry was drawn.
     let positions = renderer.read_positions()?;
     Ok(match set {
         PixelSet::All => positions.iter().map(|p| p[3] > 0.5).collect(),
@@ -146,13 +185,16 @@ pub struct Row {
     pub scene: String,
     /// Technique name.
     pub technique: String,
+    /// The light this row measures, or `None` for all lights together (errors
+    /// averaged over lights, time summed).
+    pub light: Option<usize>,
     /// Parameters, `name=value;...`.
     pub params: String,
     /// Image width.
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Median GPU ms per frame (sum of passes), when timestamps exist.
+    /// Median GPU ms per frame (sum of passes; of this light's passes in a per-light row), when timestamps exist.
     pub gpu_ms_median: Option<f64>,
     /// Minimum GPU ms per frame.
     pub gpu_ms_min: Option<f64>,
@@ -189,6 +231,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "ssim",
     "frac_over_0_05",
     "adapter",
+    "light",
     "flip_mean",
     "mean_signed_error",
     "penumbra_pixels",
@@ -198,7 +241,9 @@ pub const CSV_COLUMNS: &[&str] = &[
     "diagnostics",
 ];
 
-/// Builds the row of `measured` against `reference` (same pixels; `covered` marks the pixels with a surface).
+/// Builds the row of `measured` against `reference` over all lights (same
+/// pixels; `covered` marks the pixels the metrics cover): errors averaged over
+/// lights, FLIP of the shaded image (all lights), GPU time of the whole frame.
 #[must_use]
 pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Measured, covered: &[bool]) -> Row {
     let (width, height) = (renderer.width(), renderer.height());
@@ -211,6 +256,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
     Row {
         scene: scene.to_owned(),
         technique: measured.info.name.to_owned(),
+        light: None,
         params: measured.params.to_string(),
         width,
         height,
@@ -224,6 +270,31 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         passes: measured.pass_medians(),
         diagnostics: measured.diagnostics.clone(),
     }
+}
+
+/// The total row (as [`row`]) followed, when the scene has more than one
+/// light, by one row per light: that light's errors and the GPU time of the
+/// passes recorded for it. The shaded image combines all lights, so per-light
+/// rows repeat the total's FLIP.
+#[must_use]
+pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Measured, covered: &[bool]) -> Vec<Row> {
+    let total = row(scene, renderer, measured, reference, covered);
+    let (width, height) = (renderer.width() as usize, renderer.height() as usize);
+    let mut rows = Vec::new();
+    if measured.visibility.len() > 1 {
+        for (light, (image, truth)) in measured.visibility.iter().zip(&reference.visibility).enumerate() {
+            rows.push(Row {
+                light: Some(light),
+                gpu_ms_median: measured.gpu_ms_median_for_light(light),
+                gpu_ms_min: None,
+                metrics: compare(truth, image, covered, width, height),
+                passes: measured.pass_medians_for_light(light),
+                ..total.clone()
+            });
+        }
+    }
+    rows.insert(0, total);
+    rows
 }
 
 fn average(all: &[ErrorMetrics]) -> ErrorMetrics {
@@ -278,6 +349,7 @@ impl Row {
             number(Some(m.ssim), 6),
             number(Some(m.frac_over_0_05), 6),
             csv_field(&self.adapter),
+            self.light.map_or_else(|| "all".to_owned(), |light| light.to_string()),
             number(Some(self.flip), 6),
             number(Some(m.mean_signed), 6),
             m.penumbra_pixels.to_string(),
@@ -325,13 +397,18 @@ fn table_cells(r: &Row) -> [String; 11] {
     ]
 }
 
+/// What follows the technique's name in a per-light row: ` · light <k>`.
+fn light_suffix(row: &Row) -> String {
+    row.light.map(|light| format!(" · light {light}")).unwrap_or_default()
+}
+
 /// The Markdown table of `rows`.
 #[must_use]
 pub fn markdown_table(rows: &[Row]) -> String {
     let mut out = format!("| {} |\n|---|---|{}\n", TABLE_HEADER.join(" | "), "---:|".repeat(TABLE_HEADER.len() - 2));
     for r in rows {
         let mut cells = table_cells(r);
-        cells[0] = format!("`{}`", cells[0]);
+        cells[0] = format!("`{}`{}", cells[0], light_suffix(r));
         let _ = writeln!(out, "| {} |", cells.join(" | "));
     }
     out
@@ -401,7 +478,7 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     out += "</tr>\n";
     for r in rows {
         let cells = table_cells(r);
-        let _ = write!(out, "<tr><td><code>{}</code></td>", escape(&cells[0]));
+        let _ = write!(out, "<tr><td><code>{}</code>{}</td>", escape(&cells[0]), escape(&light_suffix(r)));
         for cell in &cells[1..] {
             let _ = write!(out, "<td>{}</td>", escape(cell));
         }
@@ -417,12 +494,35 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
         "<figure><figcaption><code>{0}</code> (ground truth)</figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"></figure>",
         escape(reference_name)
     );
-    for r in rows {
+    let lights = rows.iter().filter_map(|r| r.light).max().map_or(1, |last| last + 1);
+    for light in 1..lights {
         let _ = writeln!(
             out,
-            "<figure><figcaption><code>{0}</code></figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"><img src=\"{0}/heatmap.png\" alt=\"{0} error\"></figure>",
-            escape(&r.technique)
+            "<figure><figcaption><code>{0}</code> (ground truth) · light {light}</figcaption><img src=\"{0}/{1}.png\" alt=\"{0} visibility of light {light}\"></figure>",
+            escape(reference_name),
+            visibility_stem(light)
         );
+    }
+    for r in rows {
+        match r.light {
+            None => {
+                let _ = writeln!(
+                    out,
+                    "<figure><figcaption><code>{0}</code></figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"><img src=\"{0}/heatmap.png\" alt=\"{0} error\"></figure>",
+                    escape(&r.technique)
+                );
+            }
+            // Light 0's images are in the total's figure.
+            Some(0) => {}
+            Some(light) => {
+                let _ = writeln!(
+                    out,
+                    "<figure><figcaption><code>{0}</code> · light {light}</figcaption><img src=\"{0}/{1}.png\" alt=\"{0} visibility of light {light}\"><img src=\"{0}/heatmap-light{light}.png\" alt=\"{0} error for light {light}\"></figure>",
+                    escape(&r.technique),
+                    visibility_stem(light)
+                );
+            }
+        }
     }
     out += "<script>\nwindow.addEventListener('load', () => {\n  const images = Array.from(document.images);\n  const loaded = images.filter((i) => i.complete && i.naturalWidth > 0).length;\n  document.body.dataset.imagesLoaded = loaded + '/' + images.length;\n});\n</script>\n</body>\n</html>\n";
     out

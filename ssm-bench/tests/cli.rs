@@ -65,6 +65,89 @@ fn render_writes_every_file() {
     );
 }
 
+/// A first run on a machine without a display session prints no line starting with `error`
+/// (Mesa's window-system layer would, unless ssm switches it off), and `position.exr` tells
+/// background from geometry through its coverage channel, even for a surface at the origin.
+#[test]
+fn a_first_headless_render_prints_no_error_and_marks_background() {
+    let out = out_dir("headless");
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .args(["render", "--scene", "parallel-square", "--technique", "hard", "--width", "64", "--height", "48", "--out"])
+        .arg(&out)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let all = format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(!all.lines().any(|l| l.trim_start().to_ascii_lowercase().starts_with("error")), "{all}");
+
+    let positions = ssm_core::image_io::read_exr(&out.join("position.exr")).unwrap();
+    let channel = |name: &str| positions.channel(name).unwrap_or_else(|| panic!("no channel {name}")).to_vec();
+    let (x, y, z, coverage) = (channel("R"), channel("G"), channel("B"), channel("A"));
+    // parallel-square's camera looks at the origin, a point of the receiver: the centre pixel is covered
+    // and lies near (0, 0, 0); the top row sees the sky.
+    let centre = (48 / 2) * 64 + 64 / 2;
+    assert_eq!(coverage[centre], 1.0);
+    assert!(x[centre].abs() < 0.2 && y[centre].abs() < 1e-3 && z[centre].abs() < 0.2, "({}, {}, {})", x[centre], y[centre], z[centre]);
+    assert!(coverage[..64].iter().all(|a| *a == 0.0), "the top row is background");
+    assert!(coverage.iter().all(|a| *a == 0.0 || *a == 1.0));
+    // The visibility EXR carries the same coverage.
+    let visibility = ssm_core::image_io::read_exr(&out.join("hard/visibility.exr")).unwrap();
+    assert_eq!(visibility.channel("A").unwrap(), coverage.as_slice());
+    assert!(visibility.channel("Y").is_some());
+}
+
+/// `compare` on a scene with three lights reports each light and all of them together.
+#[test]
+fn compare_reports_every_light_and_the_total() {
+    let dir = out_dir("lights");
+    std::fs::create_dir_all(&dir).unwrap();
+    let manifest = dir.join("three-lights.toml");
+    std::fs::write(
+        &manifest,
+        "[camera]\nposition = [0.0, 5.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[light]]\ncentre = [0.0, 4.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.0, 1.0]\n\
+         [[light]]\ncentre = [2.0, 5.0, 1.0]\nnormal = [-0.3, -1.0, -0.2]\nsize = [2.0, 0.5]\nintensity = 0.5\n\
+         [[light]]\ncentre = [-2.0, 3.0, -1.0]\nnormal = [0.4, -1.0, 0.3]\nsize = [0.2, 0.2]\nintensity = 2.0\n\
+         [[object]]\nprimitive = \"sphere\"\nsize = [0.6]\ntranslate = [0.0, 1.5, 0.0]\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrole = \"receiver\"\n",
+    )
+    .unwrap();
+    let out = dir.join("report");
+    let output = ssm(&[
+        "compare",
+        "--scene",
+        manifest.to_str().unwrap(),
+        "--technique",
+        "hard",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--set",
+        "reference.samples=4",
+        "--set",
+        "reference.cache=false",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let light_column = header.iter().position(|c| *c == "light").expect("a light column");
+    let lights: Vec<String> = csv.lines().skip(1).map(|l| l.split(',').nth(light_column).unwrap().to_owned()).collect();
+    assert_eq!(lights, ["all", "0", "1", "2"], "{csv}");
+    for file in ["hard/visibility-light2.exr", "hard/heatmap-light1.png", "reference/visibility-light2.png"] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("`hard` · light 2"), "{report}");
+}
+
 #[test]
 fn list_and_scenes_name_everything() {
     let list = ssm(&["list"]);

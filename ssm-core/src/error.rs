@@ -96,6 +96,15 @@ pub enum Error {
         /// Its value.
         value: f32,
     },
+    /// The technique cannot represent this scene at these settings (its
+    /// approximation breaks down there): a refusal, not a wrong image.
+    #[error("technique `{technique}` cannot render this scene: {reason}")]
+    Unrepresentable {
+        /// Technique name.
+        technique: String,
+        /// What about the scene or the settings is beyond it, and what would help.
+        reason: String,
+    },
     /// The technique failed in a way of its own.
     #[error("technique `{technique}`: {message}")]
     Technique {
@@ -121,6 +130,14 @@ pub enum Error {
         height: u32,
         /// Why.
         problem: String,
+    },
+    /// Reading an image file failed.
+    #[error("{}: cannot read: {message}", file.display())]
+    Read {
+        /// The file.
+        file: PathBuf,
+        /// Why.
+        message: String,
     },
     /// Writing an output file failed.
     #[error("{}: cannot write: {message}", file.display())]

@@ -81,6 +81,8 @@ pub struct GpuScene {
     pub triangle_count: u32,
     /// World-space bounds.
     pub bounds: Aabb,
+    /// World-space bounds of the receiving geometry (roles `receiver` and `both`).
+    pub receiver_bounds: Aabb,
     /// The camera matrices.
     pub camera: CameraUniform,
     /// Its uniform buffer.
@@ -164,7 +166,11 @@ impl GpuScene {
             })
         };
         let camera_bind_group = uniform_group("scene_camera_bind_group", &camera_buffer);
-        let light_frames: Vec<LightFrame> = scene.lights.iter().map(|light| LightFrame::fit(light, &bounds)).collect();
+        let receivers = scene.bounds_where(Role::receives);
+        let casting_points: Vec<glam::Vec3> =
+            vertices.iter().filter(|v| v.role & ROLE_CASTS != 0).map(|v| glam::Vec3::from_array(v.position)).collect();
+        let light_frames: Vec<LightFrame> =
+            scene.lights.iter().map(|light| LightFrame::fit_with_occluders(light, &bounds, &receivers, &casting_points)).collect();
         let light_buffers: Vec<wgpu::Buffer> = light_frames
             .iter()
             .enumerate()
@@ -187,6 +193,7 @@ impl GpuScene {
             ranges,
             triangle_count: indices.len() as u32 / 3,
             bounds,
+            receiver_bounds: receivers,
             camera,
             camera_buffer,
             uniform_layout,

@@ -40,7 +40,7 @@ pub use frame::{Frame, SharedInputs};
 pub use gbuffer::GBuffer;
 pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SceneVertex};
 pub use light_depth::{LightDepthMap, LightDepthMapDesc, NO_SURFACE, ShadowMapSettings};
-pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT};
+pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT, MAX_WIDENED_HALF_ANGLE_TANGENT};
 pub use params::{ParamError, ParamKind, ParamSpec, ParamValue, ParamValues};
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};

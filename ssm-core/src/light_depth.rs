@@ -116,7 +116,8 @@ impl LightDepthMap {
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(true),
-                depth_compare: Some(if desc.farthest { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Less }),
+                // The light frame's depth is reversed (near = 1): nearest wins with Greater.
+                depth_compare: Some(if desc.farthest { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Greater }),
                 stencil: wgpu::StencilState::default(),
                 bias: wgpu::DepthBiasState::default(),
             }),
@@ -160,7 +161,7 @@ impl LightDepthMap {
             Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(if self.farthest { 0.0 } else { 1.0 }),
+                    load: wgpu::LoadOp::Clear(if self.farthest { 1.0 } else { 0.0 }),
                     store: wgpu::StoreOp::Discard,
                 }),
                 stencil_ops: None,
@@ -209,6 +210,14 @@ impl ShadowMapSettings {
             doc: "lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011)",
         },
     ];
+
+    /// `receiver_plane`: the receiver model of techniques that compare shadow-map taps
+    /// with a receiver (`pcss`, `sssm`), declared once so that they share name, default and doc.
+    pub const RECEIVER_PLANE_PARAM: ParamSpec = ParamSpec {
+        name: "receiver_plane",
+        kind: ParamKind::Bool { default: true },
+        doc: "compare each shadow-map tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch",
+    };
 
     /// The `shadow_map_size` parameter with a technique's own default.
     #[must_use]

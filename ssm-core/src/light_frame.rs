@@ -11,10 +11,16 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 use ssm_scene::{Aabb, RectLight};
 
-/// Widest half-angle a light frustum may take, as a tangent (about 84°):
-/// geometry beside the light, nearly in its plane, is clipped rather than
-/// spreading the shadow map over an unbounded angle.
+/// Widest half-angle a light frustum takes to contain the scene's bounds, as a
+/// tangent (about 84°): geometry beside the light, nearly in its plane, is
+/// clipped rather than spreading the shadow map over an unbounded angle.
 pub const MAX_HALF_ANGLE_TANGENT: f32 = 10.0;
+
+/// Widest half-angle a light frustum takes, as a tangent (about 89.99°), to
+/// contain occluders that lie between the light and a receiver: an occluder
+/// a thousandth of the scene's size below the light hides it from everything,
+/// and a frame that clipped it would lose the shadow, not just blur it.
+pub const MAX_WIDENED_HALF_ANGLE_TANGENT: f32 = 1e4;
 
 /// One light's frustum, fitted to the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -23,7 +29,7 @@ pub struct LightFrame {
     pub light: RectLight,
     /// World to light view space (right-handed: x = u, y = -v, looking along the normal).
     pub view: Mat4,
-    /// Light view to clip space, depth in `[0, 1]`.
+    /// Light view to clip space, reversed depth: 1 at the near plane, 0 at the far plane.
     pub projection: Mat4,
     /// Tangents of the half-angles along u and v.
     pub tan_half: Vec2,
@@ -38,11 +44,25 @@ impl LightFrame {
     /// the light (up to [`MAX_HALF_ANGLE_TANGENT`]) projects inside the map.
     #[must_use]
     pub fn fit(light: &RectLight, bounds: &Aabb) -> Self {
+        Self::fit_with_occluders(light, bounds, &Aabb::EMPTY, &[])
+    }
+
+    /// As [`LightFrame::fit`], and widened (up to
+    /// [`MAX_WIDENED_HALF_ANGLE_TANGENT`], with a nearer near plane) so that
+    /// every point of `casting_points` that can lie between the light and a
+    /// receiver is inside the frame: those inside the convex hull of the light
+    /// rectangle and the corners of `receivers` behind them. Geometry beside
+    /// the light that blocks nothing (a wall at the light's level) does not
+    /// widen it. Triangles are judged by their corners.
+    #[must_use]
+    pub fn fit_with_occluders(light: &RectLight, bounds: &Aabb, receivers: &Aabb, casting_points: &[Vec3]) -> Self {
         let normal = light.normal();
         let view = glam::camera::rh::view::look_to_mat4(light.centre, normal, -light.v_axis);
         let extent = bounds.size().length().max(1e-6);
-        // Closest depth kept: geometry nearer the light's plane than this is clipped.
-        let min_depth = extent * 1e-4;
+        // Closest depth kept: geometry nearer the light's plane than this is clipped. An occluder
+        // a thousandth of the scene's size below the light is kept (and casts its huge penumbra,
+        // Atty et al. Eq. 3); the reversed depth below keeps the far end precise all the same.
+        let min_depth = extent * 1e-7;
         let local = |p: Vec3| {
             let offset = p - light.centre;
             Vec3::new(offset.dot(light.u_axis), offset.dot(light.v_axis), offset.dot(normal))
@@ -58,10 +78,8 @@ impl LightFrame {
                 points.push(pa.lerp(pb, t));
             }
         }
-        let mut tan_half = Vec2::splat(1e-3);
         let (mut near, mut far) = (f32::INFINITY, min_depth);
         for p in &points {
-            tan_half = tan_half.max(Vec2::new(p.x.abs(), p.y.abs()) / p.z);
             near = near.min(p.z);
             far = far.max(p.z);
         }
@@ -70,20 +88,46 @@ impl LightFrame {
             near = min_depth;
             far = min_depth * 2.0;
         }
-        // Same aspect ratio as the light (Atty et al., Sec. 3.2); point lights are square.
-        if !light.is_point() {
-            let aspect = light.half_size.x / light.half_size.y;
-            tan_half = Vec2::new(tan_half.x.max(tan_half.y * aspect), tan_half.y.max(tan_half.x / aspect));
-        } else {
-            tan_half = Vec2::splat(tan_half.max_element());
+        let mut tan_half = light_shaped_tangents(light, widest_tangents(&points)).min(Vec2::splat(MAX_HALF_ANGLE_TANGENT));
+        if tan_half.max_element() >= MAX_HALF_ANGLE_TANGENT && !receivers.is_empty() {
+            // The box was clipped: widen the frame for the occluders it clipped that block light.
+            let receiver_corners = receivers.corners().map(local);
+            let blocking: Vec<Vec3> = casting_points
+                .iter()
+                .map(|p| local(*p))
+                .filter(|p| p.z >= min_depth && between_light_and_receivers(light, &receiver_corners, *p))
+                .collect();
+            if !blocking.is_empty() {
+                let widened = light_shaped_tangents(light, widest_tangents(&blocking)).min(Vec2::splat(MAX_WIDENED_HALF_ANGLE_TANGENT));
+                tan_half = tan_half.max(widened);
+                near = blocking.iter().fold(near, |n, p| n.min(p.z));
+            }
         }
-        // A small margin so that geometry on the boundary is not lost to rasterisation rules.
-        tan_half = (tan_half * 1.02).min(Vec2::splat(MAX_HALF_ANGLE_TANGENT));
         let near = (near * 0.98).max(min_depth);
         let far = far * 1.02 + min_depth;
         let fov_y = 2.0 * tan_half.y.atan();
-        let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, near, far);
+        // Reversed depth (near → 1, far → 0): with a 32-bit float depth buffer the precision is then
+        // nearly constant relative to depth, so a near plane a million times closer than the far
+        // one still orders surfaces at the far end correctly. Depth tests use `Greater` for nearest.
+        let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, far, near);
         Self { light: *light, view, projection, tan_half, near, far }
+    }
+
+    /// Size in texels, along the map's two axes, of the part of a `map_size`²
+    /// map that `region` (clipped to the frame's depth range) covers: how finely
+    /// a map of this frame resolves it. Zero when nothing of it lies in front of
+    /// the light.
+    #[must_use]
+    pub fn footprint_texels(&self, region: &Aabb, map_size: u32) -> Vec2 {
+        let (mut low, mut high) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for corner in region.corners() {
+            let offset = corner - self.light.centre;
+            let depth = offset.dot(self.light.normal()).max(self.near);
+            let uv = Vec2::new(offset.dot(self.light.u_axis), offset.dot(self.light.v_axis)) / (depth * self.tan_half) * 0.5 + 0.5;
+            low = low.min(uv.clamp(Vec2::ZERO, Vec2::ONE));
+            high = high.max(uv.clamp(Vec2::ZERO, Vec2::ONE));
+        }
+        if region.is_empty() { Vec2::ZERO } else { (high - low).max(Vec2::ZERO) * map_size as f32 }
     }
 
     /// World to clip.
@@ -102,6 +146,42 @@ impl LightFrame {
         let y = offset.dot(self.light.v_axis) / (depth * self.tan_half.y);
         Vec3::new(0.5 + 0.5 * x, 0.5 + 0.5 * y, depth)
     }
+}
+
+/// Largest |x|/z and |y|/z over light-space points (at least 1e-3).
+fn widest_tangents(points: &[Vec3]) -> Vec2 {
+    points.iter().fold(Vec2::splat(1e-3), |tan, p| tan.max(Vec2::new(p.x.abs(), p.y.abs()) / p.z))
+}
+
+/// Tangents given the light's aspect ratio (Atty et al., Sec. 3.2; point lights
+/// are square) and a small margin, so that geometry on the boundary is not lost
+/// to rasterisation rules.
+fn light_shaped_tangents(light: &RectLight, tan_half: Vec2) -> Vec2 {
+    let shaped = if light.is_point() {
+        Vec2::splat(tan_half.max_element())
+    } else {
+        let aspect = light.half_size.x / light.half_size.y;
+        Vec2::new(tan_half.x.max(tan_half.y * aspect), tan_half.y.max(tan_half.x / aspect))
+    };
+    shaped * 1.02
+}
+
+/// True when light-space point `p` lies in the convex hull of the light
+/// rectangle and some receiver corner behind it, per axis: a segment from the
+/// light to that receiver can pass through `p`. (Conservative: the hull of the
+/// whole receiver box is taken corner by corner.)
+fn between_light_and_receivers(light: &RectLight, receiver_corners: &[Vec3; 8], p: Vec3) -> bool {
+    // 0.1% of slack: an occluder exactly as wide as the light has its corners on the hull.
+    let slack = 1.001;
+    let (mut reach_x, mut reach_y) = (0.0f32, 0.0f32);
+    let mut any_behind = false;
+    for r in receiver_corners.iter().filter(|r| r.z > p.z) {
+        any_behind = true;
+        let t = p.z / r.z;
+        reach_x = reach_x.max(light.half_size.x * (1.0 - t) + r.x.abs() * t);
+        reach_y = reach_y.max(light.half_size.y * (1.0 - t) + r.y.abs() * t);
+    }
+    any_behind && p.x.abs() <= reach_x * slack && p.y.abs() <= reach_y * slack
 }
 
 const BOX_EDGES: [(usize, usize); 12] = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
@@ -155,6 +235,7 @@ mod tests {
             let frame = LightFrame::fit(&scene.lights[0], &bounds);
             for corner in bounds.corners() {
                 let uvd = frame.uv_depth(corner);
+                // Reversed depth: the near plane maps to 1, the far plane to 0.
                 assert!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0, "{}: {corner} -> {uvd}", entry.name);
                 assert!(uvd.z >= frame.near && uvd.z <= frame.far, "{}", entry.name);
                 // The matrix path (as the rasteriser sees it) and the closed form agree.
@@ -165,6 +246,38 @@ mod tests {
                 assert!(ndc.z >= 0.0 && ndc.z <= 1.0);
             }
         }
+    }
+
+    /// An occluder 0.001 below the unit light, between it and the receiver, widens the frame far past
+    /// the usual limit and pulls the near plane in front of it; the same square beside the light
+    /// (it blocks nothing) does not.
+    #[test]
+    fn occluders_between_the_light_and_the_receivers_widen_the_frame_and_others_do_not() {
+        let scene = builtin("parallel-square").unwrap().build();
+        let light = scene.lights[0];
+        let receivers = Aabb { min: Vec3::new(-4.0, 0.0, -4.0), max: Vec3::new(4.0, 0.0, 4.0) };
+        let square = |centre: Vec3| {
+            [Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 0.0, -0.5), Vec3::new(0.5, 0.0, 0.5), Vec3::new(-0.5, 0.0, 0.5)].map(|c| c + centre)
+        };
+        let fit = |occluder: [Vec3; 4]| {
+            let mut bounds = receivers;
+            occluder.iter().for_each(|p| bounds.extend(*p));
+            LightFrame::fit_with_occluders(&light, &bounds, &receivers, &occluder)
+        };
+        let below = fit(square(Vec3::new(0.0, 3.999, 0.0)));
+        assert!(below.tan_half.x > 400.0 && below.tan_half.x <= MAX_WIDENED_HALF_ANGLE_TANGENT, "{}", below.tan_half);
+        assert!(below.near < 0.001, "{}", below.near);
+        for corner in square(Vec3::new(0.0, 3.999, 0.0)) {
+            let uvd = below.uv_depth(corner);
+            assert!(uvd.x > 0.0 && uvd.x < 1.0 && uvd.z > below.near, "{uvd}");
+        }
+        let beside = fit(square(Vec3::new(30.0, 3.999, 0.0)));
+        assert_eq!(beside.tan_half.x, MAX_HALF_ANGLE_TANGENT, "a square beside the light blocks nothing");
+        // Without occluders near the light, the fit is the plain one.
+        assert_eq!(
+            LightFrame::fit_with_occluders(&light, &scene.bounds(), &receivers, &[Vec3::Y * 2.0]),
+            LightFrame::fit(&light, &scene.bounds())
+        );
     }
 
     #[test]

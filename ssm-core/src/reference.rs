@@ -359,10 +359,12 @@ struct ReferenceTechnique {
     cache_dir: Option<PathBuf>,
     /// The G-buffer's points, read once: the scene and camera are static.
     points: Option<Vec<Option<SurfacePoint>>>,
-    traced: wgpu::Texture,
-    traced_group: wgpu::BindGroup,
+    /// One texture and bind group per light: an upload is recorded on the queue
+    /// before the frame's commands run, so lights sharing one texture would all
+    /// read the last light's upload.
+    traced: Vec<(wgpu::Texture, wgpu::BindGroup)>,
     upload: crate::ScreenPass,
-    /// Each light's traced image, kept: the scene and camera are static, so later frames only upload it.
+    /// Each light's traced image, kept: the scene and camera are static, so later frames only copy it into the target.
     traced_per_light: Vec<Option<ReferenceImage>>,
 }
 
@@ -399,6 +401,11 @@ impl crate::ShadowTechnique for ReferenceTechnique {
             .get(light)
             .map(|f| f.light)
             .ok_or_else(|| crate::Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
+        let (traced, traced_group) = self
+            .traced
+            .get(light)
+            .cloned()
+            .ok_or_else(|| crate::Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
         if self.traced_per_light.len() <= light {
             self.traced_per_light.resize(light + 1, None);
         }
@@ -410,17 +417,17 @@ impl crate::ShadowTechnique for ReferenceTechnique {
                 Some(dir) => self.truth.trace_cached(&rect, &points, samples, seed, dir),
                 None => self.truth.trace(&rect, &points, samples, seed),
             };
+            // Uploaded once, into this light's own texture: the scene and camera are static.
+            let (width, height) = (traced.width(), traced.height());
+            frame.gpu.queue.write_texture(
+                traced.as_image_copy(),
+                bytemuck::cast_slice(&image.visibility),
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            );
             self.traced_per_light[light] = Some(image);
         }
-        let Some(image) = &self.traced_per_light[light] else { unreachable!("traced above") };
-        let (width, height) = (self.traced.width(), self.traced.height());
-        frame.gpu.queue.write_texture(
-            self.traced.as_image_copy(),
-            bytemuck::cast_slice(&image.visibility),
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
-            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-        );
-        self.upload.encode(frame, light, output, Some(&self.traced_group), None);
+        self.upload.encode(frame, light, output, Some(&traced_group), None);
         Ok(())
     }
 
@@ -448,18 +455,24 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
     let params = setup.params;
     let device = &setup.gpu.device;
     let (width, height) = (setup.scene.width, setup.scene.height);
-    let traced =
-        crate::passes::render_texture(device, "reference_traced", width, height, crate::VISIBILITY_FORMAT, wgpu::TextureUsages::COPY_DST);
-    let traced_view = crate::passes::labelled_view(&traced, "reference_traced");
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("reference_traced_layout"),
         entries: &[crate::passes::texture_entry(0)],
     });
-    let traced_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("reference_traced_bind_group"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&traced_view) }],
-    });
+    let traced = (0..setup.scene.light_count())
+        .map(|light| {
+            let label = format!("reference_traced_light{light}");
+            let texture =
+                crate::passes::render_texture(device, &label, width, height, crate::VISIBILITY_FORMAT, wgpu::TextureUsages::COPY_DST);
+            let view = crate::passes::labelled_view(&texture, &label);
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(&format!("{label}_bind_group")),
+                layout: &layout,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) }],
+            });
+            (texture, group)
+        })
+        .collect();
     let module =
         crate::shader::create_shader(setup.gpu, "reference_upload_shader", include_str!("../../shaders/core/reference_upload.wgsl"))?;
     let upload = crate::ScreenPass::new(
@@ -477,7 +490,6 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         cache_dir: params.bool("cache")?.then(default_cache_dir),
         points: None,
         traced,
-        traced_group,
         upload,
         traced_per_light: Vec::new(),
     }))

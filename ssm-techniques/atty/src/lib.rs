@@ -56,6 +56,11 @@ pub const PARAMS: &[ParamSpec] = &[
         doc: "projection lookup point moved off the surface along its normal, in receiver-map texels",
     },
     ParamSpec {
+        name: "receiver_tolerance",
+        kind: ParamKind::Float { default: 2.0, min: 0.0, max: 64.0 },
+        doc: "receiver-map depths within this many texel footprints (world size of one receiver-map texel at the depth looked up) of a receiver count as that receiver: the SSM's bilinear lookup blends only those, and a point farther behind is hidden (in umbra)",
+    },
+    ParamSpec {
         name: "self_shadow_tolerance",
         kind: ParamKind::Float { default: 0.0, min: 0.0, max: 16.0 },
         doc: "a micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper)",
@@ -91,6 +96,8 @@ pub struct AttySettings {
     pub accumulation: wgpu::TextureFormat,
     /// Normal offset, texels.
     pub normal_offset: f32,
+    /// Same-receiver depth tolerance, receiver-map texel footprints.
+    pub receiver_tolerance: f32,
     /// Self-shadow tolerance, micro-patch widths.
     pub self_shadow_tolerance: f32,
 }
@@ -111,6 +118,7 @@ impl AttySettings {
                 _ => wgpu::TextureFormat::R32Float,
             },
             normal_offset: params.float("normal_offset")? as f32,
+            receiver_tolerance: params.float("receiver_tolerance")? as f32,
             self_shadow_tolerance: params.float("self_shadow_tolerance")? as f32,
         })
     }
@@ -142,6 +150,7 @@ impl SoftShadowMaps {
     /// A parameter or GPU error.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = AttySettings::from_params(setup.params)?;
+        check_receivers_resolved(setup, settings.ssm_size)?;
         let device = &setup.gpu.device;
         let depth_map = |label: &str, size: u32, geometry: Geometry, cull_mode: Option<wgpu::Face>, farthest: bool| {
             // No bias: micro-patches and receivers sit at their true depths.
@@ -156,7 +165,7 @@ impl SoftShadowMaps {
             occluder_map_size: settings.occluder_map_size as f32,
             soft_shadow_map_size: settings.ssm_size as f32,
             normal_offset: settings.normal_offset,
-            receiver_tolerance: 2.0,
+            receiver_tolerance: settings.receiver_tolerance,
             self_shadow_tolerance: settings.self_shadow_tolerance,
             // The baselines' default constant bias: 0.1% of the scene's diagonal.
             receiver_bias: 1e-3 * setup.scene.bounds.size().length(),
@@ -289,6 +298,30 @@ impl SoftShadowMaps {
             patches: settings.occluder_map_size * settings.occluder_map_size,
         })
     }
+}
+
+/// Fewest receiver-map texels across the receivers for the SSM to represent a penumbra on them.
+const MIN_RECEIVER_TEXELS: f32 = 4.0;
+
+/// The SSM lives on the receiver map of the light's frame. When that frame must be very wide (an
+/// occluder almost touching the light, which every technique's frame keeps), the receivers can
+/// shrink below a texel of it and would silently read as lit: refuse instead.
+fn check_receivers_resolved(setup: &TechniqueSetup<'_>, ssm_size: u32) -> Result<()> {
+    for (light, frame) in setup.scene.light_frames.iter().enumerate() {
+        let texels = frame.footprint_texels(&setup.scene.receiver_bounds, ssm_size);
+        if !setup.scene.receiver_bounds.is_empty() && texels.min_element() < MIN_RECEIVER_TEXELS {
+            return Err(Error::Unrepresentable {
+                technique: NAME.into(),
+                reason: format!(
+                    "light {light}'s frame is {:.1}° wide (an occluder lies almost in the light's plane), so the receivers cover only {:.1}×{:.1} texels of the {ssm_size}² soft shadow map; at least {MIN_RECEIVER_TEXELS} are needed",
+                    2.0 * frame.tan_half.max_element().atan().to_degrees(),
+                    texels.x,
+                    texels.y
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 impl ShadowTechnique for SoftShadowMaps {

@@ -34,11 +34,7 @@ pub const PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Int { default: 15, min: 1, max: 128 },
         doc: "samples per axis of the PCF filter (m; m² taps per pixel)",
     },
-    ParamSpec {
-        name: "receiver_plane",
-        kind: ParamKind::Bool { default: true },
-        doc: "compare each tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch",
-    },
+    ShadowMapSettings::RECEIVER_PLANE_PARAM,
     ShadowMapSettings::BIAS_PARAMS[0],
     ShadowMapSettings::BIAS_PARAMS[1],
     ShadowMapSettings::BIAS_PARAMS[2],

@@ -56,6 +56,12 @@ pub const PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Float { default: 0.5, min: 0.05, max: 4.0 },
         doc: "Gaussian standard deviation in units of the blur's half-width (the paper's N(0, 0.5))",
     },
+    ShadowMapSettings::RECEIVER_PLANE_PARAM,
+    ParamSpec {
+        name: "bilateral_depth",
+        kind: ParamKind::Float { default: 0.005, min: 0.0, max: 1.0 },
+        doc: "blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur)",
+    },
     ShadowMapSettings::BIAS_PARAMS[0],
     ShadowMapSettings::BIAS_PARAMS[1],
     ShadowMapSettings::BIAS_PARAMS[2],
@@ -71,14 +77,15 @@ struct SssmSettingsUniform {
     blocker_kernel: u32,
     blur_kernel: u32,
     gaussian: u32,
-    padding0: u32,
+    receiver_plane: u32,
     alpha: f32,
     beta: f32,
     sigma: f32,
     normal_offset: f32,
     pixel_scale: f32,
     light_half_size: f32,
-    padding1: [f32; 2],
+    bilateral_depth: f32,
+    padding: f32,
 }
 
 /// Separable soft shadow mapping.
@@ -149,20 +156,23 @@ impl SeparableSoftShadowMaps {
         let (blocker_kernel, blur_kernel) = (kernel("blocker_kernel")?, kernel("blur_kernel")?);
         let (alpha, beta, sigma) =
             (params.float("alpha")? as f32 * diagonal, params.float("beta")? as f32 * diagonal, params.float("sigma")? as f32);
+        let receiver_plane = u32::from(params.bool("receiver_plane")?);
+        let bilateral_depth = params.float("bilateral_depth")? as f32 * diagonal;
         let mut groups = Vec::new();
         for (light_index, light_frame) in setup.scene.light_frames.iter().enumerate() {
             let uniform = SssmSettingsUniform {
                 blocker_kernel,
                 blur_kernel,
                 gaussian,
-                padding0: 0,
+                receiver_plane,
                 alpha,
                 beta,
                 sigma,
                 normal_offset: map_settings.normal_offset,
                 pixel_scale: 2.0 * (camera.fov_y * 0.5).tan() / height as f32,
                 light_half_size: 0.5 * (light_frame.light.half_size.x + light_frame.light.half_size.y),
-                padding1: [0.0; 2],
+                bilateral_depth,
+                padding: 0.0,
             };
             let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(&format!("sssm_settings_uniform_{light_index}")),
