@@ -13,9 +13,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3};
-use ssm_core::{Error, Registry};
-use ssm_integration_tests::{Rendered, at, gpu, link_techniques, pixel_of, render};
+use ssm_core::Error;
+use ssm_integration_tests::registry;
 use ssm_scene::{Instance, Manifest, Mesh, RectLight, Role, Scene, SceneError, builtin, primitives};
+use ssm_testing::{Rendered, at, gpu, pixel_of, render};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;
@@ -188,14 +189,13 @@ fn check(technique: &str, (scene_name, scene): (&str, &Scene), expect: Expect, r
 
 #[test]
 fn every_technique_survives_every_extreme() {
-    link_techniques();
     let gpu = gpu();
-    let registry = Registry::global().unwrap();
+    let registry = registry();
     let mut failures = Vec::new();
     let mut runs = 0;
     for (scene_name, scene, expect) in extreme_scenes() {
         for info in registry.iter() {
-            match render(&gpu, &scene, info.name, &[], WIDTH, HEIGHT) {
+            match render(&gpu, &scene, info, &[], WIDTH, HEIGHT) {
                 Ok(rendered) => {
                     runs += 1;
                     if let Err(panic) =
@@ -219,20 +219,25 @@ fn every_technique_survives_every_extreme() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Non-finite geometry and lights are refused with a typed error before any rendering, by every technique.
 #[test]
 fn non_finite_geometry_is_a_typed_error_before_any_rendering() {
     let gpu = gpu();
-    let mut scene = builtin("parallel-square").unwrap().build();
-    scene.meshes[1].positions[2].y = f32::NAN;
-    match render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT) {
-        Err(Error::Scene(SceneError::NonFiniteVertex { vertex: 2, .. })) => {}
-        Err(other) => panic!("expected a non-finite vertex error, got: {other}"),
-        Ok(_) => panic!("a NaN vertex was rendered"),
+    for info in registry().iter() {
+        let mut scene = builtin("parallel-square").unwrap().build();
+        scene.meshes[1].positions[2].y = f32::NAN;
+        match render(&gpu, &scene, info, &[], WIDTH, HEIGHT) {
+            Err(Error::Scene(SceneError::NonFiniteVertex { vertex: 2, .. })) => {}
+            Err(other) => panic!("{}: expected a non-finite vertex error, got: {other}", info.name),
+            Ok(_) => panic!("{}: a NaN vertex was rendered", info.name),
+        }
+        let mut scene = builtin("parallel-square").unwrap().build();
+        scene.instances[1].transform.w_axis.x = f32::INFINITY;
+        let transform = render(&gpu, &scene, info, &[], WIDTH, HEIGHT);
+        assert!(matches!(transform, Err(Error::Scene(SceneError::InvalidTransform { .. }))), "{}", info.name);
+        let mut scene = builtin("parallel-square").unwrap().build();
+        scene.lights[0].half_size.x = f32::NAN;
+        let light = render(&gpu, &scene, info, &[], WIDTH, HEIGHT);
+        assert!(matches!(light, Err(Error::Scene(SceneError::InvalidLight { .. }))), "{}", info.name);
     }
-    let mut scene = builtin("parallel-square").unwrap().build();
-    scene.instances[1].transform.w_axis.x = f32::INFINITY;
-    assert!(matches!(render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT), Err(Error::Scene(SceneError::InvalidTransform { .. }))));
-    let mut scene = builtin("parallel-square").unwrap().build();
-    scene.lights[0].half_size.x = f32::NAN;
-    assert!(matches!(render(&gpu, &scene, "hard", &[], WIDTH, HEIGHT), Err(Error::Scene(SceneError::InvalidLight { .. }))));
 }

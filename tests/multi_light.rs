@@ -9,9 +9,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use glam::{Vec2, Vec3};
-use ssm_core::{Error, Registry};
-use ssm_integration_tests::{gpu, link_techniques, render};
+use ssm_core::Error;
+use ssm_integration_tests::registry;
 use ssm_scene::{RectLight, Scene, builtin};
+use ssm_testing::{gpu, render};
 
 const WIDTH: u32 = 80;
 const HEIGHT: u32 = 60;
@@ -37,16 +38,15 @@ fn scene_with(lights: Vec<RectLight>) -> Scene {
 
 #[test]
 fn each_light_of_three_equals_that_light_alone_for_every_technique() {
-    link_techniques();
     let gpu = gpu();
     let lights = three_lights();
     let all = scene_with(lights.clone());
     let mut failures = Vec::new();
     let mut checked = 0;
-    for info in Registry::global().unwrap().iter() {
+    for info in registry().iter() {
         // The ground truth with few rays and no cache: deterministic per pixel, and quick.
         let settings: &[(&str, &str)] = if info.name == "reference" { &[("samples", "4"), ("cache", "false")] } else { &[] };
-        let together = match render(&gpu, &all, info.name, settings, WIDTH, HEIGHT) {
+        let together = match render(&gpu, &all, info, settings, WIDTH, HEIGHT) {
             Ok(rendered) => rendered,
             Err(Error::MissingFeatures { .. } | Error::LimitTooLow { .. }) => continue,
             Err(e) => panic!("{}: {e}", info.name),
@@ -54,7 +54,7 @@ fn each_light_of_three_equals_that_light_alone_for_every_technique() {
         let mut alone_images = Vec::new();
         for (k, light) in lights.iter().enumerate() {
             let of_three = together.renderer.read_visibility(k, info.name).unwrap();
-            let alone = render(&gpu, &scene_with(vec![*light]), info.name, settings, WIDTH, HEIGHT).unwrap().visibility;
+            let alone = render(&gpu, &scene_with(vec![*light]), info, settings, WIDTH, HEIGHT).unwrap().visibility;
             let worst = of_three.iter().zip(&alone).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
             if worst > TOLERANCE {
                 failures.push(format!("{}: light {k} of three differs from light {k} alone by up to {worst}", info.name));

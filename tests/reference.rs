@@ -13,8 +13,8 @@
 
 use glam::{Vec2, Vec3};
 use ssm_core::reference::{GroundTruth, SurfacePoint, parallel_rectangle_visibility};
-use ssm_integration_tests::{gpu, render};
 use ssm_scene::builtin;
+use ssm_testing::{gpu, render};
 
 const SIZE: (u32, u32) = (128, 96);
 
@@ -24,7 +24,7 @@ fn errors(samples: u32) -> (f32, f32, usize) {
     let scene = builtin("parallel-square").unwrap().build();
     let settings = [("samples", samples.to_string()), ("cache", "false".to_owned())];
     let settings: Vec<(&str, &str)> = settings.iter().map(|(k, v)| (*k, v.as_str())).collect();
-    let rendered = render(&gpu, &scene, "reference", &settings, SIZE.0, SIZE.1).unwrap();
+    let rendered = render(&gpu, &scene, &ssm_core::reference::INFO, &settings, SIZE.0, SIZE.1).unwrap();
     let positions = rendered.renderer.read_positions().unwrap();
     let light = &scene.lights[0];
     let (mut max, mut sum, mut count) = (0.0f32, 0.0f32, 0usize);

@@ -89,3 +89,96 @@ fn unknown_imports_and_cycles_are_errors() {
     assert_eq!(composed.matches("fn c()").count(), 1, "{composed}");
     assert!(composed.find("fn c()") < composed.find("fn a()"));
 }
+
+/// A WGSL struct's size and its members' names and byte offsets.
+type WgslLayout = (u32, Vec<(String, u32)>);
+
+/// The size and field offsets of a WGSL struct, from naga's reflection of `source` (imports resolved).
+fn wgsl_layout(source: &str, imports: &[(&str, &str)], name: &str) -> Result<WgslLayout, String> {
+    let lookup = |path: &str| COMMON_SHADERS.iter().chain(imports).find(|(p, _)| *p == path).map(|(_, text)| (*text).to_owned());
+    let composed = compose_with(source, &lookup)?;
+    let module = naga::front::wgsl::parse_str(&composed).map_err(|e| e.emit_to_string(&composed))?;
+    module
+        .types
+        .iter()
+        .find_map(|(_, ty)| match &ty.inner {
+            naga::TypeInner::Struct { members, span } if ty.name.as_deref() == Some(name) => {
+                Some((*span, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect()))
+            }
+            _ => None,
+        })
+        .ok_or_else(|| format!("no struct `{name}` in the WGSL"))
+}
+
+/// Differences between a Rust uniform and the WGSL struct that reads it: size, and the offset of
+/// every WGSL member (Rust fields named `_pad...`/`pad...` are padding and need no WGSL twin).
+fn layout_mismatches(rust: &ssm_core::RustLayout, (size, members): &WgslLayout) -> Vec<String> {
+    let mut out = Vec::new();
+    if rust.size != *size as usize {
+        out.push(format!("{} is {} bytes, the WGSL struct {size}", rust.name, rust.size));
+    }
+    for (name, offset) in members {
+        match rust.fields.iter().find(|(field, _)| field == name) {
+            Some((_, rust_offset)) if *rust_offset == *offset as usize => {}
+            Some((_, rust_offset)) => out.push(format!("{}.{name} is at byte {rust_offset}, in WGSL at {offset}", rust.name)),
+            None if name.starts_with("_pad") || name.starts_with("pad") => {}
+            None => out.push(format!("{} has no field `{name}` (WGSL offset {offset})", rust.name)),
+        }
+    }
+    for (field, _) in rust.fields {
+        let padding = field.starts_with("_pad") || field.starts_with("pad");
+        if !padding && !members.iter().any(|(name, _)| name == field) {
+            out.push(format!("{}.{field} has no WGSL member", rust.name));
+        }
+    }
+    out
+}
+
+/// Every registered technique's uniforms, and the framework's own, match the WGSL structs the
+/// shaders read them as: a field added, moved or resized on one side only fails here, without a GPU.
+#[test]
+fn every_uniform_matches_its_wgsl_struct() {
+    use ssm_core::UniformStruct;
+    let core_shader = |file: &str| std::fs::read_to_string(shaders_dir().join(file)).unwrap();
+    let mut checks: Vec<(String, ssm_core::RustLayout, Result<WgslLayout, String>)> = vec![
+        (
+            "core/light_frame".into(),
+            ssm_core::LightFrameUniform::LAYOUT,
+            wgsl_layout(&core_shader("core/light_depth.wgsl"), &[], "LightFrame"),
+        ),
+        ("core/camera".into(), ssm_core::CameraUniform::LAYOUT, wgsl_layout(&core_shader("common/camera.wgsl"), &[], "Camera")),
+        (
+            "core/light_depth".into(),
+            ssm_core::DepthBiasUniform::LAYOUT,
+            wgsl_layout(&core_shader("core/light_depth.wgsl"), &[], "DepthBias"),
+        ),
+    ];
+    let registry = ssm_integration_tests::registry();
+    for info in registry.iter() {
+        for check in info.uniforms {
+            checks.push((info.name.to_owned(), check.rust, wgsl_layout(check.wgsl_source, check.imports, check.wgsl_struct)));
+        }
+    }
+    let techniques_checked = registry.iter().filter(|i| !i.uniforms.is_empty()).count();
+    assert!(techniques_checked >= 5, "only {techniques_checked} techniques declare their uniforms");
+    let mut failures = Vec::new();
+    for (owner, rust, wgsl) in &checks {
+        match wgsl {
+            Ok(layout) => failures.extend(layout_mismatches(rust, layout).into_iter().map(|m| format!("{owner}: {m}"))),
+            Err(e) => failures.push(format!("{owner}: {e}")),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The comparison itself fails on a moved field, a resized struct and a missing member.
+#[test]
+fn a_mismatched_layout_is_reported() {
+    let wgsl = (16, vec![("a".to_owned(), 0), ("b".to_owned(), 4), ("_pad0".to_owned(), 8), ("_pad1".to_owned(), 12)]);
+    let good = ssm_core::RustLayout { name: "Good", size: 16, fields: &[("a", 0), ("b", 4), ("_pad0", 8), ("_pad1", 12)] };
+    assert!(layout_mismatches(&good, &wgsl).is_empty());
+    let moved = ssm_core::RustLayout { name: "Moved", size: 16, fields: &[("b", 0), ("a", 4), ("_pad", 8)] };
+    assert_eq!(layout_mismatches(&moved, &wgsl).len(), 2);
+    let short = ssm_core::RustLayout { name: "Short", size: 12, fields: &[("a", 0), ("b", 4), ("c", 8)] };
+    assert_eq!(layout_mismatches(&short, &wgsl).len(), 2, "{:?}", layout_mismatches(&short, &wgsl));
+}

@@ -58,7 +58,7 @@ fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     }
     // Depths within this of the lookup's count as the same receiver: a constant bias plus
     // `receiver_tolerance` texel footprints of the receiver map at this depth.
-    let tolerance = settings.receiver_bias + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);
+    let tolerance = scene_length(frame, settings.receiver_bias) + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);
     // The SSM holds the occlusion of the receiver nearest the light's centre in each texel. A point
     // behind it (an object with the role `both` between it and the light) has no value of its own:
     // count it as in umbra, as a hard shadow would.

@@ -12,7 +12,7 @@ struct AttySettings {
     // A micro-patch less than this many of its own widths in front of a receiver counts as the
     // receiver's own surface and hides nothing (objects with the role `both` are in both maps).
     self_shadow_tolerance: f32,
-    // Constant depth tolerance of the hidden-receiver test, world units (as the baselines' constant bias).
+    // Constant depth tolerance of the hidden-receiver test, a fraction of the scene's diagonal (as the baselines' constant bias).
     receiver_bias: f32,
     _pad0: f32,
     _pad1: f32,

@@ -18,7 +18,14 @@ struct LightFrame {
     normal: vec4<f32>,
     // x, y: tangents of the frustum's half angles along u and v; z: near; w: far.
     projection: vec4<f32>,
+    // x: the diagonal of the scene's bounding box, the scale of scene-relative settings; y, z, w: unused.
+    scene: vec4<f32>,
 };
+
+// A length given as a fraction of the scene's diagonal (biases, thresholds), in world units.
+fn scene_length(frame: LightFrame, fraction: f32) -> f32 {
+    return fraction * frame.scene.x;
+}
 
 // Distance of `world` in front of the light's plane (its linear light-space depth).
 fn light_depth(frame: LightFrame, world: vec3<f32>) -> f32 {

@@ -36,7 +36,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
         var reuse = false;
         if (screen.z > 0.0 && on_screen(screen.xy)) {
             let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
-            if (other.x >= 0.0 && abs(d - other.x) < settings.alpha) {
+            if (other.x >= 0.0 && abs(d - other.x) < scene_length(frame, settings.alpha)) {
                 sum += other.y;
                 count += other.z;
                 reused += 1.0;
@@ -66,8 +66,9 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     var radii = kernel_screen_radii(point.position, point.normal, light_uv_depth(frame, point.position).xy, extent);
     if (radii.x < 0.0) {
         // The plane runs along the light's rays: the width on a surface facing the camera.
-        let half_width = settings.light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6);
-        radii = vec2<f32>(half_width / max(view_depth(point.position) * settings.pixel_scale, 1e-9));
+        // The mean of the rectangle's half-sides: a single width.
+        let light_half_size = 0.5 * (frame.u_axis.w + frame.v_axis.w);
+        radii = vec2<f32>(facing_radius(point.position, light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6)));
     }
     // A penumbra under half a pixel keeps the hard value.
     if (max(radii.x, radii.y) < 0.5) {

@@ -12,21 +12,19 @@ struct SssmSettings {
     gaussian: u32,
     // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
     receiver_plane: u32,
-    // Reuse thresholds, world units: light-depth difference (α) and normal-adjusted camera-depth difference (β).
+    // Reuse thresholds as fractions of the scene's diagonal (scene_length): light-depth
+    // difference (α) and normal-adjusted camera-depth difference (β).
     alpha: f32,
     beta: f32,
     // Standard deviation of the Gaussian, in units of the kernel's half-width.
     sigma: f32,
     // Normal offset of shadow-map lookups, texels.
     normal_offset: f32,
-    // World size of one pixel per unit of distance from the eye: 2 tan(fov_y / 2) / height.
-    pixel_scale: f32,
-    // Light half-size used where the kernel's screen footprint cannot be found (a tangent plane
-    // along the light's rays): the mean of the rectangle's two half-sides.
-    light_half_size: f32,
-    // Depth tolerance of the blurs' bilateral weights, world units; 0: no bilateral weighting.
+    // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    _pad: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 };
 
 @group(2) @binding(0) var<uniform> camera: Camera;
@@ -109,12 +107,16 @@ fn on_screen(pixel: vec2<f32>) -> bool {
     return all(pixel >= vec2<f32>(0.0)) && all(pixel < camera.viewport.xy);
 }
 
-// Depth of `world` along the camera's view direction: a pixel's footprint on a surface facing
-// the camera is this times `pixel_scale`.
-fn view_depth(world: vec3<f32>) -> f32 {
-    let centre = far_point(camera.viewport.xy * 0.5);
-    let forward = normalize(centre - camera.position.xyz);
-    return dot(world - camera.position.xyz, forward);
+// Half-width in pixels of a blur `half_width` world units wide on a surface at `world` facing the
+// camera: the fallback where the kernel's footprint on the tangent plane cannot be found.
+fn facing_radius(world: vec3<f32>, half_width: f32) -> f32 {
+    let centre = camera.viewport.xy * 0.5;
+    let eye = camera.position.xyz;
+    let forward = normalize(far_point(centre) - eye);
+    // World size of one pixel per unit of distance along the view direction.
+    let far = far_point(centre);
+    let pixel_scale = distance(far, far_point(centre + vec2<f32>(0.0, 1.0))) / dot(far - eye, forward);
+    return half_width / max(dot(world - eye, forward) * pixel_scale, 1e-9);
 }
 
 // Shadow-map taps compare with this depth (the receiver model shared with pcss).
@@ -178,7 +180,7 @@ fn bilateral_weight(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel
         return 0.0;
     }
     let eye = camera.position.xyz;
-    let gap = (distance(other.xyz, eye) - distance(expected.xyz, eye)) / settings.bilateral_depth;
+    let gap = (distance(other.xyz, eye) - distance(expected.xyz, eye)) / scene_length(frame, settings.bilateral_depth);
     let turn = max(dot(normal, textureLoad(gbuffer_normal, texel, 0).xyz), 0.0);
     // The normal term falls to 1/2 at about 23°.
     return exp(-gap * gap) * pow(turn, 8.0);

@@ -44,7 +44,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
             let texel = vec2<i32>(row);
             let other = textureLoad(gbuffer_position, texel, 0);
             let expected = tangent_plane_point(rays, point.position, point.normal, row);
-            if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < settings.beta) {
+            if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < scene_length(frame, settings.beta)) {
                 value = textureLoad(horizontal_blur, texel, 0).x;
                 weight *= bilateral_weight(rays, point.position, point.normal, row);
                 reuse = true;

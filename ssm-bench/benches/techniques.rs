@@ -12,26 +12,14 @@
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ssm_bench::{output_requirements, registry};
+use ssm_bench::{bench_size, output_requirements, registry};
 use ssm_core::{GpuContext, Renderer, TechniqueKind};
 use ssm_scene::BUILTIN_SCENES;
-
-/// The image size from `SSM_BENCH_SIZE`.
-fn bench_size() -> (u32, u32) {
-    match std::env::var("SSM_BENCH_SIZE").as_deref() {
-        Ok("full") => (1280, 720),
-        Ok(text) => text
-            .split_once('x')
-            .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
-            .unwrap_or_else(|| panic!("SSM_BENCH_SIZE={text}: expected WxH or full")),
-        Err(_) => (256, 192),
-    }
-}
 
 fn techniques(c: &mut Criterion) {
     let registry = registry().unwrap_or_else(|e| panic!("{e}"));
     let gpu = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
-    let (width, height) = bench_size();
+    let (width, height) = bench_size().unwrap_or_else(|e| panic!("{e}"));
     let realtime: Vec<_> = registry.iter().filter(|i| i.kind == TechniqueKind::Realtime).collect();
     for scene_entry in BUILTIN_SCENES {
         let scene = scene_entry.build();
@@ -57,7 +45,7 @@ fn techniques(c: &mut Criterion) {
                     let mut total = Duration::ZERO;
                     for _ in 0..iterations {
                         let timings = renderer.render(technique.as_mut(), info.name).unwrap_or_else(|e| panic!("{}: {e}", info.name));
-                        total += Duration::from_secs_f64(timings.gpu_ms.unwrap_or(timings.cpu_wall_ms) * 1e-3);
+                        total += Duration::from_secs_f64(timings.frame_ms() * 1e-3);
                     }
                     total
                 });

@@ -1,5 +1,6 @@
 //! Support for the `ssm` command-line tool and the criterion benches: the
-//! list of linked technique crates and the rendering of one technique to files.
+//! registry (every technique crate linked through the `ssm-techniques`
+//! facade), the bench image size, and the rendering of one technique to files.
 
 pub mod report;
 pub mod sweep;
@@ -10,20 +11,30 @@ use serde_json::json;
 use ssm_core::image_io::write_exr_positions;
 use ssm_core::{GpuContext, ParamValues, Registry, Renderer, Requirements, TechniqueInfo};
 
-/// Keeps every technique crate linked into the binary, so that their
-/// registrations reach the registry. A new technique crate adds one line here
-/// and one dependency in this crate's manifest.
-pub fn link_techniques() -> [&'static str; 6] {
-    [ssm_core::reference::link(), ssm_atty::link(), ssm_hard::link(), ssm_multi_sm::link(), ssm_pcss::link(), ssm_sssm::link()]
-}
-
-/// The registry, with every technique crate linked.
+/// The registry, with every technique crate linked (through the
+/// `ssm-techniques` facade: a new technique crate is one line in its manifest).
 ///
 /// # Errors
 /// A duplicate technique name.
 pub fn registry() -> ssm_core::Result<&'static Registry> {
-    link_techniques();
-    Registry::global()
+    ssm_techniques::registry()
+}
+
+/// The image size of the criterion benches: `SSM_BENCH_SIZE=WxH`, or `full`
+/// for 1280×720; 256×192 by default, small enough for lavapipe.
+///
+/// # Errors
+/// A value that is neither `full` nor `WxH` with positive sides.
+pub fn bench_size() -> Result<(u32, u32), String> {
+    match std::env::var("SSM_BENCH_SIZE").as_deref() {
+        Ok("full") => Ok((1280, 720)),
+        Ok(text) => text
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
+            .filter(|&(w, h): &(u32, u32)| w > 0 && h > 0)
+            .ok_or_else(|| format!("SSM_BENCH_SIZE={text}: expected WxH or full")),
+        Err(_) => Ok((256, 192)),
+    }
 }
 
 /// Median of `values` (the mean of the middle two for an even count); `None` when empty.
@@ -77,8 +88,8 @@ pub fn render_technique(
         "diagnostics": measured.diagnostics.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
     });
     let file = dir.join("timings.json");
-    let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::Write { file: file.clone(), message: e.to_string() })?;
-    std::fs::write(&file, text).map_err(|e| ssm_core::Error::Write { file, message: e.to_string() })?;
+    let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::write(&file, e))?;
+    std::fs::write(&file, text).map_err(|e| ssm_core::Error::write(&file, e))?;
     Ok(measured)
 }
 

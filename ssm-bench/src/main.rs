@@ -34,8 +34,8 @@ enum Command {
 
 #[derive(clap::Args)]
 struct SweepArgs {
-    /// A built-in scene name, a scene manifest (.toml) or a model file.
-    #[arg(long, required_unless_present = "list_presets")]
+    /// A built-in scene name, a scene manifest (.toml) or a model file; default: the preset's first scene.
+    #[arg(long, required_unless_present_any = ["list_presets", "preset"])]
     scene: Option<String>,
     /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step);
     /// `scene.light_scale` and `scene.occluder_lift` vary the scene; repeatable.
@@ -50,9 +50,9 @@ struct SweepArgs {
     /// Fixed parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
-    /// The measure on the y axis (`time` for the papers' timing figures).
-    #[arg(long, value_enum, default_value = "mae-penumbra")]
-    error: sweep::ErrorAxis,
+    /// The measure on the y axis (`time` for the papers' timing figures); default: the preset's, else mae-penumbra.
+    #[arg(long, value_enum)]
+    error: Option<sweep::ErrorAxis>,
     /// The x axis: `time`, or a varied parameter as `<technique>.<param>` (`scene.light_scale`); default: the preset's, else time.
     #[arg(long)]
     x: Option<String>,
@@ -65,9 +65,9 @@ struct SweepArgs {
     /// Frames timed per point after one warm-up.
     #[arg(long, default_value_t = 3)]
     frames: u32,
-    /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1).
-    #[arg(long, value_enum, default_value = "all")]
-    pixels: report::PixelSet,
+    /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
+    #[arg(long, value_enum)]
+    pixels: Option<report::PixelSet>,
     /// Output directory: sweep.csv, sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
@@ -361,95 +361,103 @@ fn compare(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
-/// One technique point of a sweep: the technique, its parameters, and its varied values (`<technique>.<param>`, value).
-type SweepPoint = (&'static TechniqueInfo, ParamValues, Vec<(String, String)>);
+/// Every varied value of one sweep row, `(qualified parameter, value)`, scene ones first.
+type VariedValues = Vec<(String, String)>;
 
-fn sweep_command(args: &SweepArgs) -> Result<()> {
-    if args.list_presets {
-        for preset in sweep::PRESETS {
-            say!(
-                "{:<22} {}\n{:<22} --vary {}  (x axis: {})",
-                preset.name,
-                preset.summary,
-                "",
-                preset.varies.join(" --vary "),
-                preset.x_axis
-            );
-        }
-        return Ok(());
+/// A sweep with every default resolved: the scene, the axes, the pixels and the plan.
+struct ResolvedSweep {
+    scene_spec: String,
+    out: PathBuf,
+    plan: sweep::SweepPlan,
+    x_axis: String,
+    error: sweep::ErrorAxis,
+    pixels: report::PixelSet,
+}
+
+fn list_presets(registry: &ssm_core::Registry) -> Result<()> {
+    for preset in sweep::presets(registry)? {
+        let owner = preset.owner.map_or_else(String::new, |o| format!(" [{o}]"));
+        say!("{}{owner}: {}", preset.name, preset.summary);
+        say!(
+            "  --scene {}  --vary {}  (x: {}, y: {}, pixels: {})",
+            preset.scenes.join("|"),
+            preset.varies.join(" --vary "),
+            preset.x_axis,
+            sweep_axis_name(preset.y_axis),
+            sweep_pixels_name(preset.pixels)
+        );
     }
-    let (Some(scene_spec), Some(out)) = (&args.scene, &args.out) else { bail!("--scene and --out are required") };
-    let registry = registry()?;
+    Ok(())
+}
+
+fn sweep_axis_name(axis: sweep::ErrorAxis) -> String {
+    clap::ValueEnum::to_possible_value(&axis).map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+fn sweep_pixels_name(pixels: report::PixelSet) -> String {
+    clap::ValueEnum::to_possible_value(&pixels).map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+/// The preset's defaults under the command line's choices, and the plan, checked before the GPU is touched.
+fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&str, &str, &str)]) -> Result<ResolvedSweep> {
+    let preset = args.preset.as_deref().map(|name| sweep::preset(registry, name)).transpose()?;
     let mut specs: Vec<String> = args.varies.clone();
-    let mut x_axis = args.x.clone();
-    if let Some(name) = &args.preset {
-        let preset = sweep::preset(name)?;
-        specs.extend(preset.varies.iter().map(|v| (*v).to_owned()));
-        x_axis = x_axis.or_else(|| Some(preset.x_axis.to_owned()));
+    if let Some(preset) = &preset {
+        specs.extend(preset.varies.iter().cloned());
     }
-    let x_axis = x_axis.unwrap_or_else(|| "time".to_owned());
     if specs.is_empty() {
         bail!("nothing to sweep: give --vary or --preset (see --list-presets)");
     }
-    let varies: Vec<sweep::Vary> = specs.iter().map(|s| sweep::Vary::parse(s)).collect::<Result<_>>()?;
-    if x_axis != "time" && !varies.iter().any(|v| v.params.iter().any(|n| format!("{}.{n}", v.technique) == x_axis)) {
+    let scene_spec = args
+        .scene
+        .clone()
+        .or_else(|| preset.as_ref().and_then(|p| p.scenes.first().cloned()))
+        .context("--scene is required (the preset names no scene)")?;
+    let out = args.out.clone().context("--out is required")?;
+    let plan = sweep::SweepPlan::new(registry, &specs, settings)?;
+    let x_axis = args.x.clone().or_else(|| preset.as_ref().map(|p| p.x_axis.clone())).unwrap_or_else(|| "time".to_owned());
+    if x_axis != "time" && !plan.varied.contains(&x_axis) {
         bail!("--x {x_axis}: not a varied parameter (give `time` or one of the --vary parameters as <technique>.<param>)");
     }
-    let scene_axes: Vec<&sweep::Vary> = varies.iter().filter(|v| v.technique == sweep::SCENE_AXIS).collect();
-    let mut techniques: Vec<&'static TechniqueInfo> = Vec::new();
-    for vary in varies.iter().filter(|v| v.technique != sweep::SCENE_AXIS) {
-        let info = registry.get(&vary.technique)?;
-        if !techniques.iter().any(|t| t.name == info.name) {
-            techniques.push(info);
-        }
-    }
-    if techniques.is_empty() {
-        bail!("no technique is varied: add a --vary <technique>.<param>=... (scene parameters alone compare nothing)");
-    }
-    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
-    // Every grid point resolved before the GPU is touched: a bad value fails fast.
-    let scene_points: Vec<Vec<(String, String)>> = sweep::grid(&scene_axes);
-    let scene_overrides: Vec<sweep::SceneOverrides> =
-        scene_points.iter().map(|p| sweep::SceneOverrides::from_point(p)).collect::<Result<_>>()?;
-    let mut points: Vec<SweepPoint> = Vec::new();
-    for info in &techniques {
-        let axes: Vec<&sweep::Vary> = varies.iter().filter(|v| v.technique == info.name).collect();
-        for point in sweep::grid(&axes) {
-            let mut params = params_for(info, &settings)?;
-            for (name, value) in &point {
-                params.set(name, value)?;
-            }
-            let qualified = point.into_iter().map(|(name, value)| (format!("{}.{name}", info.name), value)).collect();
-            points.push((info, params, qualified));
-        }
-    }
-    let base_scene = load_scene(scene_spec)?;
+    let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::MaePenumbra);
+    let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(report::PixelSet::All);
+    Ok(ResolvedSweep { scene_spec, out, plan, x_axis, error, pixels })
+}
+
+/// Measures every point of the plan, each scene point with its own renderer and ground truth;
+/// returns the rows and, per row, every varied value (scene ones first).
+fn run_sweep(
+    gpu: &GpuContext,
+    args: &SweepArgs,
+    registry: &ssm_core::Registry,
+    sweep: &ResolvedSweep,
+    settings: &[(&str, &str, &str)],
+) -> Result<(Vec<report::Row>, Vec<VariedValues>)> {
+    let base_scene = load_scene(&sweep.scene_spec)?;
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
-    let reference_params = params_for(reference_info, &settings)?;
+    let reference_params = params_for(reference_info, settings)?;
     let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
-    for (info, params, _) in &points {
+    for (info, params, _) in &sweep.plan.points {
         needs = needs.union((info.requirements)(params)?);
     }
-    let gpu = GpuContext::new()?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let progress = ProgressBar::new(((points.len() + 1) * scene_points.len()) as u64);
+    let plan = &sweep.plan;
+    let progress = ProgressBar::new(((plan.points.len() + 1) * plan.scene_points.len()) as u64);
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     let (mut rows, mut varied) = (Vec::new(), Vec::new());
-    for (scene_point, overrides) in scene_points.iter().zip(&scene_overrides) {
-        // Each scene gets its own renderer and ground truth.
-        let scene = overrides.apply(&base_scene).with_context(|| format!("scene {scene_spec} with {scene_point:?}"))?;
+    for (scene_point, overrides) in plan.scene_points.iter().zip(&plan.scene_overrides) {
+        let scene = overrides.apply(&base_scene).with_context(|| format!("scene {} with {scene_point:?}", sweep.scene_spec))?;
         let scene_name = if scene_point.is_empty() {
-            scene_spec.clone()
+            sweep.scene_spec.clone()
         } else {
-            format!("{scene_spec}[{}]", scene_point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";"))
+            format!("{}[{}]", sweep.scene_spec, scene_point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";"))
         };
-        let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+        let mut renderer = Renderer::new(gpu, &scene, args.width, args.height, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
         let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
-        let covered = report::pixel_mask(&renderer, args.pixels)?;
+        let covered = report::pixel_mask(&renderer, sweep.pixels)?;
         progress.inc(1);
-        for (info, params, technique_point) in &points {
+        for (info, params, technique_point) in &plan.points {
             progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
             let measured = report::measure(&mut renderer, info, params, args.frames)?;
             rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
@@ -460,20 +468,31 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         }
     }
     progress.finish_and_clear();
-    std::fs::write(out.join("sweep.csv"), report::csv(&rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
+    Ok((rows, varied))
+}
 
+/// `sweep.csv`, the plot (PNG and SVG) and the table on stdout.
+fn write_sweep(
+    gpu: &GpuContext,
+    args: &SweepArgs,
+    sweep: &ResolvedSweep,
+    rows: &[report::Row],
+    varied: &[Vec<(String, String)>],
+) -> Result<()> {
+    let (out, x_axis, error) = (&sweep.out, &sweep.x_axis, sweep.error);
+    std::fs::write(out.join("sweep.csv"), report::csv(rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
     // One series per technique and combination of the varied values that are not on the x axis.
     let plot_points: Vec<sweep::PlotPoint> = rows
         .iter()
-        .zip(&varied)
+        .zip(varied)
         .map(|(row, values)| {
             let prefix = format!("{}.", row.technique);
             let others: Vec<String> =
-                values.iter().filter(|(k, _)| *k != x_axis).map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k))).collect();
+                values.iter().filter(|(k, _)| k != x_axis).map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k))).collect();
             let x = if x_axis == "time" {
                 sweep::time_of(row)
             } else {
-                values.iter().find(|(k, _)| *k == x_axis).and_then(|(_, v)| v.parse().ok()).unwrap_or(f64::NAN)
+                values.iter().find(|(k, _)| k == x_axis).and_then(|(_, v)| v.parse().ok()).unwrap_or(f64::NAN)
             };
             let series = if x_axis == "time" {
                 row.technique.clone()
@@ -481,27 +500,27 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
                 std::iter::once(row.technique.clone()).chain(others.iter().cloned()).collect::<Vec<_>>().join(" ")
             };
             let label = if x_axis == "time" { sweep::point_label(values) } else { String::new() };
-            sweep::PlotPoint { series, x, y: args.error.of(row), label }
+            sweep::PlotPoint { series, x, y: error.of(row), label }
         })
         .collect();
     let axes = sweep::PlotAxes {
         x_label: if x_axis == "time" { "time per frame, ms (log)".to_owned() } else { x_axis.clone() },
-        y_label: format!("{} (log)", args.error.label()),
+        y_label: format!("{} (log)", error.label()),
         log_x: x_axis == "time",
-        pareto: x_axis == "time" && args.error != sweep::ErrorAxis::Time,
+        pareto: x_axis == "time" && error != sweep::ErrorAxis::Time,
     };
-    let title = format!("{} at {}x{} on {}", scene_spec, args.width, args.height, gpu.info.name);
+    let title = format!("{} at {}x{} on {}", sweep.scene_spec, args.width, args.height, gpu.info.name);
     sweep::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
     let front = if axes.pareto { sweep::pareto_front(&plot_points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>()) } else { Vec::new() };
-    for (index, (row, values)) in rows.iter().zip(&varied).enumerate() {
+    for (index, (row, values)) in rows.iter().zip(varied).enumerate() {
         let mark = if front.contains(&index) { "*" } else { " " };
         say!(
             "{mark} {:<10} {:<40} {:>9.3} ms  {} {:.4}",
             row.technique,
             sweep::point_label(values),
             sweep::time_of(row),
-            args.error.label(),
-            args.error.of(row)
+            error.label(),
+            error.of(row)
         );
     }
     if axes.pareto {
@@ -509,4 +528,18 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
     }
     say!("wrote {}, {} and {}", out.join("sweep.csv").display(), out.join("sweep.png").display(), out.join("sweep.svg").display());
     Ok(())
+}
+
+fn sweep_command(args: &SweepArgs) -> Result<()> {
+    let registry = registry()?;
+    if args.list_presets {
+        return list_presets(registry);
+    }
+    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
+    // Every grid point resolved before the GPU is touched: a bad value fails fast.
+    let sweep = resolve_sweep(args, registry, &settings)?;
+    let gpu = GpuContext::new()?;
+    std::fs::create_dir_all(&sweep.out).with_context(|| format!("creating {}", sweep.out.display()))?;
+    let (rows, varied) = run_sweep(&gpu, args, registry, &sweep, &settings)?;
+    write_sweep(&gpu, args, &sweep, &rows, &varied)
 }

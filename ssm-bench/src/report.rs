@@ -131,7 +131,7 @@ pub fn write_images(
     coverage: &[bool],
     reference: Option<(&Measured, &[bool])>,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Write { file: dir.into(), message: e.to_string() })?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
     for (light, visibility) in measured.visibility.iter().enumerate() {
         let stem = visibility_stem(light);
         write_exr_gray(&dir.join(format!("{stem}.exr")), width, height, visibility, coverage)?;
@@ -148,9 +148,9 @@ pub fn write_images(
         for (light, (truth, image)) in reference.visibility.iter().zip(&measured.visibility).enumerate() {
             let file = dir.join(if light == 0 { "heatmap.png".to_owned() } else { format!("heatmap-light{light}.png") });
             let rgb = heat_map(truth, image, covered, 0.5);
-            let picture = image::RgbImage::from_raw(width, height, rgb)
-                .ok_or_else(|| Error::Write { file: file.clone(), message: "buffer size".into() })?;
-            picture.save(&file).map_err(|e| Error::Write { file: file.clone(), message: e.to_string() })?;
+            let picture =
+                image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| Error::write(&file, ssm_core::Reason("buffer size".into())))?;
+            picture.save(&file).map_err(|e| Error::write(&file, e))?;
         }
     }
     Ok(())

@@ -5,10 +5,12 @@
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 
-use crate::report::Row;
+use ssm_core::{ParamValues, Registry, TechniqueInfo, TechniqueKind};
+
+use crate::report::{PixelSet, Row};
 
 /// One axis of a sweep: parameters of one technique that vary together.
-/// `pcss.pcf_kernel=7,15,21` varies one; `pcss.blocker_kernel:pcf_kernel=7:15,11:21`
+/// `mine.kernel=7,15,21` varies one; `mine.search:kernel=7:15,11:21`
 /// varies two in step (the kernel pairs of Buades et al., Table 4).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vary {
@@ -41,78 +43,159 @@ impl Vary {
     }
 }
 
-/// A named sweep: the techniques and their varies (the studies of the papers).
-#[derive(Clone, Copy, Debug)]
-pub struct Preset {
+/// A sweep preset as the tool runs it: one a technique declares
+/// ([`ssm_core::Preset`], next to its parameters), or `trade`, assembled from
+/// every technique's quality knob ([`ssm_core::TechniqueInfo::trade`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PresetSpec {
     /// Name for `--preset`.
-    pub name: &'static str,
+    pub name: String,
     /// What it reproduces.
-    pub summary: &'static str,
+    pub summary: String,
+    /// The technique that declares it (`None` for `trade`).
+    pub owner: Option<&'static str>,
+    /// Scenes it is meant for; the first is used without `--scene`.
+    pub scenes: Vec<String>,
     /// `--vary` specifications.
-    pub varies: &'static [&'static str],
+    pub varies: Vec<String>,
     /// The plot's x axis unless `--x` says otherwise: `time` or a varied parameter.
-    pub x_axis: &'static str,
+    pub x_axis: String,
+    /// The plot's y axis unless `--error` says otherwise.
+    pub y_axis: ErrorAxis,
+    /// The pixels the errors cover unless `--pixels` says otherwise.
+    pub pixels: PixelSet,
 }
 
-/// The built-in presets.
-pub const PRESETS: &[Preset] = &[
-    Preset {
-        name: "trade",
-        summary: "the baselines' trade curves: PCSS kernel pairs, multi-sm sample counts, hard shadow-map sizes",
-        varies: &[
-            "pcss.blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41",
-            "multi-sm.samples=1,4,16,64",
-            "hard.shadow_map_size=512,1024,2048,4096",
-        ],
-        x_axis: "time",
-    },
-    Preset {
-        name: "pcss-kernels",
-        summary: "PCSS with the kernel pairs of Buades et al., Table 4 (7/15, 11/21, 29/41)",
-        varies: &["pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41"],
-        x_axis: "time",
-    },
-    Preset {
-        name: "multi-sm-samples",
-        summary: "multi-sm with K = 1, 4, 16, 64, 256 shadow maps",
-        varies: &["multi-sm.samples=1,4,16,64,256"],
-        x_axis: "time",
-    },
-    Preset {
-        name: "shadow-map-size",
-        summary: "hard and PCSS against shadow-map resolution",
-        varies: &["hard.shadow_map_size=256,512,1024,2048,4096", "pcss.shadow_map_size=256,512,1024,2048,4096"],
-        x_axis: "time",
-    },
-    Preset {
-        name: "sssm-table4",
-        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse (use on leaves, the plant scene's nearest)",
-        varies: &[
-            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
-            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
-            "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
-        ],
-        x_axis: "time",
-    },
-    Preset {
-        name: "atty-map-size",
-        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided",
-        varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
-        x_axis: "atty.occluder_map_size",
-    },
-    Preset {
-        name: "atty-light-size",
-        summary: "Atty et al., Fig. 18 and Fig. 24 (error, or time with --error time) against the light's size for 63², 127², 255² maps (not powers of two, as the paper notes in Sec. 5.2.3; use a thick occluder such as floating-sphere)",
-        varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255"],
-        x_axis: "scene.light_scale",
-    },
-    Preset {
-        name: "atty-occluder-height",
-        summary: "Atty et al., Fig. 20: error as the occluders move from the receiver towards the light (on floating-sphere: from 0.05 above the ground to 0.05 below the light)",
-        varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
-        x_axis: "scene.occluder_lift",
-    },
-];
+impl PresetSpec {
+    /// A technique's preset, its axes checked.
+    ///
+    /// # Errors
+    /// A y axis or pixel set the tool does not know.
+    pub fn from_technique(owner: &'static str, preset: &ssm_core::Preset) -> Result<Self> {
+        let y_axis = <ErrorAxis as clap::ValueEnum>::from_str(preset.y_axis, false)
+            .map_err(|e| anyhow::anyhow!("preset `{}` of `{owner}`: y axis `{}`: {e}", preset.name, preset.y_axis))?;
+        let pixels = <PixelSet as clap::ValueEnum>::from_str(preset.pixels, false)
+            .map_err(|e| anyhow::anyhow!("preset `{}` of `{owner}`: pixels `{}`: {e}", preset.name, preset.pixels))?;
+        Ok(Self {
+            name: preset.name.to_owned(),
+            summary: preset.summary.to_owned(),
+            owner: Some(owner),
+            scenes: preset.scenes.iter().map(|s| (*s).to_owned()).collect(),
+            varies: preset.varies.iter().map(|v| (*v).to_owned()).collect(),
+            x_axis: preset.x_axis.to_owned(),
+            y_axis,
+            pixels,
+        })
+    }
+}
+
+/// The scene the `trade` preset runs on without `--scene`.
+pub const TRADE_SCENE: &str = "sphere-cube";
+
+/// `trade`: every real-time technique's quality knob on one scene, time
+/// against error: the cross-technique speed/accuracy plot.
+#[must_use]
+pub fn trade_preset(registry: &Registry) -> PresetSpec {
+    let knobs: Vec<(&str, &str)> =
+        registry.iter().filter(|i| i.kind == TechniqueKind::Realtime).filter_map(|i| i.trade.map(|knob| (i.name, knob))).collect();
+    PresetSpec {
+        name: "trade".into(),
+        summary: format!(
+            "every technique's quality knob, time against error: {}",
+            knobs.iter().map(|(name, knob)| format!("{name} {}", knob.split('=').next().unwrap_or(knob))).collect::<Vec<_>>().join(", ")
+        ),
+        owner: None,
+        scenes: vec![TRADE_SCENE.into()],
+        varies: knobs.iter().map(|(name, knob)| format!("{name}.{knob}")).collect(),
+        x_axis: "time".into(),
+        y_axis: ErrorAxis::MaePenumbra,
+        pixels: PixelSet::All,
+    }
+}
+
+/// Every preset: `trade`, then each technique's, by technique name.
+///
+/// # Errors
+/// A technique's preset with axes the tool does not know, or two presets of one name.
+pub fn presets(registry: &Registry) -> Result<Vec<PresetSpec>> {
+    let mut all = vec![trade_preset(registry)];
+    for info in registry.iter() {
+        for preset in info.presets {
+            let spec = PresetSpec::from_technique(info.name, preset)?;
+            if let Some(other) = all.iter().find(|p| p.name == spec.name) {
+                bail!("two presets are named `{}`: {} and {}", spec.name, other.owner.unwrap_or("ssm"), info.name);
+            }
+            all.push(spec);
+        }
+    }
+    Ok(all)
+}
+
+/// The preset called `name`.
+///
+/// # Errors
+/// An unknown name, listing the known ones.
+pub fn preset(registry: &Registry, name: &str) -> Result<PresetSpec> {
+    let all = presets(registry)?;
+    let known = all.iter().map(|p| p.name.clone()).collect::<Vec<_>>().join(", ");
+    all.into_iter().find(|p| p.name == name).with_context(|| format!("unknown preset `{name}`; presets: {known}"))
+}
+
+/// One technique point of a sweep: the technique, its parameters, and its
+/// varied values (`<technique>.<param>`, value).
+pub type SweepPoint = (&'static TechniqueInfo, ParamValues, Vec<(String, String)>);
+
+/// A sweep resolved against the registry before the GPU is touched: every
+/// technique point with its parameters, and every scene point.
+#[derive(Debug)]
+pub struct SweepPlan {
+    /// The points of every varied technique.
+    pub points: Vec<SweepPoint>,
+    /// The scene points (`scene.<param>`, value), one renderer and ground truth each.
+    pub scene_points: Vec<Vec<(String, String)>>,
+    /// The overrides of each scene point.
+    pub scene_overrides: Vec<SceneOverrides>,
+    /// The varied parameters, qualified (`mine.kernel`, `scene.light_scale`).
+    pub varied: Vec<String>,
+}
+
+impl SweepPlan {
+    /// Resolves `varies` (specifications) with the fixed `settings` (technique, param, value).
+    ///
+    /// # Errors
+    /// A malformed specification, an unknown technique or parameter, a bad value, or no technique varied.
+    pub fn new(registry: &Registry, varies: &[String], settings: &[(&str, &str, &str)]) -> Result<Self> {
+        let varies: Vec<Vary> = varies.iter().map(|s| Vary::parse(s)).collect::<Result<_>>()?;
+        let scene_axes: Vec<&Vary> = varies.iter().filter(|v| v.technique == SCENE_AXIS).collect();
+        let mut techniques: Vec<&'static TechniqueInfo> = Vec::new();
+        for vary in varies.iter().filter(|v| v.technique != SCENE_AXIS) {
+            let info = registry.get(&vary.technique)?;
+            if !techniques.iter().any(|t| t.name == info.name) {
+                techniques.push(info);
+            }
+        }
+        if techniques.is_empty() {
+            bail!("no technique is varied: add a --vary <technique>.<param>=... (scene parameters alone compare nothing)");
+        }
+        let scene_points = grid(&scene_axes);
+        let scene_overrides = scene_points.iter().map(|p| SceneOverrides::from_point(p)).collect::<Result<_>>()?;
+        let mut points = Vec::new();
+        for info in &techniques {
+            let axes: Vec<&Vary> = varies.iter().filter(|v| v.technique == info.name).collect();
+            for point in grid(&axes) {
+                let fixed = settings.iter().filter(|(t, _, _)| *t == info.name).map(|(_, p, v)| (*p, *v));
+                let mut params = info.params_from(fixed)?;
+                for (name, value) in &point {
+                    params.set(name, value)?;
+                }
+                let qualified = point.into_iter().map(|(name, value)| (format!("{}.{name}", info.name), value)).collect();
+                points.push((*info, params, qualified));
+            }
+        }
+        let varied = varies.iter().flat_map(|v| v.params.iter().map(move |p| format!("{}.{p}", v.technique))).collect();
+        Ok(Self { points, scene_points, scene_overrides, varied })
+    }
+}
 
 /// The pseudo-technique whose varies change the scene instead of a technique.
 pub const SCENE_AXIS: &str = "scene";
@@ -170,17 +253,6 @@ impl SceneOverrides {
         scene.validate()?;
         Ok(scene)
     }
-}
-
-/// The preset called `name`.
-///
-/// # Errors
-/// An unknown name, listing the known ones.
-pub fn preset(name: &str) -> Result<&'static Preset> {
-    PRESETS
-        .iter()
-        .find(|p| p.name == name)
-        .with_context(|| format!("unknown preset `{name}`; presets: {}", PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")))
 }
 
 /// Every point of the grid of one technique: the cartesian product of its varies, as `(param, value)` lists.
@@ -418,28 +490,18 @@ mod tests {
 
     #[test]
     fn vary_specifications_parse_and_expand() {
-        let single = Vary::parse("pcss.pcf_kernel=7,15,21").unwrap();
-        assert_eq!(single.params, vec!["pcf_kernel"]);
+        let single = Vary::parse("mine.kernel=7,15,21").unwrap();
+        assert_eq!(single.params, vec!["kernel"]);
         assert_eq!(single.values.len(), 3);
-        let paired = Vary::parse("pcss.blocker_kernel:pcf_kernel=7:15,11:21").unwrap();
-        let size = Vary::parse("pcss.shadow_map_size=512,1024").unwrap();
+        let paired = Vary::parse("mine.search:kernel=7:15,11:21").unwrap();
+        let size = Vary::parse("mine.map_size=512,1024").unwrap();
         let points = grid(&[&paired, &size]);
         assert_eq!(points.len(), 4);
-        assert_eq!(
-            points[1],
-            vec![("blocker_kernel".into(), "7".into()), ("pcf_kernel".into(), "15".into()), ("shadow_map_size".into(), "1024".into())]
-        );
+        assert_eq!(points[1], vec![("search".into(), "7".into()), ("kernel".into(), "15".into()), ("map_size".into(), "1024".into())]);
         assert_eq!(point_label(&points[1]), "7/15/1024");
-        assert!(Vary::parse("pcss.a:b=1:2,3").is_err());
-        assert!(Vary::parse("pcss=1").is_err());
-        assert!(Vary::parse("pcss.a=").is_err());
-        for p in PRESETS {
-            let varies: Vec<Vary> = p.varies.iter().map(|v| Vary::parse(v).unwrap()).collect();
-            let on_an_axis =
-                p.x_axis == "time" || varies.iter().any(|v| v.params.iter().any(|n| format!("{}.{n}", v.technique) == p.x_axis));
-            assert!(on_an_axis, "preset {}: x axis {} is not varied", p.name, p.x_axis);
-        }
-        assert!(preset("nope").unwrap_err().to_string().contains("trade"));
+        assert!(Vary::parse("mine.a:b=1:2,3").is_err());
+        assert!(Vary::parse("mine=1").is_err());
+        assert!(Vary::parse("mine.a=").is_err());
     }
 
     #[test]

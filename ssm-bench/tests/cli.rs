@@ -4,8 +4,12 @@
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
+
+use common::{column, int_param, pass_prefix, split_csv, two_techniques};
 
 fn ssm(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_ssm")).args(args).output().expect("the ssm binary runs")
@@ -29,18 +33,23 @@ fn assert_one_line_error(output: &Output, needle: &str) {
 #[test]
 fn render_writes_every_file() {
     let out = out_dir("render");
+    let (first, second) = two_techniques();
+    let (param, default, min, _) = int_param(first).unwrap();
+    let value = if default == min { min + 1 } else { min };
+    let setting = format!("{}.{param}={value}", first.name);
+    let techniques = format!("{},{}", first.name, second.name);
     let output = ssm(&[
         "render",
         "--scene",
         "floating-sphere",
         "--technique",
-        "hard,pcss",
+        &techniques,
         "--width",
         "96",
         "--height",
         "64",
         "--set",
-        "pcss.pcf_kernel=9",
+        &setting,
         "--frames",
         "2",
         "--out",
@@ -48,20 +57,20 @@ fn render_writes_every_file() {
     ]);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     assert!(out.join("position.exr").is_file());
-    for technique in ["hard", "pcss"] {
+    for technique in [first.name, second.name] {
         for file in ["visibility.exr", "visibility.png", "shaded.png", "timings.json"] {
             assert!(out.join(technique).join(file).is_file(), "{technique}/{file}");
         }
     }
-    let timings = std::fs::read_to_string(out.join("pcss/timings.json")).unwrap();
-    assert!(timings.contains("pcf_kernel=9"), "{timings}");
-    assert!(timings.contains("pcss_blocker_search_and_filter"), "every pass is timed by name: {timings}");
-    let shaded = image::open(out.join("hard/shaded.png")).unwrap();
+    let timings = std::fs::read_to_string(out.join(first.name).join("timings.json")).unwrap();
+    assert!(timings.contains(&format!("{param}={value}")), "{timings}");
+    assert!(timings.contains(&format!("\"{}_", pass_prefix(first))), "every pass is timed by name: {timings}");
+    let shaded = image::open(out.join(second.name).join("shaded.png")).unwrap();
     assert_eq!((shaded.width(), shaded.height()), (96, 64));
-    let visibility = image::open(out.join("hard/visibility.png")).unwrap().into_luma16();
+    let visibility = image::open(out.join(second.name).join("visibility.png")).unwrap().into_luma16();
     assert!(
-        visibility.pixels().any(|p| p.0[0] == 0) && visibility.pixels().any(|p| p.0[0] == u16::MAX),
-        "hard visibility is binary and has both values"
+        visibility.pixels().any(|p| p.0[0] < u16::MAX / 4) && visibility.pixels().any(|p| p.0[0] == u16::MAX),
+        "the sphere's shadow and lit ground are both there"
     );
 }
 
@@ -72,7 +81,7 @@ fn render_writes_every_file() {
 fn a_first_headless_render_prints_no_error_and_marks_background() {
     let out = out_dir("headless");
     let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
-        .args(["render", "--scene", "parallel-square", "--technique", "hard", "--width", "64", "--height", "48", "--out"])
+        .args(["render", "--scene", "parallel-square", "--technique", two_techniques().0.name, "--width", "64", "--height", "48", "--out"])
         .arg(&out)
         .env_remove("XDG_RUNTIME_DIR")
         .env_remove("NODEVICE_SELECT")
@@ -94,7 +103,7 @@ fn a_first_headless_render_prints_no_error_and_marks_background() {
     assert!(coverage[..64].iter().all(|a| *a == 0.0), "the top row is background");
     assert!(coverage.iter().all(|a| *a == 0.0 || *a == 1.0));
     // The visibility EXR carries the same coverage.
-    let visibility = ssm_core::image_io::read_exr(&out.join("hard/visibility.exr")).unwrap();
+    let visibility = ssm_core::image_io::read_exr(&out.join(two_techniques().0.name).join("visibility.exr")).unwrap();
     assert_eq!(visibility.channel("A").unwrap(), coverage.as_slice());
     assert!(visibility.channel("Y").is_some());
 }
@@ -121,7 +130,7 @@ fn compare_reports_every_light_and_the_total() {
         "--scene",
         manifest.to_str().unwrap(),
         "--technique",
-        "hard",
+        two_techniques().0.name,
         "--width",
         "64",
         "--height",
@@ -137,15 +146,17 @@ fn compare_reports_every_light_and_the_total() {
     ]);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let light_column = header.iter().position(|c| *c == "light").expect("a light column");
-    let lights: Vec<String> = csv.lines().skip(1).map(|l| l.split(',').nth(light_column).unwrap().to_owned()).collect();
+    let light_column = column(csv.lines().next().unwrap(), "light");
+    let lights: Vec<String> = csv.lines().skip(1).map(|l| split_csv(l)[light_column].clone()).collect();
     assert_eq!(lights, ["all", "0", "1", "2"], "{csv}");
-    for file in ["hard/visibility-light2.exr", "hard/heatmap-light1.png", "reference/visibility-light2.png"] {
-        assert!(out.join(file).is_file(), "{file}");
+    let technique = two_techniques().0.name;
+    for file in
+        [format!("{technique}/visibility-light2.exr"), format!("{technique}/heatmap-light1.png"), "reference/visibility-light2.png".into()]
+    {
+        assert!(out.join(&file).is_file(), "{file}");
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("`hard` · light 2"), "{report}");
+    assert!(report.contains(&format!("`{technique}` · light 2")), "{report}");
 }
 
 #[test]
@@ -153,12 +164,19 @@ fn list_and_scenes_name_everything() {
     let list = ssm(&["list"]);
     assert!(list.status.success());
     let text = String::from_utf8_lossy(&list.stdout);
-    for needle in ["hard:", "pcss:", "--set pcss.pcf_kernel=15", "int in [1, 128]", "runs here: yes", "needs: G-buffer"] {
+    for info in ssm_bench::registry().unwrap().iter() {
+        assert!(text.contains(&format!("{}:", info.name)), "`{}` missing from:\n{text}", info.name);
+        for spec in info.params {
+            let line = format!("--set {}.{}={}  ({}", info.name, spec.name, spec.default_value(), spec.range_text());
+            assert!(text.contains(&line), "`{line}` missing from:\n{text}");
+        }
+    }
+    for needle in ["runs here: yes", "needs: G-buffer"] {
         assert!(text.contains(needle), "`{needle}` missing from:\n{text}");
     }
     let scenes = String::from_utf8_lossy(&ssm(&["scenes"]).stdout).into_owned();
-    for name in ["parallel-square", "floating-sphere", "contact", "sphere-cube", "leaves"] {
-        assert!(scenes.contains(name), "{scenes}");
+    for entry in ssm_scene::BUILTIN_SCENES {
+        assert!(scenes.contains(entry.name), "{scenes}");
     }
 }
 
@@ -166,23 +184,20 @@ fn list_and_scenes_name_everything() {
 fn bad_arguments_fail_with_one_line() {
     let out = out_dir("bad");
     let out = out.to_str().unwrap();
+    let (first, second) = two_techniques();
+    let (param, _, _, max) = int_param(first).unwrap();
+    let (other_param, _, _, _) = int_param(second).unwrap();
+    let render = |technique: &str, setting: &str| {
+        ssm(&["render", "--scene", "parallel-square", "--technique", technique, "--set", setting, "--out", out])
+    };
     assert_one_line_error(&ssm(&["render", "--scene", "parallel-square", "--technique", "nope", "--out", out]), "unknown technique `nope`");
+    assert_one_line_error(&render(first.name, &format!("{}.no_such_parameter=3", first.name)), "no parameter `no_such_parameter`");
+    assert_one_line_error(&render(first.name, &format!("{}.{param}={}", first.name, max + 1)), "out of range");
+    assert_one_line_error(&render(first.name, &format!("{}.{param}=many", first.name)), "not a valid value");
+    assert_one_line_error(&render(first.name, &format!("{}.{other_param}=1", second.name)), "not among --technique");
+    assert_one_line_error(&ssm(&["render", "--scene", "no-such-scene", "--technique", first.name, "--out", out]), "unknown built-in scene");
     assert_one_line_error(
-        &ssm(&["render", "--scene", "parallel-square", "--technique", "pcss", "--set", "pcss.kernel=3", "--out", out]),
-        "no parameter `kernel`",
+        &ssm(&["render", "--scene", "parallel-square", "--technique", first.name, "--width", "0", "--out", out]),
+        "invalid",
     );
-    assert_one_line_error(
-        &ssm(&["render", "--scene", "parallel-square", "--technique", "pcss", "--set", "pcss.pcf_kernel=1000", "--out", out]),
-        "out of range",
-    );
-    assert_one_line_error(
-        &ssm(&["render", "--scene", "parallel-square", "--technique", "pcss", "--set", "pcss.pcf_kernel=many", "--out", out]),
-        "not a valid value",
-    );
-    assert_one_line_error(
-        &ssm(&["render", "--scene", "parallel-square", "--technique", "pcss", "--set", "hard.slope_bias=1", "--out", out]),
-        "not among --technique",
-    );
-    assert_one_line_error(&ssm(&["render", "--scene", "no-such-scene", "--technique", "hard", "--out", out]), "unknown built-in scene");
-    assert_one_line_error(&ssm(&["render", "--scene", "parallel-square", "--technique", "hard", "--width", "0", "--out", out]), "invalid");
 }

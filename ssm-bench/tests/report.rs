@@ -6,8 +6,12 @@
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use common::{column, int_param, knob_vary, split_csv, two_techniques};
 
 fn ssm(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_ssm")).args(args).output().expect("the ssm binary runs")
@@ -47,6 +51,8 @@ fn chromium(profile: &Path, args: &[&str]) -> std::process::Output {
 fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     let out = scratch("compare");
     let cache = scratch("cache");
+    let (first, second) = two_techniques();
+    let techniques = format!("{},{}", first.name, second.name);
     let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
         .env("SSM_CACHE_DIR", &cache)
         .args([
@@ -54,7 +60,7 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
             "--scene",
             "parallel-square",
             "--technique",
-            "hard,pcss",
+            &techniques,
             "--width",
             "96",
             "--height",
@@ -77,18 +83,16 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     ));
     let rows: Vec<Vec<String>> = lines.map(split_csv).collect();
     assert_eq!(rows.len(), 2);
-    let column = |row: &Vec<String>, i: usize| row[i].parse::<f64>().unwrap();
+    let value = |row: &Vec<String>, i: usize| row[i].parse::<f64>().unwrap();
     for row in &rows {
         assert_eq!(row[0], "parallel-square");
-        assert!(column(row, 5) > 0.0, "GPU time is measured: {row:?}");
-        assert!((0.0..=1.0).contains(&column(row, 8)) && (0.0..=1.0).contains(&column(row, 12)), "{row:?}");
+        assert!(value(row, 5) > 0.0, "GPU time is measured: {row:?}");
+        assert!((0.0..=1.0).contains(&value(row, 8)) && (0.0..=1.0).contains(&value(row, 12)), "{row:?}");
     }
-    let (hard, pcss) = (&rows[0], &rows[1]);
-    assert_eq!((hard[1].as_str(), pcss[1].as_str()), ("hard", "pcss"));
-    assert!(column(pcss, 8) < column(hard, 8), "pcss is nearer the ground truth than hard on parallel-square");
-    assert!(std::fs::read_to_string(out.join("report.md")).unwrap().contains("| `pcss` |"));
-    for file in ["reference/shaded.png", "hard/heatmap.png", "pcss/visibility.png", "pcss/visibility.exr"] {
-        assert!(out.join(file).is_file(), "{file}");
+    assert_eq!((rows[0][1].as_str(), rows[1][1].as_str()), (first.name, second.name));
+    assert!(std::fs::read_to_string(out.join("report.md")).unwrap().contains(&format!("| `{}` |", second.name)));
+    for file in ["reference/shaded.png".to_owned(), format!("{}/heatmap.png", first.name), format!("{}/visibility.exr", second.name)] {
+        assert!(out.join(&file).is_file(), "{file}");
     }
 
     // The report, opened from disk with no network: every image loads.
@@ -108,39 +112,13 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     let _ = std::fs::remove_dir_all(&cache);
 }
 
-/// Splits one CSV line, honouring quotes.
-fn split_csv(line: &str) -> Vec<String> {
-    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                field.push('"');
-                chars.next();
-            }
-            ('"', _) => quoted = !quoted,
-            (',', false) => fields.push(std::mem::take(&mut field)),
-            _ => field.push(c),
-        }
-    }
-    fields.push(field);
-    fields
-}
-
 #[test]
 fn unknown_settings_in_compare_fail_with_one_line() {
     let out = scratch("bad");
-    let output = ssm(&[
-        "compare",
-        "--scene",
-        "parallel-square",
-        "--technique",
-        "hard",
-        "--set",
-        "pcss.pcf_kernel=3",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (first, second) = two_techniques();
+    let setting = format!("{}.{}=3", second.name, int_param(second).unwrap().0);
+    let output =
+        ssm(&["compare", "--scene", "parallel-square", "--technique", first.name, "--set", &setting, "--out", out.to_str().unwrap()]);
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.lines().filter(|l| l.starts_with("error:")).count() == 1 && stderr.contains("not compared"), "{stderr}");
@@ -150,6 +128,9 @@ fn unknown_settings_in_compare_fail_with_one_line() {
 fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
     let out = scratch("sweep");
     let cache = scratch("sweep-cache");
+    // Each technique's own quality knob, as the trade preset varies it.
+    let (first, second) = two_techniques();
+    let ((first_vary, first_count), (second_vary, second_count)) = (knob_vary(first, 2), knob_vary(second, 3));
     let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
         .env("SSM_CACHE_DIR", &cache)
         .args([
@@ -157,9 +138,9 @@ fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
             "--scene",
             "parallel-square",
             "--vary",
-            "pcss.blocker_kernel:pcf_kernel=3:5,7:15",
+            &first_vary,
             "--vary",
-            "multi-sm.samples=1,4,16",
+            &second_vary,
             "--set",
             "reference.samples=8",
             "--width",
@@ -176,15 +157,15 @@ fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     let rows: Vec<Vec<String>> = csv.lines().skip(1).map(split_csv).collect();
-    assert_eq!(rows.len(), 5, "{csv}");
-    assert!(rows[1][2].contains("blocker_kernel=7") && rows[1][2].contains("pcf_kernel=15"), "{:?}", rows[1]);
-    // multi-sm's error falls with K along the sweep.
-    let mae: Vec<f64> = rows[2..].iter().map(|r| r[8].parse().unwrap()).collect();
-    assert!(mae[0] > mae[1] && mae[1] > mae[2], "{mae:?}");
+    assert_eq!(rows.len(), first_count + second_count, "{csv}");
+    assert!(rows.iter().take(first_count).all(|r| r[1] == first.name) && rows.iter().skip(first_count).all(|r| r[1] == second.name));
+    // Each row carries its own point's parameters: the second point differs from the first.
+    assert_ne!(rows[0][2], rows[1][2]);
+    assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[8].parse::<f64>().unwrap())), "{csv}");
     let png = image::open(out.join("sweep.png")).unwrap();
     assert_eq!((png.width(), png.height()), (1000, 700));
     let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
-    assert!(svg.contains("Pareto front") && svg.contains("multi-sm") && svg.contains("<circle"), "the plot has its legend and points");
+    assert!(svg.contains("Pareto front") && svg.contains(second.name) && svg.contains("<circle"), "the plot has its legend and points");
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.lines().any(|l| l.starts_with('*')), "the Pareto front is marked:\n{stdout}");
     let _ = std::fs::remove_dir_all(&out);
@@ -195,6 +176,9 @@ fn sweep_writes_a_csv_row_per_point_and_the_trade_plot() {
 fn sweep_varies_the_scene_and_plots_against_a_parameter() {
     let out = scratch("sweep-scene");
     let cache = scratch("sweep-scene-cache");
+    let (first, _) = two_techniques();
+    let (param, default, _, _) = int_param(first).unwrap();
+    let fixed_point = format!("{}.{param}={default}", first.name);
     let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
         .env("SSM_CACHE_DIR", &cache)
         .args([
@@ -204,7 +188,7 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
             "--vary",
             "scene.light_scale=0.5,2",
             "--vary",
-            "pcss.pcf_kernel=9",
+            &fixed_point,
             "--x",
             "scene.light_scale",
             "--pixels",
@@ -228,22 +212,14 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
     assert_eq!(rows.len(), 2, "{csv}");
     assert_eq!(rows[0][0], "parallel-square[light_scale=0.5]");
     assert_eq!(rows[1][0], "parallel-square[light_scale=2]");
-    // A larger light, a wider penumbra: more penumbra pixels (column 17).
-    let penumbra: Vec<u64> = rows.iter().map(|r| r[17].parse().unwrap()).collect();
+    // A larger light, a wider penumbra: more penumbra pixels.
+    let penumbra_column = column(csv.lines().next().unwrap(), "penumbra_pixels");
+    let penumbra: Vec<u64> = rows.iter().map(|r| r[penumbra_column].parse().unwrap()).collect();
     assert!(penumbra[1] > penumbra[0], "{penumbra:?}");
     let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
     assert!(svg.contains("scene.light_scale") && !svg.contains("Pareto front"), "parameter axis, no Pareto front");
-    let bad = ssm(&[
-        "sweep",
-        "--scene",
-        "parallel-square",
-        "--vary",
-        "scene.colour=1",
-        "--vary",
-        "hard.slope_bias=0",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let bad =
+        ssm(&["sweep", "--scene", "parallel-square", "--vary", "scene.colour=1", "--vary", &fixed_point, "--out", out.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown scene parameter"));
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);

@@ -4,7 +4,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::{color_attachment, fullscreen_pipeline, labelled_view, render_texture, texture_entry};
+use crate::passes::{color_attachment, fullscreen_pipeline, labelled_view, render_texture};
 use crate::shader::create_shader;
 
 /// The composite pass and its target.
@@ -26,37 +26,34 @@ impl Composite {
     ///
     /// # Errors
     /// [`Error::Gpu`](crate::Error::Gpu) if the shader is rejected.
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, gbuffer: &GBuffer, visibility_views: &[wgpu::TextureView]) -> Result<Self> {
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, visibility_views: &[wgpu::TextureView]) -> Result<Self> {
         let device = &gpu.device;
         let target = render_texture(device, "composite_target", scene.width, scene.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
         let target_view = labelled_view(&target, "composite_target");
-        let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("composite_visibility_layout"),
-            entries: &[texture_entry(0)],
-        });
-        let module = create_shader(gpu, "composite_shader", include_str!("../../shaders/core/composite.wgsl"))?;
-        let layouts = [&scene.uniform_layout, &gbuffer.layout, &visibility_layout];
-        let base_pipeline =
-            fullscreen_pipeline(device, "composite_base_pipeline", &module, "composite_base", &layouts, Self::FORMAT.into());
-        // Additive: each light adds its term to what the base pass wrote (blending is linear on sRGB targets).
+        let visibility_layout = gpu.texture_layout();
+        // Both pipelines once per device, shared by every renderer.
+        let build = |entry: &'static str, blend: Option<wgpu::BlendState>| {
+            gpu.cached_render_pipeline(&format!("{entry}_pipeline"), |gpu| {
+                let module = create_shader(gpu, "composite_shader", include_str!("../../shaders/core/composite.wgsl"))?;
+                let layouts = [gpu.uniform_layout(), gpu.gbuffer_layout(), gpu.texture_layout()];
+                let target = wgpu::ColorTargetState { format: Self::FORMAT, blend, write_mask: wgpu::ColorWrites::ALL };
+                Ok(fullscreen_pipeline(&gpu.device, &format!("{entry}_pipeline"), &module, entry, &layouts, target))
+            })
+        };
+        let base_pipeline = build("composite_base", None)?;
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let light_target = wgpu::ColorTargetState {
-            format: Self::FORMAT,
-            blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
-            write_mask: wgpu::ColorWrites::ALL,
-        };
-        let light_pipeline = fullscreen_pipeline(device, "composite_light_pipeline", &module, "composite_light", &layouts, light_target);
+        let light_pipeline = build("composite_light", Some(wgpu::BlendState { color: additive, alpha: additive }))?;
         let visibility_groups = visibility_views
             .iter()
             .enumerate()
             .map(|(light, view)| {
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&format!("composite_visibility_bind_group_{light}")),
-                    layout: &visibility_layout,
+                    layout: visibility_layout,
                     entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) }],
                 })
             })

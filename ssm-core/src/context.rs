@@ -1,7 +1,10 @@
 //! The GPU context: instance, adapter, device and queue, with the optional
 //! features this adapter offers negotiated once.
 
+use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
+
+use crate::passes::{texture_entry, uniform_entry};
 
 /// Optional device features ssm asks for when the adapter has them.
 ///
@@ -23,20 +26,22 @@ pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::FLOAT32_BLENDABLE
 pub enum ContextError {
     /// No adapter at all: neither a GPU nor a software rasteriser.
     #[error(
-        "no graphics adapter found ({detail}). ssm needs Vulkan: on a machine without a GPU install Mesa's software driver \
+        "no graphics adapter found ({source}). ssm needs Vulkan: on a machine without a GPU install Mesa's software driver \
          with `sudo apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), then check with `vulkaninfo --summary`"
     )]
     NoAdapter {
         /// What wgpu said.
-        detail: String,
+        #[source]
+        source: wgpu::RequestAdapterError,
     },
     /// The adapter refused to make a device.
-    #[error("the adapter `{adapter}` could not create a device: {detail}")]
+    #[error("the adapter `{adapter}` could not create a device")]
     NoDevice {
         /// Adapter name.
         adapter: String,
         /// What wgpu said.
-        detail: String,
+        #[source]
+        source: wgpu::RequestDeviceError,
     },
 }
 
@@ -58,6 +63,37 @@ pub struct GpuContext {
     /// The adapter's description.
     pub info: wgpu::AdapterInfo,
     errors: Arc<Mutex<Vec<String>>>,
+    shared: Arc<SharedObjects>,
+}
+
+/// GPU objects every renderer and technique on one device shares, made once:
+/// the common bind group layouts and the pipelines of the shared passes.
+#[derive(Debug)]
+struct SharedObjects {
+    uniform_layout: wgpu::BindGroupLayout,
+    gbuffer_layout: wgpu::BindGroupLayout,
+    texture_layout: wgpu::BindGroupLayout,
+    render_pipelines: Mutex<HashMap<String, wgpu::RenderPipeline>>,
+}
+
+impl SharedObjects {
+    fn new(device: &wgpu::Device) -> Self {
+        Self {
+            uniform_layout: device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("shared_uniform_layout"),
+                entries: &[uniform_entry(0)],
+            }),
+            gbuffer_layout: device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gbuffer_layout"),
+                entries: &[texture_entry(0), texture_entry(1)],
+            }),
+            texture_layout: device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("shared_texture_layout"),
+                entries: &[texture_entry(0)],
+            }),
+            render_pipelines: Mutex::new(HashMap::new()),
+        }
+    }
 }
 
 impl GpuContext {
@@ -71,7 +107,7 @@ impl GpuContext {
     pub fn new() -> Result<Self, ContextError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
-            .map_err(|e| ContextError::NoAdapter { detail: e.to_string() })?;
+            .map_err(|source| ContextError::NoAdapter { source })?;
         let info = adapter.get_info();
         let features = adapter.features() & OPTIONAL_FEATURES;
         let descriptor = wgpu::DeviceDescriptor {
@@ -84,7 +120,7 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))
-            .map_err(|e| ContextError::NoDevice { adapter: info.name.clone(), detail: e.to_string() })?;
+            .map_err(|source| ContextError::NoDevice { adapter: info.name.clone(), source })?;
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&errors);
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
@@ -92,7 +128,50 @@ impl GpuContext {
                 list.push(error.to_string());
             }
         }));
-        Ok(Self { instance, adapter, device, queue, info, errors })
+        let shared = Arc::new(SharedObjects::new(&device));
+        Ok(Self { instance, adapter, device, queue, info, errors, shared })
+    }
+
+    /// The layout of a bind group holding one uniform buffer at binding 0,
+    /// visible to every stage: the camera's and each light frame's.
+    #[must_use]
+    pub fn uniform_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.shared.uniform_layout
+    }
+
+    /// The layout of the G-buffer's bind group: world position (binding 0)
+    /// and normal (binding 1), as `common/screen_pass.wgsl` declares them.
+    #[must_use]
+    pub fn gbuffer_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.shared.gbuffer_layout
+    }
+
+    /// The layout of a bind group holding one unfilterable float 2D texture at binding 0.
+    #[must_use]
+    pub fn texture_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.shared.texture_layout
+    }
+
+    /// The render pipeline cached under `key`, built by `build` the first time
+    /// it is asked for on this device: the shared passes (light depth maps,
+    /// G-buffer, composite) compile their shaders once however many renderers
+    /// and techniques use them.
+    ///
+    /// # Errors
+    /// Whatever `build` returns.
+    pub fn cached_render_pipeline(
+        &self,
+        key: &str,
+        build: impl FnOnce(&Self) -> crate::Result<wgpu::RenderPipeline>,
+    ) -> crate::Result<wgpu::RenderPipeline> {
+        if let Some(pipeline) = self.shared.render_pipelines.lock().ok().and_then(|cache| cache.get(key).cloned()) {
+            return Ok(pipeline);
+        }
+        let pipeline = build(self)?;
+        if let Ok(mut cache) = self.shared.render_pipelines.lock() {
+            cache.insert(key.to_owned(), pipeline.clone());
+        }
+        Ok(pipeline)
     }
 
     /// The features the device was created with.

@@ -114,12 +114,13 @@ pub enum Error {
         message: String,
     },
     /// Reading a GPU resource back failed.
-    #[error("reading back {what} failed: {detail}")]
+    #[error("reading back {what} failed")]
     Readback {
         /// The resource.
         what: String,
         /// Why.
-        detail: String,
+        #[source]
+        source: BoxedError,
     },
     /// The requested image size is unusable.
     #[error("image size {width}x{height} is invalid: {problem}")]
@@ -132,21 +133,43 @@ pub enum Error {
         problem: String,
     },
     /// Reading an image file failed.
-    #[error("{}: cannot read: {message}", file.display())]
+    #[error("{}: cannot read", file.display())]
     Read {
         /// The file.
         file: PathBuf,
         /// Why.
-        message: String,
+        #[source]
+        source: BoxedError,
     },
     /// Writing an output file failed.
-    #[error("{}: cannot write: {message}", file.display())]
+    #[error("{}: cannot write", file.display())]
     Write {
         /// The file.
         file: PathBuf,
         /// Why.
-        message: String,
+        #[source]
+        source: BoxedError,
     },
+}
+
+/// A cause from any library (I/O, image codecs, wgpu), kept for `source()`.
+pub type BoxedError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// A cause that is only a sentence (no underlying error to keep).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Reason(pub String);
+
+impl Error {
+    /// [`Error::Write`] for `file`, caused by `source`.
+    pub fn write(file: impl Into<PathBuf>, source: impl Into<BoxedError>) -> Self {
+        Self::Write { file: file.into(), source: source.into() }
+    }
+
+    /// [`Error::Readback`] of `what`, caused by `source`.
+    pub fn readback(what: impl Into<String>, source: impl Into<BoxedError>) -> Self {
+        Self::Readback { what: what.into(), source: source.into() }
+    }
 }
 
 /// Shorthand for results of this crate.

@@ -4,6 +4,7 @@ use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
+use crate::passes::color_attachment;
 use crate::timing::PassTimer;
 
 /// Shared inputs built by the framework, each only when a technique in use
@@ -34,10 +35,15 @@ impl SharedInputs {
     }
 }
 
-/// One frame being recorded: the device, the scene, the shared inputs, an
-/// encoder the technique may submit and replace (for mid-frame readbacks),
-/// and a timer that times every pass opened through [`Frame::render_pass`] or
-/// [`Frame::compute_pass`].
+/// One frame being recorded for one technique: the device, the scene, the
+/// shared inputs, and the passes the technique opens.
+///
+/// The command encoder is private: every pass goes through
+/// [`Frame::render_pass`] or [`Frame::compute_pass`], which label it and time
+/// it on the GPU, inside the debug group the renderer opens for the technique;
+/// copies go through [`Frame::copy_texture_to_buffer`] and the like, which
+/// mark them; a mid-frame readback goes through [`Frame::read_back`], which
+/// times the stall on the CPU. An unlabelled or untimed pass cannot be written.
 pub struct Frame<'a> {
     /// The GPU.
     pub gpu: &'a GpuContext,
@@ -45,13 +51,41 @@ pub struct Frame<'a> {
     pub scene: &'a GpuScene,
     /// Shared inputs.
     pub shared: &'a SharedInputs,
-    /// The command encoder passes are recorded into.
-    pub encoder: wgpu::CommandEncoder,
-    /// The pass timer.
-    pub timer: &'a mut PassTimer,
+    encoder: wgpu::CommandEncoder,
+    timer: &'a mut PassTimer,
+    /// The debug group every pass of the technique is recorded in.
+    group: String,
 }
 
-impl Frame<'_> {
+impl<'a> Frame<'a> {
+    /// A frame for technique `group` (the debug group its passes go in).
+    pub(crate) fn new(gpu: &'a GpuContext, scene: &'a GpuScene, shared: &'a SharedInputs, timer: &'a mut PassTimer, group: &str) -> Self {
+        let encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{group}_frame_encoder")) });
+        Self { gpu, scene, shared, encoder, timer, group: group.to_owned() }
+    }
+
+    /// Starts light `light`'s passes: clears `target` to fully lit (the
+    /// technique contract) and opens the technique's debug group.
+    pub(crate) fn begin_light(&mut self, light: usize, target: &wgpu::TextureView) {
+        drop(self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("visibility_clear"),
+            color_attachments: &[color_attachment(target, Some(wgpu::Color::WHITE))],
+            ..Default::default()
+        }));
+        self.timer.set_light(light);
+        self.encoder.push_debug_group(&self.group);
+    }
+
+    /// Closes light `light`'s debug group.
+    pub(crate) fn end_light(&mut self) {
+        self.encoder.pop_debug_group();
+    }
+
+    /// The encoder, after the last pass: for the framework to resolve the timers and submit.
+    pub(crate) fn finish(self) -> wgpu::CommandEncoder {
+        self.encoder
+    }
+
     /// Begins a render pass labelled `label`, timed under that name.
     pub fn render_pass<'p>(
         &'p mut self,
@@ -75,12 +109,67 @@ impl Frame<'_> {
         self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes })
     }
 
-    /// Submits what was recorded so far and starts a new encoder, so that the
-    /// technique can read results back in the middle of the frame (PVSM's tile
-    /// grid, for instance). Returns the submission to wait for.
-    pub fn submit_and_replace(&mut self, label: &str) -> wgpu::SubmissionIndex {
-        let next = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        let done = std::mem::replace(&mut self.encoder, next);
-        self.gpu.queue.submit([done.finish()])
+    /// Copies a texture region into a buffer, marked `label` in captures.
+    pub fn copy_texture_to_buffer(
+        &mut self,
+        label: &str,
+        source: wgpu::TexelCopyTextureInfo<'_>,
+        destination: wgpu::TexelCopyBufferInfo<'_>,
+        size: wgpu::Extent3d,
+    ) {
+        self.encoder.insert_debug_marker(label);
+        self.encoder.copy_texture_to_buffer(source, destination, size);
+    }
+
+    /// Copies between buffers, marked `label` in captures.
+    pub fn copy_buffer_to_buffer(
+        &mut self,
+        label: &str,
+        source: &wgpu::Buffer,
+        source_offset: u64,
+        destination: &wgpu::Buffer,
+        destination_offset: u64,
+        size: u64,
+    ) {
+        self.encoder.insert_debug_marker(label);
+        self.encoder.copy_buffer_to_buffer(source, source_offset, destination, destination_offset, size);
+    }
+
+    /// Fills a buffer range with zeros, marked `label` in captures.
+    pub fn clear_buffer(&mut self, label: &str, buffer: &wgpu::Buffer, offset: u64, size: Option<u64>) {
+        self.encoder.insert_debug_marker(label);
+        self.encoder.clear_buffer(buffer, offset, size);
+    }
+
+    /// Reads `buffer` (usage `MAP_READ`) back in the middle of the frame: what
+    /// was recorded so far is submitted, the CPU waits for it and maps the
+    /// buffer, and recording goes on in a new encoder (PVSM's tile grid). The
+    /// wait is timed on the CPU under `label`: it is part of the technique's cost.
+    ///
+    /// # Errors
+    /// [`Error::Readback`] if the GPU fails or the buffer cannot be mapped.
+    pub fn read_back(&mut self, label: &str, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+        let start = std::time::Instant::now();
+        let next = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{}_after_{label}", self.group)) });
+        let mut done = std::mem::replace(&mut self.encoder, next);
+        // Debug groups do not span command buffers: close it here, reopen it in the next one.
+        done.pop_debug_group();
+        self.gpu.queue.submit([done.finish()]);
+        self.encoder.push_debug_group(&self.group);
+        let bytes = crate::readback::map_and_read(self.gpu, buffer, label)?;
+        self.timer.cpu_scope(label, start.elapsed().as_secs_f64() * 1e3);
+        Ok(bytes)
+    }
+
+    /// Runs CPU work of the technique's (what its paper puts on the CPU, such
+    /// as PVSM's kd-tree) and times it under `label`.
+    pub fn cpu_scope<T>(&mut self, label: &str, work: impl FnOnce() -> T) -> T {
+        let start = std::time::Instant::now();
+        let out = work();
+        self.timer.cpu_scope(label, start.elapsed().as_secs_f64() * 1e3);
+        out
     }
 }

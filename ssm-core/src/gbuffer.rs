@@ -2,8 +2,8 @@
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::gpu_scene::{Geometry, GpuScene, SceneVertex};
-use crate::passes::{color_attachment, labelled_view, render_texture, texture_entry};
+use crate::gpu_scene::{GpuScene, SceneVertex};
+use crate::passes::{color_attachment, labelled_view, render_texture};
 use crate::shader::create_shader;
 use crate::timing::PassTimer;
 
@@ -50,10 +50,7 @@ impl GBuffer {
         let position_view = labelled_view(&position, "gbuffer_position");
         let normal_view = labelled_view(&normal, "gbuffer_normal");
         let depth_view = labelled_view(&depth, "gbuffer_depth");
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gbuffer_layout"),
-            entries: &[texture_entry(0), texture_entry(1)],
-        });
+        let layout = gpu.gbuffer_layout().clone();
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer_bind_group"),
             layout: &layout,
@@ -62,40 +59,43 @@ impl GBuffer {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&normal_view) },
             ],
         });
-        let module = create_shader(gpu, "gbuffer_shader", include_str!("../../shaders/core/gbuffer.wgsl"))?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer_pipeline_layout"),
-            bind_group_layouts: &[Some(&scene.uniform_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer_pipeline"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("gbuffer_vertex"),
-                compilation_options: Default::default(),
-                buffers: &[Some(SceneVertex::layout())],
-            },
-            // Surfaces are two-sided: no culling.
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: Self::DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("gbuffer_fragment"),
-                compilation_options: Default::default(),
-                targets: &[Some(Self::POSITION_FORMAT.into()), Some(Self::NORMAL_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        // One pipeline per device, shared by every renderer.
+        let pipeline = gpu.cached_render_pipeline("gbuffer_pipeline", |gpu| {
+            let device = &gpu.device;
+            let module = create_shader(gpu, "gbuffer_shader", include_str!("../../shaders/core/gbuffer.wgsl"))?;
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gbuffer_pipeline_layout"),
+                bind_group_layouts: &[Some(gpu.uniform_layout())],
+                immediate_size: 0,
+            });
+            Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("gbuffer_pipeline"),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("gbuffer_vertex"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(SceneVertex::layout())],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: Self::DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                }),
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("gbuffer_fragment"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(Self::POSITION_FORMAT.into()), Some(Self::NORMAL_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            }))
+        })?;
         Ok(Self { position, position_view, normal, normal_view, depth, depth_view, layout, bind_group, pipeline })
     }
 
@@ -118,6 +118,6 @@ impl GBuffer {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.camera_bind_group, &[]);
-        scene.draw(&mut pass, Geometry::All);
+        scene.draw(&mut pass, scene.all());
     }
 }

@@ -9,6 +9,7 @@ use ssm_scene::{Aabb, Role, Scene};
 use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
+use crate::error::{Error, Result};
 use crate::light_frame::{LightFrame, LightFrameUniform};
 
 /// One vertex as the GPU sees it: world space, with its instance's role.
@@ -56,7 +57,7 @@ pub enum Geometry {
 
 /// The camera as a uniform (`shaders/common/camera.wgsl`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, crate::UniformStruct)]
 pub struct CameraUniform {
     /// World to clip.
     pub view_proj: [[f32; 4]; 4],
@@ -73,10 +74,14 @@ pub struct CameraUniform {
 pub struct GpuScene {
     /// World-space vertices ([`SceneVertex`]).
     pub vertex_buffer: wgpu::Buffer,
-    /// Triangle list, `u32`, sorted occluder-only, both, receiver-only so that
-    /// each [`Geometry`] is one contiguous range.
+    /// Triangle list, `u32`. With roles, sorted occluder-only, both,
+    /// receiver-only so that each [`Geometry`] is one contiguous range;
+    /// without, in scene order.
     pub index_buffer: wgpu::Buffer,
     ranges: [Range<u32>; 3],
+    /// Whether the geometry was sorted by role, because a technique in use
+    /// declared [`Requirements::roles`](crate::Requirements).
+    pub has_roles: bool,
     /// Number of triangles.
     pub triangle_count: u32,
     /// World-space bounds.
@@ -87,7 +92,8 @@ pub struct GpuScene {
     pub camera: CameraUniform,
     /// Its uniform buffer.
     pub camera_buffer: wgpu::Buffer,
-    /// Layout of a bind group holding one uniform buffer (camera or light frame) at binding 0.
+    /// Layout of a bind group holding one uniform buffer (camera or light frame) at binding 0
+    /// ([`GpuContext::uniform_layout`]).
     pub uniform_layout: wgpu::BindGroupLayout,
     /// The camera's bind group (layout [`GpuScene::uniform_layout`]).
     pub camera_bind_group: wgpu::BindGroup,
@@ -104,9 +110,11 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    /// Uploads a validated scene for images of `width` × `height`.
+    /// Uploads a validated scene for images of `width` × `height`, sorted by
+    /// role when `roles` (some technique in use draws occluders and receivers
+    /// apart).
     #[must_use]
-    pub fn new(gpu: &GpuContext, scene: &Scene, width: u32, height: u32) -> Self {
+    pub fn new(gpu: &GpuContext, scene: &Scene, width: u32, height: u32, roles: bool) -> Self {
         let device = &gpu.device;
         let mut vertices = Vec::new();
         // Three index lists, concatenated in role order afterwards.
@@ -114,6 +122,7 @@ impl GpuScene {
         for triangle in scene.world_triangles() {
             let flags = (u32::from(triangle.role.casts()) * ROLE_CASTS) | (u32::from(triangle.role.receives()) * ROLE_RECEIVES);
             let slot = match triangle.role {
+                _ if !roles => 0,
                 Role::Occluder => 0,
                 Role::Both => 1,
                 Role::Receiver => 2,
@@ -130,7 +139,12 @@ impl GpuScene {
         }
         let [occluder_only, both, receiver_only] = by_role.each_ref().map(|list| list.len() as u32);
         let indices: Vec<u32> = by_role.concat();
-        let ranges = [0..indices.len() as u32, 0..occluder_only + both, occluder_only..occluder_only + both + receiver_only];
+        let all = 0..indices.len() as u32;
+        let ranges = if roles {
+            [all, 0..occluder_only + both, occluder_only..occluder_only + both + receiver_only]
+        } else {
+            [all.clone(), all.clone(), all]
+        };
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene_vertex_buffer"),
             contents: bytemuck::cast_slice(&vertices),
@@ -149,15 +163,7 @@ impl GpuScene {
             contents: bytemuck::bytes_of(&camera),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene_uniform_layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
-                count: None,
-            }],
-        });
+        let uniform_layout = gpu.uniform_layout().clone();
         let uniform_group = |label: &str, buffer: &wgpu::Buffer| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
@@ -191,6 +197,7 @@ impl GpuScene {
             vertex_buffer,
             index_buffer,
             ranges,
+            has_roles: roles,
             triangle_count: indices.len() as u32 / 3,
             bounds,
             receiver_bounds: receivers,
@@ -207,18 +214,29 @@ impl GpuScene {
     }
 
     /// Index range of `geometry` in [`GpuScene::index_buffer`].
-    #[must_use]
-    pub fn index_range(&self, geometry: Geometry) -> Range<u32> {
-        match geometry {
+    ///
+    /// # Errors
+    /// [`Error::UndeclaredRequirement`] naming `technique` when `geometry`
+    /// selects by role and no technique in use declared roles.
+    pub fn index_range(&self, technique: &str, geometry: Geometry) -> Result<Range<u32>> {
+        if geometry != Geometry::All && !self.has_roles {
+            return Err(Error::UndeclaredRequirement { technique: technique.into(), input: "occluder/receiver roles" });
+        }
+        Ok(match geometry {
             Geometry::All => self.ranges[0].clone(),
             Geometry::Occluders => self.ranges[1].clone(),
             Geometry::Receivers => self.ranges[2].clone(),
-        }
+        })
     }
 
-    /// Binds the geometry buffers at vertex slot 0 and draws `geometry`.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, geometry: Geometry) {
-        let range = self.index_range(geometry);
+    /// Index range of every triangle.
+    #[must_use]
+    pub fn all(&self) -> Range<u32> {
+        self.ranges[0].clone()
+    }
+
+    /// Binds the geometry buffers at vertex slot 0 and draws `range` (from [`GpuScene::index_range`]).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, range: Range<u32>) {
         if range.is_empty() {
             return;
         }

@@ -6,17 +6,17 @@ use std::path::Path;
 
 use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec, WritableImage};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Reason, Result};
 
-fn write_error(file: &Path, message: impl std::fmt::Display) -> Error {
-    Error::Write { file: file.into(), message: message.to_string() }
+fn write_error(file: &Path, source: impl Into<crate::error::BoxedError>) -> Error {
+    Error::write(file, source)
 }
 
 fn check_len(file: &Path, len: usize, width: u32, height: u32, channels: usize) -> Result<()> {
     if len == width as usize * height as usize * channels {
         Ok(())
     } else {
-        Err(write_error(file, format!("{len} values for a {width}x{height} image of {channels} channels")))
+        Err(write_error(file, Reason(format!("{len} values for a {width}x{height} image of {channels} channels"))))
     }
 }
 
@@ -100,8 +100,7 @@ impl ExrImage {
 /// # Errors
 /// [`Error::Read`] naming the file.
 pub fn read_exr(file: &Path) -> Result<ExrImage> {
-    let image =
-        exr::prelude::read_first_flat_layer_from_file(file).map_err(|e| Error::Read { file: file.into(), message: e.to_string() })?;
+    let image = exr::prelude::read_first_flat_layer_from_file(file).map_err(|e| Error::Read { file: file.into(), source: e.into() })?;
     let layer = image.layer_data;
     let size = layer.size;
     let channels =
@@ -116,8 +115,8 @@ pub fn read_exr(file: &Path) -> Result<ExrImage> {
 pub fn write_png_gray16(file: &Path, width: u32, height: u32, values: &[f32]) -> Result<()> {
     check_len(file, values.len(), width, height, 1)?;
     let pixels: Vec<u16> = values.iter().map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16).collect();
-    let image =
-        image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels).ok_or_else(|| write_error(file, "buffer size"))?;
+    let image = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
+        .ok_or_else(|| write_error(file, Reason("buffer size".into())))?;
     image.save(file).map_err(|e| write_error(file, e))
 }
 
@@ -127,6 +126,6 @@ pub fn write_png_gray16(file: &Path, width: u32, height: u32, values: &[f32]) ->
 /// [`Error::Write`] naming the file.
 pub fn write_png_rgba8(file: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
     check_len(file, rgba.len(), width, height, 4)?;
-    let image = image::RgbaImage::from_raw(width, height, rgba.to_vec()).ok_or_else(|| write_error(file, "buffer size"))?;
+    let image = image::RgbaImage::from_raw(width, height, rgba.to_vec()).ok_or_else(|| write_error(file, Reason("buffer size".into())))?;
     image.save(file).map_err(|e| write_error(file, e))
 }

@@ -13,6 +13,9 @@
 //!   [`ScreenPass`]: a full-screen pass over the G-buffer for one light.
 //! - [`image_io`]: EXR and PNG output.
 
+// The derives name this crate `::ssm_core`, also when used inside it.
+extern crate self as ssm_core;
+
 mod composite;
 mod context;
 mod error;
@@ -35,17 +38,24 @@ mod technique;
 mod timing;
 
 pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
-pub use error::{Error, Result};
+pub use error::{BoxedError, Error, Reason, Result};
 pub use frame::{Frame, SharedInputs};
 pub use gbuffer::GBuffer;
 pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SceneVertex};
-pub use light_depth::{LightDepthMap, LightDepthMapDesc, NO_SURFACE, ShadowMapSettings};
+pub use light_depth::{
+    DepthBiasUniform, LightDepthMap, LightDepthMapDesc, NO_SURFACE, ReceiverModel, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ShadowMapBias,
+    screen_space_requirements,
+};
 pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT, MAX_WIDENED_HALF_ANGLE_TANGENT};
-pub use params::{ParamError, ParamKind, ParamSpec, ParamValue, ParamValues};
+pub use params::{Choice, ParamError, ParamKind, ParamSpec, ParamValue, ParamValues, Settings, concat_params};
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
-pub use technique::{ExtraImage, Requirements, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup};
+pub use ssm_derive::{Choice, Settings, UniformStruct};
+pub use technique::{
+    ExtraImage, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
+    UniformStruct,
+};
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 
 /// Re-exported so that technique crates can register without depending on it.

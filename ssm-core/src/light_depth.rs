@@ -1,6 +1,7 @@
 //! A light-space depth map pass that techniques instantiate with their own
-//! size, geometry selection, culling and bias (hard shadows, PCSS, SSSM and
-//! the occluder/receiver maps of Atty et al. all start from one).
+//! size, geometry selection, culling and bias: hard shadow maps, blocker
+//! searches, and the occluder and receiver maps of Atty et al. all start
+//! from one.
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -9,8 +10,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::gpu_scene::{Geometry, GpuScene, SceneVertex};
-use crate::params::{ParamKind, ParamSpec};
-use crate::passes::{color_attachment, labelled_view, render_texture, uniform_entry};
+use crate::passes::{color_attachment, labelled_view, render_texture};
 use crate::shader::create_shader;
 
 /// Linear depth written where no surface was drawn (cleared value).
@@ -19,7 +19,7 @@ pub const NO_SURFACE: f32 = f32::MAX;
 /// How to build a [`LightDepthMap`].
 #[derive(Clone, Copy, Debug)]
 pub struct LightDepthMapDesc<'a> {
-    /// Label prefix of every GPU object (`"pcss_shadow_map"`).
+    /// Label prefix of every GPU object (`"mine_shadow_map"`).
     pub label: &'a str,
     /// Width in texels.
     pub width: u32,
@@ -39,10 +39,12 @@ pub struct LightDepthMapDesc<'a> {
     pub slope_bias: f32,
 }
 
+/// The bias uniform of `shaders/core/light_depth.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct DepthBiasUniform {
-    values: [f32; 4],
+#[derive(Clone, Copy, Debug, Pod, Zeroable, crate::UniformStruct)]
+pub struct DepthBiasUniform {
+    /// x: constant bias (world units), y: slope factor, z, w: the map's width and height in texels.
+    pub values: [f32; 4],
 }
 
 /// A light-space map of linear depth (`R32Float`: distance along the light's
@@ -57,80 +59,41 @@ pub struct LightDepthMap {
     pipeline: wgpu::RenderPipeline,
     bias_bind_group: wgpu::BindGroup,
     label: String,
-    geometry: Geometry,
+    indices: std::ops::Range<u32>,
     farthest: bool,
 }
 
 impl LightDepthMap {
     /// Format of [`LightDepthMap::linear_depth`].
     pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+    /// Format of the depth buffer the nearest (or farthest) surface is kept with.
+    pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-    /// Allocates the map and builds its pipeline.
+    /// Allocates the map; its pipeline is built once per device and culling mode, and shared.
     ///
     /// # Errors
-    /// [`Error::Gpu`](crate::Error::Gpu) if the shader is rejected.
+    /// [`Error::UndeclaredRequirement`](crate::Error::UndeclaredRequirement) for a
+    /// [`Geometry`] by role without roles, or [`Error::Gpu`](crate::Error::Gpu) if the shader is rejected.
     pub fn new(gpu: &GpuContext, scene: &GpuScene, desc: &LightDepthMapDesc<'_>) -> Result<Self> {
         let device = &gpu.device;
         let label = desc.label;
+        let indices = scene.index_range(label, desc.geometry)?;
         let linear_depth =
             render_texture(device, &format!("{label}_linear_depth"), desc.width, desc.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
-        let depth = render_texture(
-            device,
-            &format!("{label}_depth"),
-            desc.width,
-            desc.height,
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::empty(),
-        );
+        let depth =
+            render_texture(device, &format!("{label}_depth"), desc.width, desc.height, Self::DEPTH_FORMAT, wgpu::TextureUsages::empty());
         let bias = DepthBiasUniform { values: [desc.constant_bias, desc.slope_bias, desc.width as f32, desc.height as f32] };
         let bias_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(&format!("{label}_bias_uniform")),
             contents: bytemuck::bytes_of(&bias),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bias_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("{label}_bias_layout")),
-            entries: &[uniform_entry(0)],
-        });
         let bias_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(&format!("{label}_bias_bind_group")),
-            layout: &bias_layout,
+            layout: gpu.uniform_layout(),
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: bias_buffer.as_entire_binding() }],
         });
-        let module = create_shader(gpu, &format!("{label}_shader"), include_str!("../../shaders/core/light_depth.wgsl"))?;
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label}_pipeline_layout")),
-            bind_group_layouts: &[Some(&scene.uniform_layout), Some(&bias_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(&format!("{label}_pipeline")),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("light_depth_vertex"),
-                compilation_options: Default::default(),
-                buffers: &[Some(SceneVertex::layout())],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: desc.cull_mode, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                // The light frame's depth is reversed (near = 1): nearest wins with Greater.
-                depth_compare: Some(if desc.farthest { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Greater }),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("light_depth_fragment"),
-                compilation_options: Default::default(),
-                targets: &[Some(Self::FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = Self::pipeline(gpu, desc.cull_mode, desc.farthest)?;
         Ok(Self {
             linear_depth_view: labelled_view(&linear_depth, &format!("{label}_linear_depth")),
             linear_depth,
@@ -138,8 +101,50 @@ impl LightDepthMap {
             pipeline,
             bias_bind_group,
             label: label.to_owned(),
-            geometry: desc.geometry,
+            indices,
             farthest: desc.farthest,
+        })
+    }
+
+    /// The shared pipeline for one culling mode and depth order.
+    fn pipeline(gpu: &GpuContext, cull_mode: Option<wgpu::Face>, farthest: bool) -> Result<wgpu::RenderPipeline> {
+        let key = format!("light_depth_pipeline/{cull_mode:?}/farthest={farthest}");
+        gpu.cached_render_pipeline(&key, |gpu| {
+            let device = &gpu.device;
+            let module = create_shader(gpu, "light_depth_shader", include_str!("../../shaders/core/light_depth.wgsl"))?;
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("light_depth_pipeline_layout"),
+                bind_group_layouts: &[Some(gpu.uniform_layout()), Some(gpu.uniform_layout())],
+                immediate_size: 0,
+            });
+            Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(&key),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("light_depth_vertex"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(SceneVertex::layout())],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: Self::DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    // The light frame's depth is reversed (near = 1): nearest wins with Greater.
+                    depth_compare: Some(if farthest { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Greater }),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                }),
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("light_depth_fragment"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(Self::FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            }))
         })
     }
 
@@ -150,7 +155,7 @@ impl LightDepthMap {
     }
 
     /// Records the pass seen through another frame: a bind group of
-    /// [`GpuScene::uniform_layout`](crate::GpuScene) holding a
+    /// [`GpuContext::uniform_layout`] holding a
     /// [`LightFrameUniform`](crate::LightFrameUniform) (a point on the light,
     /// a tile of it...).
     pub fn encode_with(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup) {
@@ -170,101 +175,44 @@ impl LightDepthMap {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);
         pass.set_bind_group(1, &self.bias_bind_group, &[]);
-        scene.draw(&mut pass, self.geometry);
+        scene.draw(&mut pass, self.indices.clone());
     }
 }
 
-/// Size and bias of a square light depth map over all geometry, read from the
-/// parameters `shadow_map_size`, `constant_bias`, `slope_bias` and
-/// `normal_offset` that the shadow-map techniques share. Declare the last
-/// three with [`ShadowMapSettings::BIAS_PARAMS`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ShadowMapSettings {
-    /// Side of the square map, texels.
-    pub size: u32,
-    /// Constant bias, fraction of the scene diagonal.
+/// Smallest side of a shadow map a technique may ask for, texels.
+pub const SHADOW_MAP_MIN_SIZE: u32 = 16;
+/// Largest side of a shadow map a technique may ask for, texels (devices may allow less).
+pub const SHADOW_MAP_MAX_SIZE: u32 = 16384;
+
+/// The bias of a light depth map and of its lookups, shared by the shadow-map
+/// techniques (flatten it into their settings).
+#[derive(Clone, Copy, Debug, PartialEq, crate::Settings)]
+pub struct ShadowMapBias {
+    /// Depth bias added to every texel, as a fraction of the scene's bounding-box diagonal.
+    #[param(default = 1e-3, min = 0.0, max = 0.1)]
     pub constant_bias: f32,
-    /// Slope-scaled bias, multiples of the depth change per texel.
+    /// Slope-scaled bias: multiples of the depth change across one texel (clamped to 4 texels; normal offset usually makes it unnecessary).
+    #[param(default = 0.0, min = 0.0, max = 16.0)]
     pub slope_bias: f32,
-    /// Normal offset of the lookup point, shadow-map texels (used by the lookup shader).
+    /// Lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011).
+    #[param(default = 0.5, min = 0.0, max = 8.0)]
     pub normal_offset: f32,
 }
 
-impl ShadowMapSettings {
-    /// `constant_bias`, `slope_bias` and `normal_offset`, with their defaults
-    /// and ranges, for a technique's parameter list.
-    pub const BIAS_PARAMS: [ParamSpec; 3] = [
-        ParamSpec {
-            name: "constant_bias",
-            kind: ParamKind::Float { default: 1e-3, min: 0.0, max: 0.1 },
-            doc: "depth bias added to every texel, as a fraction of the scene's bounding-box diagonal",
-        },
-        ParamSpec {
-            name: "slope_bias",
-            kind: ParamKind::Float { default: 0.0, min: 0.0, max: 16.0 },
-            doc: "slope-scaled bias: multiples of the depth change across one texel (clamped to 4 texels; normal offset usually makes it unnecessary)",
-        },
-        ParamSpec {
-            name: "normal_offset",
-            kind: ParamKind::Float { default: 0.5, min: 0.0, max: 8.0 },
-            doc: "lookup point moved off the surface along its normal, in shadow-map texels (Holbert 2011)",
-        },
-    ];
-
-    /// `receiver_plane`: the receiver model of techniques that compare shadow-map taps
-    /// with a receiver (`pcss`, `sssm`), declared once so that they share name, default and doc.
-    pub const RECEIVER_PLANE_PARAM: ParamSpec = ParamSpec {
-        name: "receiver_plane",
-        kind: ParamKind::Bool { default: true },
-        doc: "compare each shadow-map tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch",
-    };
-
-    /// The `shadow_map_size` parameter with a technique's own default.
-    #[must_use]
-    pub const fn size_param(default: i64) -> ParamSpec {
-        ParamSpec {
-            name: "shadow_map_size",
-            kind: ParamKind::Int { default, min: 16, max: 16384 },
-            doc: "side of the square shadow map, texels",
-        }
-    }
-
-    /// Reads `shadow_map_size` and the [`ShadowMapSettings::BIAS_PARAMS`].
-    ///
-    /// # Errors
-    /// A parameter error if one is missing or of another type.
-    pub fn from_params(params: &crate::ParamValues) -> Result<Self> {
-        Ok(Self {
-            size: u32::try_from(params.int("shadow_map_size")?).unwrap_or(u32::MAX),
-            constant_bias: params.float("constant_bias")? as f32,
-            slope_bias: params.float("slope_bias")? as f32,
-            normal_offset: params.float("normal_offset")? as f32,
-        })
-    }
-
-    /// The requirements of a technique made of this map and screen passes:
-    /// the G-buffer, and textures of `shadow_map_size`.
-    ///
-    /// # Errors
-    /// A parameter error.
-    pub fn screen_space_requirements(params: &crate::ParamValues) -> Result<crate::Requirements> {
-        let settings = Self::from_params(params)?;
-        Ok(crate::Requirements { gbuffer: true, max_texture_size: settings.size, ..crate::Requirements::NONE })
-    }
-
-    /// Builds the depth map over all geometry, labelled `label`.
+impl ShadowMapBias {
+    /// A square depth map of side `size` over all geometry with this bias, labelled `label`.
     ///
     /// # Errors
     /// A GPU error if the pipeline is rejected.
-    pub fn depth_map(&self, setup: &crate::TechniqueSetup<'_>, label: &str) -> Result<LightDepthMap> {
+    pub fn depth_map(&self, setup: &crate::TechniqueSetup<'_>, label: &str, size: u32) -> Result<LightDepthMap> {
         let diagonal = setup.scene.bounds.size().length();
         LightDepthMap::new(
             setup.gpu,
             setup.scene,
             &LightDepthMapDesc {
                 label,
-                width: self.size,
-                height: self.size,
+                width: size,
+                height: size,
                 geometry: Geometry::All,
                 cull_mode: None,
                 farthest: false,
@@ -273,4 +221,21 @@ impl ShadowMapSettings {
             },
         )
     }
+}
+
+/// What shadow-map taps are compared with, for techniques that compare taps
+/// with a receiver (percentage-closer filters and their variants): declared once so that they share its
+/// name, default and meaning (flatten it into their settings).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, crate::Settings)]
+pub struct ReceiverModel {
+    /// Compare each shadow-map tap with the receiver's tangent plane along its ray (Isidoro 2006) instead of the receiver's depth; false is Fernando's sketch.
+    #[param(default = true)]
+    pub receiver_plane: bool,
+}
+
+/// The requirements of a technique made of a square shadow map of side
+/// `shadow_map_size` and screen passes: the G-buffer and textures of that size.
+#[must_use]
+pub fn screen_space_requirements(shadow_map_size: u32) -> crate::Requirements {
+    crate::Requirements { gbuffer: true, max_texture_size: shadow_map_size, ..crate::Requirements::NONE }
 }

@@ -37,6 +37,9 @@ pub struct LightFrame {
     pub near: f32,
     /// Far plane (linear depth).
     pub far: f32,
+    /// Length of the diagonal of the scene's bounding box: the scale that
+    /// scene-relative settings (biases, thresholds) are fractions of.
+    pub scene_diagonal: f32,
 }
 
 impl LightFrame {
@@ -110,7 +113,7 @@ impl LightFrame {
         // nearly constant relative to depth, so a near plane a million times closer than the far
         // one still orders surfaces at the far end correctly. Depth tests use `Greater` for nearest.
         let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, far, near);
-        Self { light: *light, view, projection, tan_half, near, far }
+        Self { light: *light, view, projection, tan_half, near, far, scene_diagonal: bounds.size().length() }
     }
 
     /// Size in texels, along the map's two axes, of the part of a `map_size`²
@@ -188,7 +191,7 @@ const BOX_EDGES: [(usize, usize); 12] = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2),
 
 /// [`LightFrame`] as the uniform `shaders/common/light_frame.wgsl` declares.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, crate::UniformStruct)]
 pub struct LightFrameUniform {
     /// World to clip.
     pub view_proj: [[f32; 4]; 4],
@@ -204,6 +207,8 @@ pub struct LightFrameUniform {
     pub normal: [f32; 4],
     /// tan half u, tan half v, near, far.
     pub projection: [f32; 4],
+    /// The scene's bounding-box diagonal; y, z, w unused.
+    pub scene: [f32; 4],
 }
 
 impl From<&LightFrame> for LightFrameUniform {
@@ -217,6 +222,7 @@ impl From<&LightFrame> for LightFrameUniform {
             v_axis: light.v_axis.extend(light.half_size.y).to_array(),
             normal: light.normal().extend(light.area()).to_array(),
             projection: [frame.tan_half.x, frame.tan_half.y, frame.near, frame.far],
+            scene: [frame.scene_diagonal, 0.0, 0.0, 0.0],
         }
     }
 }

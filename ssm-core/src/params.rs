@@ -42,7 +42,7 @@ pub enum ParamKind {
 /// One parameter of a technique: name, kind (type, default, range) and one line of doc.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParamSpec {
-    /// Name used on the command line (`--set pcss.pcf_kernel=15`).
+    /// Name used on the command line (`--set mine.kernel=15`).
     pub name: &'static str,
     /// Type, default and range.
     pub kind: ParamKind,
@@ -287,6 +287,62 @@ impl fmt::Display for ParamValues {
         }
         Ok(())
     }
+}
+
+/// A technique's typed settings: a documented struct whose fields are its
+/// parameters. Derive it (`#[derive(Settings)]`, see [`ssm_derive::Settings`]):
+/// the string parameters of `ssm list`, `--set` and sweeps are made from the
+/// struct, so no name, default or range is written twice.
+pub trait Settings: Sized {
+    /// The parameters, in field order (flattened settings in place).
+    const PARAMS: &'static [ParamSpec];
+
+    /// Reads the settings from a complete set of parameter values.
+    ///
+    /// # Errors
+    /// [`ParamError::WrongType`] when `values` belong to other parameters.
+    fn from_params(values: &ParamValues) -> Result<Self, ParamError>;
+}
+
+/// An enum parameter: one of a fixed set of words. Derive it
+/// (`#[derive(Choice)]`, see [`ssm_derive::Choice`]).
+pub trait Choice: Sized + Copy {
+    /// The words, in declaration order.
+    const OPTIONS: &'static [&'static str];
+    /// The first variant.
+    const FIRST: Self;
+
+    /// The variant called `word`.
+    fn from_name(word: &str) -> Option<Self>;
+
+    /// This variant's word.
+    fn name(self) -> &'static str;
+}
+
+/// A placeholder for filling arrays of parameters in constant code.
+const NO_PARAM: ParamSpec = ParamSpec { name: "", kind: ParamKind::Bool { default: false }, doc: "" };
+
+/// Concatenates parameter lists at compile time (what `#[derive(Settings)]`
+/// uses for flattened settings). `N` must be the total length.
+///
+/// # Panics
+/// At compile time, when `N` is not the total length.
+#[must_use]
+pub const fn concat_params<const N: usize>(parts: &[&[ParamSpec]]) -> [ParamSpec; N] {
+    let mut out = [NO_PARAM; N];
+    let mut filled = 0;
+    let mut part = 0;
+    while part < parts.len() {
+        let mut index = 0;
+        while index < parts[part].len() {
+            out[filled] = parts[part][index];
+            filled += 1;
+            index += 1;
+        }
+        part += 1;
+    }
+    assert!(filled == N, "concat_params: N is not the total length");
+    out
 }
 
 #[cfg(test)]

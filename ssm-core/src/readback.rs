@@ -1,7 +1,7 @@
 //! Copying GPU buffers and textures back to the CPU.
 
 use crate::context::GpuContext;
-use crate::error::{Error, Result};
+use crate::error::{Error, Reason, Result};
 
 /// Maps `size` bytes of a `COPY_SRC` buffer through a staging buffer and returns them.
 ///
@@ -17,19 +17,22 @@ pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer, size: u64, what: &st
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback_encoder") });
     encoder.copy_buffer_to_buffer(source, 0, &staging, 0, size);
     gpu.queue.submit([encoder.finish()]);
-    map_and_copy(gpu, &staging, what)
+    map_and_read(gpu, &staging, what)
 }
 
-fn map_and_copy(gpu: &GpuContext, staging: &wgpu::Buffer, what: &str) -> Result<Vec<u8>> {
-    let fail = |detail: String| Error::Readback { what: what.into(), detail };
+/// Waits for the GPU, maps a whole `MAP_READ` buffer, copies its bytes out and unmaps it.
+///
+/// # Errors
+/// [`Error::Readback`] if mapping fails or the device is lost.
+pub fn map_and_read(gpu: &GpuContext, staging: &wgpu::Buffer, what: &str) -> Result<Vec<u8>> {
     let (sender, receiver) = std::sync::mpsc::channel();
     staging.map_async(wgpu::MapMode::Read, .., move |result| {
         // The receiver outlives the wait below; a send failure only means nobody listens any more.
         let _ = sender.send(result);
     });
-    gpu.wait_idle().map_err(fail)?;
-    receiver.recv().map_err(|e| fail(e.to_string()))?.map_err(|e| fail(e.to_string()))?;
-    let bytes = staging.get_mapped_range(..).map_err(|e| fail(e.to_string()))?.to_vec();
+    gpu.wait_idle().map_err(|e| Error::readback(what, Reason(e)))?;
+    receiver.recv().map_err(|e| Error::readback(what, e))?.map_err(|e| Error::readback(what, e))?;
+    let bytes = staging.get_mapped_range(..).map_err(|e| Error::readback(what, e))?.to_vec();
     staging.unmap();
     Ok(bytes)
 }
@@ -59,7 +62,7 @@ pub fn read_texture(gpu: &GpuContext, texture: &wgpu::Texture, bytes_per_pixel: 
         wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([encoder.finish()]);
-    let padded = map_and_copy(gpu, &staging, what)?;
+    let padded = map_and_read(gpu, &staging, what)?;
     let mut packed = Vec::with_capacity((row * height) as usize);
     for y in 0..height as usize {
         let start = y * padded_row as usize;

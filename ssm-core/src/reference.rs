@@ -455,10 +455,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
     let params = setup.params;
     let device = &setup.gpu.device;
     let (width, height) = (setup.scene.width, setup.scene.height);
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("reference_traced_layout"),
-        entries: &[crate::passes::texture_entry(0)],
-    });
+    let layout = setup.gpu.texture_layout();
     let traced = (0..setup.scene.light_count())
         .map(|light| {
             let label = format!("reference_traced_light{light}");
@@ -467,7 +464,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
             let view = crate::passes::labelled_view(&texture, &label);
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(&format!("{label}_bind_group")),
-                layout: &layout,
+                layout,
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) }],
             });
             (texture, group)
@@ -480,7 +477,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         NAME,
         "reference_upload",
         (&module, "reference_upload"),
-        Some(&layout),
+        Some(layout),
         crate::VISIBILITY_FORMAT.into(),
     )?;
     Ok(Box::new(ReferenceTechnique {
@@ -504,6 +501,9 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     params: PARAMS,
     requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,
+    presets: &[],
+    trade: None,
+    uniforms: &[],
 };
 
 crate::register_technique!(INFO);

@@ -85,6 +85,9 @@ mod tests {
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,
+        presets: &[],
+        trade: None,
+        uniforms: &[],
     };
     static ALPHA_AGAIN: TechniqueInfo = TechniqueInfo {
         name: "alpha",
@@ -94,6 +97,9 @@ mod tests {
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,
+        presets: &[],
+        trade: None,
+        uniforms: &[],
     };
     static BETA: TechniqueInfo = TechniqueInfo {
         name: "beta",
@@ -103,6 +109,9 @@ mod tests {
         params: &[],
         requirements: |_| Ok(Requirements::NONE),
         create: no_create,
+        presets: &[],
+        trade: None,
+        uniforms: &[],
     };
 
     #[test]

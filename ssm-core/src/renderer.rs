@@ -13,7 +13,7 @@ use crate::frame::{Frame, SharedInputs};
 use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
 use crate::params::ParamValues;
-use crate::passes::{color_attachment, labelled_view, render_texture};
+use crate::passes::{labelled_view, render_texture};
 use crate::readback::read_texture;
 use crate::technique::{Requirements, ShadowTechnique, TechniqueInfo, create_checked};
 use crate::timing::{FrameTimings, PassTimer, PassTiming};
@@ -35,7 +35,8 @@ pub struct Renderer {
     pub cpu_scene: std::sync::Arc<Scene>,
     /// The shared inputs built for the techniques in use.
     pub shared: SharedInputs,
-    visibility: Vec<(wgpu::Texture, wgpu::TextureView)>,
+    visibility: Vec<wgpu::Texture>,
+    visibility_views: Vec<wgpu::TextureView>,
     composite: Option<Composite>,
     timer: PassTimer,
     /// Times of the shared passes (the G-buffer), measured once when built.
@@ -56,7 +57,7 @@ impl Renderer {
             return Err(Error::InvalidSize { width, height, problem: format!("each side must be in [1, {max}] on this adapter") });
         }
         let gpu = gpu.clone();
-        let gpu_scene = GpuScene::new(&gpu, scene, width, height);
+        let gpu_scene = GpuScene::new(&gpu, scene, width, height, needs.roles);
         let mut timer = PassTimer::new(&gpu);
         let mut shared = SharedInputs::default();
         let mut shared_timings = Vec::new();
@@ -77,27 +78,27 @@ impl Renderer {
         if needs.adjacency {
             shared.adjacency = Some(casting_adjacency(scene));
         }
-        let visibility = (0..gpu_scene.light_count())
+        let visibility: Vec<wgpu::Texture> = (0..gpu_scene.light_count())
             .map(|light| {
-                let label = format!("visibility_target_{light}");
-                let texture = render_texture(
+                render_texture(
                     &gpu.device,
-                    &label,
+                    &format!("visibility_target_{light}"),
                     width,
                     height,
                     VISIBILITY_FORMAT,
                     wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
-                );
-                let view = labelled_view(&texture, &label);
-                (texture, view)
+                )
             })
             .collect();
+        let visibility_views =
+            visibility.iter().enumerate().map(|(light, texture)| labelled_view(texture, &format!("visibility_target_{light}"))).collect();
         let renderer = Self {
             gpu,
             scene: gpu_scene,
             cpu_scene: std::sync::Arc::new(scene.clone()),
             shared,
             visibility,
+            visibility_views,
             composite: None,
             timer,
             shared_timings,
@@ -118,7 +119,7 @@ impl Renderer {
     /// [`Error::MissingFeatures`], [`Error::LimitTooLow`], [`Error::UndeclaredRequirement`],
     /// or whatever the technique's constructor reports.
     pub fn create_technique(&self, info: &TechniqueInfo, params: &ParamValues) -> Result<Box<dyn ShadowTechnique>> {
-        create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), &self.shared, params)
+        create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), (&self.shared, &self.visibility_views), params)
     }
 
     /// Renders one frame of `technique` (registered as `name`) for every
@@ -129,30 +130,14 @@ impl Renderer {
     pub fn render(&mut self, technique: &mut dyn ShadowTechnique, name: &str) -> Result<FrameTimings> {
         let start = Instant::now();
         self.timer.reset();
-        let mut frame = Frame {
-            gpu: &self.gpu,
-            scene: &self.scene,
-            shared: &self.shared,
-            encoder: self
-                .gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{name}_frame_encoder")) }),
-            timer: &mut self.timer,
-        };
-        for (light, (_, view)) in self.visibility.iter().enumerate() {
-            // The contract: the target starts fully lit.
-            drop(frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("visibility_clear"),
-                color_attachments: &[color_attachment(view, Some(wgpu::Color::WHITE))],
-                ..Default::default()
-            }));
-            frame.timer.set_light(light);
-            frame.encoder.push_debug_group(name);
+        let mut frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, name);
+        for (light, view) in self.visibility_views.iter().enumerate() {
+            frame.begin_light(light, view);
             let result = technique.render(&mut frame, light, view);
-            frame.encoder.pop_debug_group();
+            frame.end_light();
             result?;
         }
-        let Frame { mut encoder, .. } = frame;
+        let mut encoder = frame.finish();
         self.timer.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait_idle().map_err(|e| Error::Gpu { during: format!("rendering `{name}`"), messages: vec![e] })?;
@@ -167,10 +152,10 @@ impl Renderer {
     /// # Errors
     /// [`Error::InvalidOutput`] naming `technique` and the first bad pixel, or a readback error.
     pub fn read_visibility(&self, light: usize, technique: &str) -> Result<Vec<f32>> {
-        let (texture, _) = self
+        let texture = self
             .visibility
             .get(light)
-            .ok_or_else(|| Error::Readback { what: format!("visibility of light {light}"), detail: "no such light".into() })?;
+            .ok_or_else(|| Error::readback(format!("visibility of light {light}"), crate::error::Reason("no such light".into())))?;
         let bytes = read_texture(&self.gpu, texture, 4, "visibility")?;
         let values: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         let bad = |v: &f32| !(v.is_finite() && *v >= -VISIBILITY_RANGE_TOLERANCE && *v <= 1.0 + VISIBILITY_RANGE_TOLERANCE);
@@ -215,8 +200,7 @@ impl Renderer {
     pub fn shade(&mut self) -> Result<Vec<u8>> {
         let gbuffer = self.shared.gbuffer("composite shading")?;
         if self.composite.is_none() {
-            let views: Vec<wgpu::TextureView> = self.visibility.iter().map(|(_, view)| view.clone()).collect();
-            self.composite = Some(Composite::new(&self.gpu, &self.scene, gbuffer, &views)?);
+            self.composite = Some(Composite::new(&self.gpu, &self.scene, &self.visibility_views)?);
         }
         let Some(composite) = &self.composite else { unreachable!("built above") };
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("composite_encoder") });

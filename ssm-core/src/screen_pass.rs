@@ -1,6 +1,6 @@
 //! A full-screen pass over the G-buffer for one light: the shape of every
-//! screen-space step (the lookup of hard shadows, PCSS's search and filter,
-//! SSSM's separable passes).
+//! screen-space step (a shadow-map lookup, a blocker search and filter, the
+//! passes of a separable filter).
 
 use crate::error::Result;
 use crate::frame::Frame;

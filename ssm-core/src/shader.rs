@@ -84,7 +84,7 @@ pub fn create_shader(gpu: &GpuContext, label: &str, source: &str) -> Result<wgpu
 }
 
 /// As [`create_shader`], with a technique's own importable files besides
-/// [`COMMON_SHADERS`], as `(path under shaders/, text)`: `("atty/settings.wgsl", include_str!(...))`.
+/// [`COMMON_SHADERS`], as `(path under shaders/, text)`: `("mine/settings.wgsl", include_str!(...))`.
 ///
 /// # Errors
 /// [`Error::Shader`] for a bad import, [`Error::Gpu`] when wgpu rejects the WGSL.

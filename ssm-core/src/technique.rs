@@ -95,6 +95,10 @@ pub struct TechniqueSetup<'a> {
     pub cpu_scene: &'a ssm_scene::Scene,
     /// The shared inputs.
     pub shared: &'a SharedInputs,
+    /// The visibility target of each light (`R32Float`, the view's size), the
+    /// `output` that `render` will get for that light: bind groups that use it
+    /// are made here, not per frame.
+    pub outputs: &'a [wgpu::TextureView],
     /// Parameter values, complete.
     pub params: &'a ParamValues,
 }
@@ -107,8 +111,9 @@ pub struct TechniqueSetup<'a> {
 /// `R32Float` texture of the view's size that the framework has cleared to 1.
 /// Values must be finite and in `[0, 1]`. Every pass goes through
 /// [`Frame::render_pass`] or [`Frame::compute_pass`] with a label prefixed by
-/// the technique's name, so it is labelled and timed; the framework wraps the
-/// whole in a debug group named after the technique.
+/// the technique's name, so it is labelled and timed (the frame offers no
+/// other way to record one); the framework wraps the whole in a debug group
+/// named after the technique.
 pub trait ShadowTechnique {
     /// Records one frame's passes for `light` into `frame`, writing `output`.
     ///
@@ -117,13 +122,13 @@ pub trait ShadowTechnique {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()>;
 
     /// Scalar diagnostics of the last frame, reported beside the error metrics
-    /// (SSSM's reuse share, PVSM's tile count...). Empty by default. May read
+    /// (a share of work reused, a tile count...). Empty by default. May read
     /// the GPU: it is called after the frame has finished.
     fn diagnostics(&mut self, _gpu: &GpuContext) -> Vec<(String, f64)> {
         Vec::new()
     }
 
-    /// Extra per-pixel images of the last frame (SSSM's reuse share, say),
+    /// Extra per-pixel images of the last frame (a share of work reused per pixel, say),
     /// written beside the visibility by `ssm render` and `ssm compare`. Empty
     /// by default.
     ///
@@ -156,11 +161,74 @@ pub enum TechniqueKind {
     GroundTruth,
 }
 
+/// A named sweep a technique declares beside its parameters (the studies of
+/// its paper), discovered by `ssm sweep --list-presets` and the preset benches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Preset {
+    /// Name for `ssm sweep --preset`.
+    pub name: &'static str,
+    /// What it reproduces (the paper's figure or table) and how to read it.
+    pub summary: &'static str,
+    /// Scenes it is meant for (built-in names or manifest paths); the first is
+    /// the one `ssm sweep --preset` uses without `--scene`.
+    pub scenes: &'static [&'static str],
+    /// `--vary` specifications: `<technique>.<param>[:<param>...]=<values>`,
+    /// or `scene.light_scale=...` / `scene.occluder_lift=...`.
+    pub varies: &'static [&'static str],
+    /// The plot's x axis: `time` or a varied parameter (`mine.map_size`).
+    pub x_axis: &'static str,
+    /// The plot's y axis: `mae-penumbra`, `rmse`, `one-minus-ssim`, `flip` or `time`.
+    pub y_axis: &'static str,
+    /// Which pixels the errors cover: `all` or `receivers`.
+    pub pixels: &'static str,
+}
+
+impl Preset {
+    /// A preset with the usual axes (time against penumbra error, all pixels); set
+    /// the other fields with struct update syntax.
+    pub const DEFAULT: Self =
+        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae-penumbra", pixels: "all" };
+}
+
+/// Size and field offsets of a Rust struct uploaded as a uniform
+/// (`#[derive(UniformStruct)]` makes it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RustLayout {
+    /// The Rust struct's name.
+    pub name: &'static str,
+    /// `size_of`, bytes.
+    pub size: usize,
+    /// Each field's name and byte offset.
+    pub fields: &'static [(&'static str, usize)],
+}
+
+/// A Rust struct uploaded as a uniform, whose layout can be checked against WGSL.
+pub trait UniformStruct {
+    /// Its layout.
+    const LAYOUT: RustLayout;
+}
+
+/// A uniform a technique uploads, paired with the WGSL struct its shaders read
+/// it as: a test parses the WGSL with naga and fails on any difference of size
+/// or field offset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UniformCheck {
+    /// The WGSL struct's name.
+    pub wgsl_struct: &'static str,
+    /// A WGSL file that declares it (its imports are resolved).
+    pub wgsl_source: &'static str,
+    /// The technique's own importable files, as for
+    /// [`create_shader_with_imports`](crate::shader::create_shader_with_imports).
+    pub imports: &'static [(&'static str, &'static str)],
+    /// The Rust side.
+    pub rust: RustLayout,
+}
+
 /// A technique's registration: name, documentation, parameters, requirements and constructor.
 ///
 /// Submit one per technique crate with [`register_technique!`](crate::register_technique).
 pub struct TechniqueInfo {
-    /// Unique name (`hard`, `pcss`...), used on the command line.
+    /// Unique name (`mine`), used on the command line.
     pub name: &'static str,
     /// One line: what it is.
     pub summary: &'static str,
@@ -174,6 +242,14 @@ pub struct TechniqueInfo {
     pub requirements: fn(&ParamValues) -> Result<Requirements>,
     /// Builds the technique (pipelines, textures) for a scene and size.
     pub create: fn(&TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>>,
+    /// Sweeps reproducing its paper's studies.
+    pub presets: &'static [Preset],
+    /// Its quality knob in the cross-technique `trade` sweep, as the part of a
+    /// `--vary` after the technique's name: `blocker_kernel:pcf_kernel=3:5,7:15`.
+    /// `None` keeps it out of the trade plot.
+    pub trade: Option<&'static str>,
+    /// Its uniforms, checked against the WGSL structs that read them.
+    pub uniforms: &'static [UniformCheck],
 }
 
 impl TechniqueInfo {
@@ -231,7 +307,7 @@ pub(crate) fn create_checked(
     info: &TechniqueInfo,
     gpu: &GpuContext,
     (scene, cpu_scene): (&GpuScene, &ssm_scene::Scene),
-    shared: &SharedInputs,
+    (shared, outputs): (&SharedInputs, &[wgpu::TextureView]),
     params: &ParamValues,
 ) -> Result<Box<dyn ShadowTechnique>> {
     let requirements = (info.requirements)(params)?;
@@ -245,7 +321,13 @@ pub(crate) fn create_checked(
             input: "mesh adjacency (the renderer was built without it)",
         });
     }
-    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, params })?;
+    if requirements.roles && !scene.has_roles {
+        return Err(Error::UndeclaredRequirement {
+            technique: info.name.into(),
+            input: "occluder/receiver roles (the renderer was built without them)",
+        });
+    }
+    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params })?;
     let messages = gpu.take_errors();
     if messages.is_empty() { Ok(technique) } else { Err(Error::Gpu { during: format!("creating technique `{}`", info.name), messages }) }
 }

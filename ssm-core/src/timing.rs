@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use crate::context::GpuContext;
-use crate::error::{Error, Result};
+use crate::error::{Error, Reason, Result};
 use crate::readback::read_buffer;
 
 /// Most timed passes in one frame; later passes run untimed (and are counted in [`FrameTimings::untimed_passes`]).
@@ -44,6 +44,21 @@ pub struct FrameTimings {
     pub cpu_wall_ms: f64,
     /// Passes that ran past [`MAX_TIMED_PASSES`] and were not timed.
     pub untimed_passes: u32,
+    /// CPU work inside the frame, timed on the CPU: mid-frame readback stalls
+    /// and the work a paper puts on the CPU (PVSM's kd-tree). Not in `gpu_ms`.
+    pub cpu_scopes: Vec<PassTiming>,
+}
+
+impl FrameTimings {
+    /// The frame's time: the GPU passes' sum plus the CPU scopes inside the
+    /// frame (which stall the GPU), or the CPU wall time without timestamps.
+    #[must_use]
+    pub fn frame_ms(&self) -> f64 {
+        match self.gpu_ms {
+            Some(gpu) => gpu + self.cpu_scopes.iter().map(|s| s.ms).sum::<f64>(),
+            None => self.cpu_wall_ms,
+        }
+    }
 }
 
 /// Allocates timestamp pairs for passes as they are recorded and turns them into [`PassTiming`]s.
@@ -51,6 +66,7 @@ pub struct FrameTimings {
 pub struct PassTimer {
     queries: Option<TimerQueries>,
     scopes: Vec<(String, usize)>,
+    cpu_scopes: Vec<PassTiming>,
     untimed: u32,
     light: usize,
 }
@@ -80,7 +96,7 @@ impl PassTimer {
             }),
             period_ns: f64::from(gpu.queue.get_timestamp_period()),
         });
-        Self { queries, scopes: Vec::new(), untimed: 0, light: 0 }
+        Self { queries, scopes: Vec::new(), cpu_scopes: Vec::new(), untimed: 0, light: 0 }
     }
 
     /// True when passes are timed on the GPU.
@@ -92,7 +108,13 @@ impl PassTimer {
     /// Forgets the last frame's passes.
     pub fn reset(&mut self) {
         self.scopes.clear();
+        self.cpu_scopes.clear();
         self.untimed = 0;
+    }
+
+    /// Records `ms` of CPU work named `name` for the current light.
+    pub fn cpu_scope(&mut self, name: &str, ms: f64) {
+        self.cpu_scopes.push(PassTiming { name: name.to_owned(), light: self.light, ms });
     }
 
     /// The light that subsequent passes belong to.
@@ -150,13 +172,13 @@ impl PassTimer {
                 gpu_ms: None,
                 cpu_wall_ms,
                 untimed_passes: self.untimed,
+                cpu_scopes: self.cpu_scopes.clone(),
             });
         };
         let mut passes = Vec::with_capacity(self.scopes.len());
         if !self.scopes.is_empty() {
             let bytes = read_buffer(gpu, &queries.resolve_buffer, self.scopes.len() as u64 * 16, "pass timestamps")?;
-            let stamps: &[u64] =
-                bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Readback { what: "pass timestamps".into(), detail: e.to_string() })?;
+            let stamps: &[u64] = bytemuck::try_cast_slice(&bytes).map_err(|e| Error::readback("pass timestamps", Reason(e.to_string())))?;
             for ((name, light), pair) in self.scopes.iter().zip(stamps.chunks_exact(2)) {
                 // Some drivers return an end before the begin for empty passes: count those as zero.
                 let ticks = pair[1].saturating_sub(pair[0]);
@@ -164,6 +186,13 @@ impl PassTimer {
             }
         }
         let gpu_ms = Some(passes.iter().map(|p| p.ms).sum());
-        Ok(FrameTimings { source: TimingSource::GpuTimestamps, passes, gpu_ms, cpu_wall_ms, untimed_passes: self.untimed })
+        Ok(FrameTimings {
+            source: TimingSource::GpuTimestamps,
+            passes,
+            gpu_ms,
+            cpu_wall_ms,
+            untimed_passes: self.untimed,
+            cpu_scopes: self.cpu_scopes.clone(),
+        })
     }
 }

@@ -17,115 +17,104 @@
 //! Sec. 4.3 and 7), so the cost no longer grows with a readback.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{color_attachment, labelled_view, render_texture, texture_entry, uniform_entry};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, color_attachment, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+};
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    Error, Frame, Geometry, LightDepthMap, LightDepthMapDesc, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
-    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    Choice, Error, Frame, Geometry, LightDepthMap, LightDepthMapDesc, ParamValues, Requirements, Result, ScreenPass, Settings,
+    ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
+    register_technique,
 };
-use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "atty";
 
-/// Parameters of [`SoftShadowMaps`].
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "occluder_map_size",
-        kind: ParamKind::Int { default: 256, min: 32, max: 2048 },
-        doc: "side of the occluder map, texels: one micro-patch per texel (cost grows with its square)",
-    },
-    ParamSpec {
-        name: "ssm_size",
-        kind: ParamKind::Int { default: 512, min: 32, max: 4096 },
-        doc: "side of the soft shadow map and of the receiver map, texels",
-    },
-    ParamSpec {
-        name: "two_sided",
-        kind: ParamKind::Bool { default: false },
-        doc: "also discretise the farthest back faces and keep the larger occlusion (Sec. 3.5; about twice the cost)",
-    },
-    ParamSpec {
-        name: "accumulation",
-        kind: ParamKind::Choice { default: "f32", options: &["f32", "f16"] },
-        doc: "format of the soft shadow map the patches are summed into: f32 (needs FLOAT32_BLENDABLE) or f16 (the paper's hardware; see Appendix A)",
-    },
-    ParamSpec {
-        name: "normal_offset",
-        kind: ParamKind::Float { default: 0.5, min: 0.0, max: 8.0 },
-        doc: "projection lookup point moved off the surface along its normal, in receiver-map texels",
-    },
-    ParamSpec {
-        name: "receiver_tolerance",
-        kind: ParamKind::Float { default: 2.0, min: 0.0, max: 64.0 },
-        doc: "receiver-map depths within this many texel footprints (world size of one receiver-map texel at the depth looked up) of a receiver count as that receiver: the SSM's bilinear lookup blends only those, and a point farther behind is hidden (in umbra)",
-    },
-    ParamSpec {
-        name: "self_shadow_tolerance",
-        kind: ParamKind::Float { default: 0.0, min: 0.0, max: 16.0 },
-        doc: "a micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper)",
-    },
-];
-
 /// WGSL files the Atty shaders import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("atty/atty_settings.wgsl", include_str!("../../../shaders/atty/atty_settings.wgsl"))];
+/// The accumulation of micro-patches into the SSM.
+const ACCUMULATE_SHADER: &str = include_str!("../../../shaders/atty/atty_accumulate.wgsl");
+/// The projection of the SSM onto the screen.
+const PROJECT_SHADER: &str = include_str!("../../../shaders/atty/atty_project.wgsl");
 
-/// The settings uniform both Atty shaders read (`shaders/atty/atty_settings.wgsl`).
+/// The format the micro-patches' occlusions are summed in (Sec. 4.1, Appendix A).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum Accumulation {
+    /// 32-bit float: needs FLOAT32_BLENDABLE.
+    F32,
+    /// 16-bit float: the paper's 2006 hardware; loses patches that hide less than 2⁻¹⁰ of the light.
+    F16,
+}
+
+impl Accumulation {
+    /// The soft shadow map's texture format.
+    #[must_use]
+    pub fn format(self) -> wgpu::TextureFormat {
+        match self {
+            Self::F32 => wgpu::TextureFormat::R32Float,
+            Self::F16 => wgpu::TextureFormat::R16Float,
+        }
+    }
+}
+
+/// Settings of [`SoftShadowMaps`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct AttySettings {
+    /// Side of the occluder map, texels: one micro-patch per texel (cost grows with its square).
+    #[param(default = 256, min = 32, max = 2048)]
+    pub occluder_map_size: u32,
+    /// Side of the soft shadow map and of the receiver map, texels.
+    #[param(default = 512, min = 32, max = 4096)]
+    pub ssm_size: u32,
+    /// Also discretise the farthest back faces and keep the larger occlusion (Sec. 3.5; about twice the cost).
+    #[param(default = false)]
+    pub two_sided: bool,
+    /// Format of the soft shadow map the patches are summed into: f32 (needs FLOAT32_BLENDABLE) or f16 (the paper's hardware; see Appendix A).
+    #[param(choice, default = "f32")]
+    pub accumulation: Accumulation,
+    /// Projection lookup point moved off the surface along its normal, in receiver-map texels.
+    #[param(default = 0.5, min = 0.0, max = 8.0)]
+    pub normal_offset: f32,
+    /// Receiver-map depths within this many texel footprints (world size of one receiver-map texel at the depth looked up) of a receiver count as that receiver: the SSM's bilinear lookup blends only those, and a point farther behind is hidden (in umbra).
+    #[param(default = 2.0, min = 0.0, max = 64.0)]
+    pub receiver_tolerance: f32,
+    /// A micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper).
+    #[param(default = 0.0, min = 0.0, max = 16.0)]
+    pub self_shadow_tolerance: f32,
+}
+
+/// The settings uniform both Atty shaders read (`AttySettings` in `shaders/atty/atty_settings.wgsl`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct AttySettingsUniform {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct AttySettingsUniform {
     occluder_map_size: f32,
     soft_shadow_map_size: f32,
     normal_offset: f32,
     receiver_tolerance: f32,
     self_shadow_tolerance: f32,
     receiver_bias: f32,
-    padding: [f32; 2],
+    _pad0: f32,
+    _pad1: f32,
 }
 
-/// Settings read from the parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AttySettings {
-    /// Occluder map side.
-    pub occluder_map_size: u32,
-    /// SSM and receiver map side.
-    pub ssm_size: u32,
-    /// Two-sided variant.
-    pub two_sided: bool,
-    /// SSM format.
-    pub accumulation: wgpu::TextureFormat,
-    /// Normal offset, texels.
-    pub normal_offset: f32,
-    /// Same-receiver depth tolerance, receiver-map texel footprints.
-    pub receiver_tolerance: f32,
-    /// Self-shadow tolerance, micro-patch widths.
-    pub self_shadow_tolerance: f32,
-}
-
-impl AttySettings {
-    /// Reads the parameters.
-    ///
-    /// # Errors
-    /// A parameter error.
-    pub fn from_params(params: &ParamValues) -> Result<Self> {
-        let size = |name| params.int(name).map(|v| u32::try_from(v).unwrap_or(u32::MAX));
-        Ok(Self {
-            occluder_map_size: size("occluder_map_size")?,
-            ssm_size: size("ssm_size")?,
-            two_sided: params.bool("two_sided")?,
-            accumulation: match params.choice("accumulation")? {
-                "f16" => wgpu::TextureFormat::R16Float,
-                _ => wgpu::TextureFormat::R32Float,
-            },
-            normal_offset: params.float("normal_offset")? as f32,
-            receiver_tolerance: params.float("receiver_tolerance")? as f32,
-            self_shadow_tolerance: params.float("self_shadow_tolerance")? as f32,
-        })
+impl From<&AttySettings> for AttySettingsUniform {
+    fn from(settings: &AttySettings) -> Self {
+        Self {
+            occluder_map_size: settings.occluder_map_size as f32,
+            soft_shadow_map_size: settings.ssm_size as f32,
+            normal_offset: settings.normal_offset,
+            receiver_tolerance: settings.receiver_tolerance,
+            self_shadow_tolerance: settings.self_shadow_tolerance,
+            // The baselines' default constant bias, a fraction of the scene's diagonal.
+            receiver_bias: ShadowMapBias::default().constant_bias,
+            _pad0: 0.0,
+            _pad1: 0.0,
+        }
     }
 }
 
 /// One soft shadow map and the pass that fills it from one occluder map.
-struct Accumulation {
+struct SideAccumulation {
     occluder_map: LightDepthMap,
     soft_shadow_map: wgpu::TextureView,
     bind_group: wgpu::BindGroup,
@@ -136,159 +125,41 @@ struct Accumulation {
 pub struct SoftShadowMaps {
     receiver_map: LightDepthMap,
     /// Front faces (or every face, one-sided), then back faces when two-sided.
-    accumulations: Vec<Accumulation>,
+    accumulations: Vec<SideAccumulation>,
     accumulate_pipeline: wgpu::RenderPipeline,
     project: ScreenPass,
     project_group: wgpu::BindGroup,
     patches: u32,
 }
 
+/// A linear depth map of the occluders or receivers, without bias: micro-patches and receivers sit at their true depths.
+fn unbiased_depth_map(
+    setup: &TechniqueSetup<'_>,
+    label: &str,
+    size: u32,
+    geometry: Geometry,
+    (cull_mode, farthest): (Option<wgpu::Face>, bool),
+) -> Result<LightDepthMap> {
+    LightDepthMap::new(
+        setup.gpu,
+        setup.scene,
+        &LightDepthMapDesc { label, width: size, height: size, geometry, cull_mode, farthest, constant_bias: 0.0, slope_bias: 0.0 },
+    )
+}
+
 impl SoftShadowMaps {
     /// Builds the maps and pipelines.
     ///
     /// # Errors
-    /// A parameter or GPU error.
+    /// A parameter or GPU error, or [`Error::Unrepresentable`] when the receivers are too small in the light's frame.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = AttySettings::from_params(setup.params)?;
         check_receivers_resolved(setup, settings.ssm_size)?;
-        let device = &setup.gpu.device;
-        let depth_map = |label: &str, size: u32, geometry: Geometry, cull_mode: Option<wgpu::Face>, farthest: bool| {
-            // No bias: micro-patches and receivers sit at their true depths.
-            LightDepthMap::new(
-                setup.gpu,
-                setup.scene,
-                &LightDepthMapDesc { label, width: size, height: size, geometry, cull_mode, farthest, constant_bias: 0.0, slope_bias: 0.0 },
-            )
-        };
-        let receiver_map = depth_map("atty_receiver_map", settings.ssm_size, Geometry::Receivers, None, false)?;
-        let uniform = AttySettingsUniform {
-            occluder_map_size: settings.occluder_map_size as f32,
-            soft_shadow_map_size: settings.ssm_size as f32,
-            normal_offset: settings.normal_offset,
-            receiver_tolerance: settings.receiver_tolerance,
-            self_shadow_tolerance: settings.self_shadow_tolerance,
-            // The baselines' default constant bias: 0.1% of the scene's diagonal.
-            receiver_bias: 1e-3 * setup.scene.bounds.size().length(),
-            padding: [0.0; 2],
-        };
-        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("atty_settings_uniform"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let accumulate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("atty_accumulate_layout"),
-            entries: &[texture_entry(0), texture_entry(1), uniform_entry(2)],
-        });
-        // One-sided: the nearest surface of every occluder face. Two-sided (Sec. 3.5): the nearest
-        // front faces, and the farthest back faces.
-        let occluder_maps: Vec<(&'static str, &'static str, Option<wgpu::Face>, bool)> = if settings.two_sided {
-            vec![
-                ("atty_occluder_map_front", "atty_accumulate_front", Some(wgpu::Face::Back), false),
-                ("atty_occluder_map_back", "atty_accumulate_back", Some(wgpu::Face::Front), true),
-            ]
-        } else {
-            vec![("atty_occluder_map", "atty_accumulate", None, false)]
-        };
-        let mut accumulations = Vec::new();
-        for (map_label, pass_label, cull, farthest) in occluder_maps {
-            let occluder_map = depth_map(map_label, settings.occluder_map_size, Geometry::Occluders, cull, farthest)?;
-            let texture_label = format!("{pass_label}_soft_shadow_map");
-            let texture = render_texture(
-                device,
-                &texture_label,
-                settings.ssm_size,
-                settings.ssm_size,
-                settings.accumulation,
-                wgpu::TextureUsages::empty(),
-            );
-            let soft_shadow_map = labelled_view(&texture, &texture_label);
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(&format!("{pass_label}_bind_group")),
-                layout: &accumulate_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&occluder_map.linear_depth_view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: settings_buffer.as_entire_binding() },
-                ],
-            });
-            accumulations.push(Accumulation { occluder_map, soft_shadow_map, bind_group, label: pass_label });
-        }
-
-        let accumulate_module = create_shader_with_imports(
-            setup.gpu,
-            "atty_accumulate_shader",
-            include_str!("../../../shaders/atty/atty_accumulate.wgsl"),
-            LOCAL_SHADERS,
-        )?;
-        let accumulate_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("atty_accumulate_pipeline_layout"),
-            bind_group_layouts: &[Some(&setup.scene.uniform_layout), Some(&accumulate_layout)],
-            immediate_size: 0,
-        });
-        // Sec. 4.1: the patches' occlusions are summed by additive blending into the float SSM.
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let accumulate_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("atty_accumulate_pipeline"),
-            layout: Some(&accumulate_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &accumulate_module,
-                entry_point: Some("atty_patch_vertex"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &accumulate_module,
-                entry_point: Some("atty_patch_fragment"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: settings.accumulation,
-                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
-                    write_mask: wgpu::ColorWrites::RED,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-
-        let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("atty_project_layout"),
-            entries: &[texture_entry(0), texture_entry(1), texture_entry(2), uniform_entry(3)],
-        });
-        let front = &accumulations[0].soft_shadow_map;
-        // One-sided: the front map stands in for the back one (max(x, x) = x).
-        let back = accumulations.get(1).map_or(front, |a| &a.soft_shadow_map);
-        let project_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("atty_project_bind_group"),
-            layout: &project_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(front) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(back) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view) },
-                wgpu::BindGroupEntry { binding: 3, resource: settings_buffer.as_entire_binding() },
-            ],
-        });
-        let project_module = create_shader_with_imports(
-            setup.gpu,
-            "atty_project_shader",
-            include_str!("../../../shaders/atty/atty_project.wgsl"),
-            LOCAL_SHADERS,
-        )?;
-        let project = ScreenPass::new(
-            setup,
-            NAME,
-            "atty_project",
-            (&project_module, "atty_project"),
-            Some(&project_layout),
-            VISIBILITY_FORMAT.into(),
-        )?;
+        let settings_buffer = uniform_buffer(&setup.gpu.device, "atty_settings_uniform", &AttySettingsUniform::from(&settings));
+        let receiver_map = unbiased_depth_map(setup, "atty_receiver_map", settings.ssm_size, Geometry::Receivers, (None, false))?;
+        let accumulations = Self::accumulations(setup, &settings, &receiver_map, &settings_buffer)?;
+        let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation)?;
+        let (project, project_group) = Self::projection(setup, &accumulations, &receiver_map, &settings_buffer)?;
         Ok(Self {
             receiver_map,
             accumulations,
@@ -297,6 +168,135 @@ impl SoftShadowMaps {
             project_group,
             patches: settings.occluder_map_size * settings.occluder_map_size,
         })
+    }
+
+    /// One occluder map and SSM per side: one-sided, the nearest surface of every occluder face;
+    /// two-sided (Sec. 3.5), the nearest front faces and the farthest back faces.
+    fn accumulations(
+        setup: &TechniqueSetup<'_>,
+        settings: &AttySettings,
+        receiver_map: &LightDepthMap,
+        settings_buffer: &wgpu::Buffer,
+    ) -> Result<Vec<SideAccumulation>> {
+        let device = &setup.gpu.device;
+        let layout = Self::accumulate_layout(device);
+        let sides: &[(&'static str, &'static str, Option<wgpu::Face>, bool)] = if settings.two_sided {
+            &[
+                ("atty_occluder_map_front", "atty_accumulate_front", Some(wgpu::Face::Back), false),
+                ("atty_occluder_map_back", "atty_accumulate_back", Some(wgpu::Face::Front), true),
+            ]
+        } else {
+            &[("atty_occluder_map", "atty_accumulate", None, false)]
+        };
+        sides
+            .iter()
+            .map(|&(map_label, pass_label, cull, farthest)| {
+                let occluder_map = unbiased_depth_map(setup, map_label, settings.occluder_map_size, Geometry::Occluders, (cull, farthest))?;
+                let texture_label = format!("{pass_label}_soft_shadow_map");
+                let texture = render_texture(
+                    device,
+                    &texture_label,
+                    settings.ssm_size,
+                    settings.ssm_size,
+                    settings.accumulation.format(),
+                    wgpu::TextureUsages::empty(),
+                );
+                let bind_group = bind_group(
+                    device,
+                    &format!("{pass_label}_bind_group"),
+                    &layout,
+                    &[
+                        wgpu::BindingResource::TextureView(&occluder_map.linear_depth_view),
+                        wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view),
+                        settings_buffer.as_entire_binding(),
+                    ],
+                );
+                Ok(SideAccumulation {
+                    occluder_map,
+                    soft_shadow_map: labelled_view(&texture, &texture_label),
+                    bind_group,
+                    label: pass_label,
+                })
+            })
+            .collect()
+    }
+
+    fn accumulate_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        bind_group_layout(device, "atty_accumulate_layout", &[texture_entry(0), texture_entry(1), uniform_entry(2)])
+    }
+
+    /// The instanced micro-patch pipeline: one quad per occluder texel, summed by additive
+    /// blending into the float SSM (Sec. 4.1).
+    fn accumulate_pipeline(setup: &TechniqueSetup<'_>, accumulation: Accumulation) -> Result<wgpu::RenderPipeline> {
+        let device = &setup.gpu.device;
+        let module = create_shader_with_imports(setup.gpu, "atty_accumulate_shader", ACCUMULATE_SHADER, LOCAL_SHADERS)?;
+        let layout = Self::accumulate_layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("atty_accumulate_pipeline_layout"),
+            bind_group_layouts: &[Some(setup.gpu.uniform_layout()), Some(&layout)],
+            immediate_size: 0,
+        });
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("atty_accumulate_pipeline"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("atty_patch_vertex"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("atty_patch_fragment"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: accumulation.format(),
+                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                    write_mask: wgpu::ColorWrites::RED,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        }))
+    }
+
+    /// The projection of the SSM (the larger occlusion of both sides) onto the screen.
+    fn projection(
+        setup: &TechniqueSetup<'_>,
+        accumulations: &[SideAccumulation],
+        receiver_map: &LightDepthMap,
+        settings_buffer: &wgpu::Buffer,
+    ) -> Result<(ScreenPass, wgpu::BindGroup)> {
+        let device = &setup.gpu.device;
+        let layout =
+            bind_group_layout(device, "atty_project_layout", &[texture_entry(0), texture_entry(1), texture_entry(2), uniform_entry(3)]);
+        let Some(front) = accumulations.first().map(|a| &a.soft_shadow_map) else {
+            return Err(Error::Technique { technique: NAME.into(), message: "no occluder side to project".into() });
+        };
+        // One-sided: the front map stands in for the back one (max(x, x) = x).
+        let back = accumulations.get(1).map_or(front, |a| &a.soft_shadow_map);
+        let group = bind_group(
+            device,
+            "atty_project_bind_group",
+            &layout,
+            &[
+                wgpu::BindingResource::TextureView(front),
+                wgpu::BindingResource::TextureView(back),
+                wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view),
+                settings_buffer.as_entire_binding(),
+            ],
+        );
+        let module = create_shader_with_imports(setup.gpu, "atty_project_shader", PROJECT_SHADER, LOCAL_SHADERS)?;
+        let project = ScreenPass::new(setup, NAME, "atty_project", (&module, "atty_project"), Some(&layout), VISIBILITY_FORMAT.into())?;
+        Ok((project, group))
     }
 }
 
@@ -353,8 +353,7 @@ impl ShadowTechnique for SoftShadowMaps {
 fn requirements(params: &ParamValues) -> Result<Requirements> {
     let settings = AttySettings::from_params(params)?;
     // f32 accumulation blends into R32Float: never silently fall back to another precision.
-    let features =
-        if settings.accumulation == wgpu::TextureFormat::R32Float { wgpu::Features::FLOAT32_BLENDABLE } else { wgpu::Features::empty() };
+    let features = if settings.accumulation == Accumulation::F32 { wgpu::Features::FLOAT32_BLENDABLE } else { wgpu::Features::empty() };
     Ok(Requirements {
         gbuffer: true,
         roles: true,
@@ -374,10 +373,58 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "soft shadow maps: occluder micro-patches back-projected onto the light, accumulated on the GPU (one- and two-sided)",
     paper: "Atty et al. 2006, Soft Shadow Maps: Efficient Sampling of Light Source Visibility (CGF 25(4))",
     kind: TechniqueKind::Realtime,
-    params: PARAMS,
+    params: AttySettings::PARAMS,
     requirements,
     create,
+    presets: PRESETS,
+    trade: Some("occluder_map_size=64,128,256,512"),
+    uniforms: &[UniformCheck {
+        wgsl_struct: "AttySettings",
+        wgsl_source: PROJECT_SHADER,
+        imports: LOCAL_SHADERS,
+        rust: AttySettingsUniform::LAYOUT,
+    }],
 };
+
+/// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps.
+const PRESETS: &[ssm_core::Preset] = &[
+    ssm_core::Preset {
+        name: "atty-map-size",
+        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided",
+        scenes: &["floating-sphere"],
+        varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
+        x_axis: "atty.occluder_map_size",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-map-size-time",
+        summary: "Atty et al., Fig. 22: frame time against the occluder map's size (128², 256², 512²), one- and two-sided",
+        scenes: &["floating-sphere"],
+        varies: &["atty.occluder_map_size=128,256,512", "atty.two_sided=false,true"],
+        x_axis: "atty.occluder_map_size",
+        y_axis: "time",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-light-size",
+        summary: "Atty et al., Fig. 18 and Fig. 24(b) (error; Fig. 24(a), time, with --error time) against the light's size for 63², 127², 255² maps (not powers of two, as the paper notes in Sec. 5.2.3; a thick occluder such as floating-sphere)",
+        scenes: &["floating-sphere"],
+        varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255"],
+        x_axis: "scene.light_scale",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-occluder-height",
+        summary: "Atty et al., Fig. 20: error as the occluders move from the receiver towards the light (on floating-sphere: from 0.05 above the ground to 0.05 below the light)",
+        scenes: &["floating-sphere"],
+        varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
+        x_axis: "scene.occluder_lift",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+];
 
 register_technique!(INFO);
 

@@ -7,31 +7,45 @@
 //! light shrinks to a point.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{texture_entry, uniform_entry};
+use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup,
-    VISIBILITY_FORMAT, register_technique,
+    Frame, LightDepthMap, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias,
+    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique,
+    screen_space_requirements,
 };
-use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "hard";
 
-/// Parameters of [`HardShadowMapping`].
-pub const PARAMS: &[ParamSpec] = &[
-    ShadowMapSettings::size_param(2048),
-    ShadowMapSettings::BIAS_PARAMS[0],
-    ShadowMapSettings::BIAS_PARAMS[1],
-    ShadowMapSettings::BIAS_PARAMS[2],
-];
+/// The lookup shader.
+const SHADER: &str = include_str!("../../../shaders/hard/hard.wgsl");
 
-/// The lookup settings, as `shaders/hard/hard.wgsl` reads them.
+/// Settings of [`HardShadowMapping`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct HardSettings {
+    /// Side of the square shadow map, texels.
+    #[param(default = 2048, min = SHADOW_MAP_MIN_SIZE, max = SHADOW_MAP_MAX_SIZE)]
+    pub shadow_map_size: u32,
+    /// Depth bias and normal offset.
+    #[param(flatten)]
+    pub bias: ShadowMapBias,
+}
+
+/// The lookup settings, as `shaders/hard/hard.wgsl` reads them (`HardSettings`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct HardSettingsUniform {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct HardSettingsUniform {
     normal_offset: f32,
-    padding: [f32; 3],
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+impl From<&HardSettings> for HardSettingsUniform {
+    fn from(settings: &HardSettings) -> Self {
+        Self { normal_offset: settings.bias.normal_offset, _pad0: 0.0, _pad1: 0.0, _pad2: 0.0 }
+    }
 }
 
 /// Hard shadow mapping.
@@ -47,28 +61,18 @@ impl HardShadowMapping {
     /// # Errors
     /// A parameter or GPU error.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
-        let settings = ShadowMapSettings::from_params(setup.params)?;
+        let settings = HardSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let depth_map = settings.depth_map(setup, "hard_shadow_map")?;
-        let uniform = HardSettingsUniform { normal_offset: settings.normal_offset, padding: [0.0; 3] };
-        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("hard_settings_uniform"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let map_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hard_map_layout"),
-            entries: &[texture_entry(0), uniform_entry(1)],
-        });
-        let map_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("hard_map_bind_group"),
-            layout: &map_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
-                wgpu::BindGroupEntry { binding: 1, resource: settings_buffer.as_entire_binding() },
-            ],
-        });
-        let module = create_shader(setup.gpu, "hard_lookup_shader", include_str!("../../../shaders/hard/hard.wgsl"))?;
+        let depth_map = settings.bias.depth_map(setup, "hard_shadow_map", settings.shadow_map_size)?;
+        let settings_buffer = uniform_buffer(device, "hard_settings_uniform", &HardSettingsUniform::from(&settings));
+        let map_layout = bind_group_layout(device, "hard_map_layout", &[texture_entry(0), uniform_entry(1)]);
+        let map_bind_group = bind_group(
+            device,
+            "hard_map_bind_group",
+            &map_layout,
+            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), settings_buffer.as_entire_binding()],
+        );
+        let module = create_shader(setup.gpu, "hard_lookup_shader", SHADER)?;
         let lookup = ScreenPass::new(setup, NAME, "hard_lookup", (&module, "hard_lookup"), Some(&map_layout), VISIBILITY_FORMAT.into())?;
         Ok(Self { depth_map, lookup, map_bind_group })
     }
@@ -86,15 +90,22 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(HardShadowMapping::new(setup)?))
 }
 
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    Ok(screen_space_requirements(HardSettings::from_params(params)?.shadow_map_size))
+}
+
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "hard shadow mapping from the light's centre, slope-scaled bias (baseline)",
     paper: "Williams 1978, Casting curved shadows on curved surfaces",
     kind: TechniqueKind::Realtime,
-    params: PARAMS,
-    requirements: ShadowMapSettings::screen_space_requirements,
+    params: HardSettings::PARAMS,
+    requirements,
     create,
+    presets: &[],
+    trade: Some("shadow_map_size=512,1024,2048,4096"),
+    uniforms: &[UniformCheck { wgsl_struct: "HardSettings", wgsl_source: SHADER, imports: &[], rust: HardSettingsUniform::LAYOUT }],
 };
 
 register_technique!(INFO);

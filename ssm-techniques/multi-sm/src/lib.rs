@@ -4,42 +4,54 @@
 //! shadow: the reference of Shen et al. (2011, Table 2) and of Buades et al.
 //! (2015, Fig. 13).
 
-use std::collections::HashMap;
-
 use bytemuck::{Pod, Zeroable};
 use glam::Vec2;
-use ssm_core::passes::{color_attachment, compute_pipeline, texture_entry, uniform_entry, visibility_storage_entry};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, color_attachment, compute_pipeline, texture_entry, uniform_buffer, uniform_entry,
+    visibility_storage_entry,
+};
 use ssm_core::shader::create_shader;
 use ssm_core::ssm_scene::RectLight;
 use ssm_core::{
-    Error, Frame, LightDepthMap, LightFrame, LightFrameUniform, ParamKind, ParamSpec, Result, ShadowMapSettings, ShadowTechnique,
-    TechniqueInfo, TechniqueKind, TechniqueSetup, register_technique,
+    Error, Frame, LightDepthMap, LightFrame, LightFrameUniform, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE,
+    SHADOW_MAP_MIN_SIZE, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
+    UniformStruct, register_technique, screen_space_requirements,
 };
-use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "multi-sm";
 
-/// Parameters of [`MultiShadowMaps`].
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "samples",
-        kind: ParamKind::Int { default: 16, min: 1, max: 1024 },
-        doc: "K, the number of shadow maps: a perfect square, one per stratum of a √K×√K grid on the light",
-    },
-    ShadowMapSettings::size_param(1024),
-    ShadowMapSettings::BIAS_PARAMS[0],
-    ShadowMapSettings::BIAS_PARAMS[1],
-    ShadowMapSettings::BIAS_PARAMS[2],
-];
+/// The accumulation shader.
+const SHADER: &str = include_str!("../../../shaders/multi-sm/multi_sm.wgsl");
 
-/// The accumulation settings, as `shaders/multi-sm/multi_sm.wgsl` reads them.
+/// Settings of [`MultiShadowMaps`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct MultiSmSettings {
+    /// K, the number of shadow maps: a perfect square, one per stratum of a √K×√K grid on the light.
+    #[param(default = 16, min = 1, max = 1024)]
+    pub samples: u32,
+    /// Side of each square shadow map, texels.
+    #[param(default = 1024, min = SHADOW_MAP_MIN_SIZE, max = SHADOW_MAP_MAX_SIZE)]
+    pub shadow_map_size: u32,
+    /// Depth bias and normal offset.
+    #[param(flatten)]
+    pub bias: ShadowMapBias,
+}
+
+/// The accumulation settings, as `shaders/multi-sm/multi_sm.wgsl` reads them (`MultiSmSettings`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct MultiSmSettingsUniform {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct MultiSmSettingsUniform {
     weight: f32,
     normal_offset: f32,
-    padding: [f32; 2],
+    _pad0: f32,
+    _pad1: f32,
+}
+
+impl From<&MultiSmSettings> for MultiSmSettingsUniform {
+    fn from(settings: &MultiSmSettings) -> Self {
+        Self { weight: 1.0 / settings.samples.max(1) as f32, normal_offset: settings.bias.normal_offset, _pad0: 0.0, _pad1: 0.0 }
+    }
 }
 
 /// The centres of the strata of a `per_axis` × `per_axis` grid on the light, in `[-1, 1]²`.
@@ -56,11 +68,8 @@ pub struct MultiShadowMaps {
     sample_frames: Vec<Vec<wgpu::BindGroup>>,
     accumulate: wgpu::ComputePipeline,
     gbuffer_bind_group: wgpu::BindGroup,
-    own_layout: wgpu::BindGroupLayout,
-    settings_buffer: wgpu::Buffer,
-    map_view: wgpu::TextureView,
-    /// Per light: the group binding the shadow map, the settings and that light's target (made on first use).
-    own_groups: HashMap<usize, wgpu::BindGroup>,
+    /// Per light: the group binding the shadow map, the settings and that light's target.
+    own_groups: Vec<wgpu::BindGroup>,
     width: u32,
     height: u32,
 }
@@ -71,108 +80,101 @@ impl MultiShadowMaps {
     /// # Errors
     /// A parameter error, K not a perfect square, or a GPU error.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
-        let params = setup.params;
-        let samples = u32::try_from(params.int("samples")?).unwrap_or(1);
-        let per_axis = samples.isqrt();
-        if per_axis * per_axis != samples {
+        let settings = MultiSmSettings::from_params(setup.params)?;
+        let per_axis = settings.samples.isqrt();
+        if per_axis * per_axis != settings.samples {
             return Err(Error::Technique {
                 technique: NAME.into(),
-                message: format!("samples = {samples} is not a perfect square (1, 4, 9, 16, ...): the strata form a √K×√K grid"),
+                message: format!("samples = {} is not a perfect square (1, 4, 9, 16, ...): the strata form a √K×√K grid", settings.samples),
             });
         }
-        let map_settings = ShadowMapSettings::from_params(params)?;
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
-        let depth_map = map_settings.depth_map(setup, "multi_sm_shadow_map")?;
-        let bounds = setup.scene.bounds;
-        let sample_frames = setup
-            .scene
-            .light_frames
+        let depth_map = settings.bias.depth_map(setup, "multi_sm_shadow_map", settings.shadow_map_size)?;
+        let settings_buffer = uniform_buffer(device, "multi_sm_settings_uniform", &MultiSmSettingsUniform::from(&settings));
+        let own_layout =
+            bind_group_layout(device, "multi_sm_own_layout", &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2)]);
+        let own_groups = setup
+            .outputs
             .iter()
             .enumerate()
-            .map(|(light_index, frame)| {
-                stratum_centres(per_axis)
-                    .iter()
-                    .enumerate()
-                    .map(|(k, s)| {
-                        let light = frame.light;
-                        let point_light = RectLight { centre: light.point(s.x, s.y), half_size: Vec2::ZERO, ..light };
-                        let uniform = LightFrameUniform::from(&LightFrame::fit(&point_light, &bounds));
-                        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                            label: Some(&format!("multi_sm_sample_frame_{light_index}_{k}")),
-                            contents: bytemuck::bytes_of(&uniform),
-                            usage: wgpu::BufferUsages::UNIFORM,
-                        });
-                        device.create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some(&format!("multi_sm_sample_frame_bind_group_{light_index}_{k}")),
-                            layout: &setup.scene.uniform_layout,
-                            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-                        })
-                    })
-                    .collect()
+            .map(|(light, output)| {
+                bind_group(
+                    device,
+                    &format!("multi_sm_own_bind_group_{light}"),
+                    &own_layout,
+                    &[
+                        wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                        settings_buffer.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(output),
+                    ],
+                )
             })
             .collect();
-        let settings =
-            MultiSmSettingsUniform { weight: 1.0 / samples as f32, normal_offset: map_settings.normal_offset, padding: [0.0; 2] };
-        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("multi_sm_settings_uniform"),
-            contents: bytemuck::bytes_of(&settings),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let own_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("multi_sm_own_layout"),
-            entries: &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2)],
-        });
-        let module = create_shader(setup.gpu, "multi_sm_shader", include_str!("../../../shaders/multi-sm/multi_sm.wgsl"))?;
+        let module = create_shader(setup.gpu, "multi_sm_shader", SHADER)?;
         let accumulate = compute_pipeline(
             device,
             "multi_sm_accumulate_pipeline",
             &module,
             "multi_sm_accumulate",
-            &[&setup.scene.uniform_layout, &gbuffer.layout, &own_layout],
+            &[setup.gpu.uniform_layout(), &gbuffer.layout, &own_layout],
         );
         Ok(Self {
-            map_view: depth_map.linear_depth_view.clone(),
             depth_map,
-            sample_frames,
+            sample_frames: sample_frames(setup, per_axis),
             accumulate,
             gbuffer_bind_group: gbuffer.bind_group.clone(),
-            own_layout,
-            settings_buffer,
-            own_groups: HashMap::new(),
+            own_groups,
             width: setup.scene.width,
             height: setup.scene.height,
         })
     }
 }
 
+/// Per light, per stratum: the light frame of a point light at the stratum's centre.
+fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<wgpu::BindGroup>> {
+    let device = &setup.gpu.device;
+    let bounds = setup.scene.bounds;
+    setup
+        .scene
+        .light_frames
+        .iter()
+        .enumerate()
+        .map(|(light_index, frame)| {
+            stratum_centres(per_axis)
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    let light = frame.light;
+                    let point_light = RectLight { centre: light.point(s.x, s.y), half_size: Vec2::ZERO, ..light };
+                    let uniform = LightFrameUniform::from(&LightFrame::fit(&point_light, &bounds));
+                    let buffer = uniform_buffer(device, &format!("multi_sm_sample_frame_{light_index}_{k}"), &uniform);
+                    bind_group(
+                        device,
+                        &format!("multi_sm_sample_frame_bind_group_{light_index}_{k}"),
+                        setup.gpu.uniform_layout(),
+                        &[buffer.as_entire_binding()],
+                    )
+                })
+                .collect()
+        })
+        .collect()
+}
+
 impl ShadowTechnique for MultiShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
-        let device = &frame.gpu.device;
-        let own_group = self.own_groups.entry(light).or_insert_with(|| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(&format!("multi_sm_own_bind_group_{light}")),
-                layout: &self.own_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&self.map_view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: self.settings_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(output) },
-                ],
-            })
-        });
+        let no_light = || Error::Technique { technique: NAME.into(), message: format!("no light {light}") };
+        let own_group = self.own_groups.get(light).ok_or_else(no_light)?;
+        let frames = self.sample_frames.get(light).ok_or_else(no_light)?;
         // The sum starts at 0, not at the framework's 1.
         drop(frame.render_pass("multi_sm_clear", &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))], None));
-        let frames = self
-            .sample_frames
-            .get(light)
-            .ok_or_else(|| Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
         for sample_frame in frames {
             self.depth_map.encode_with(frame, sample_frame);
             let mut pass = frame.compute_pass("multi_sm_accumulate");
             pass.set_pipeline(&self.accumulate);
             pass.set_bind_group(0, sample_frame, &[]);
             pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
-            pass.set_bind_group(2, &*own_group, &[]);
+            pass.set_bind_group(2, own_group, &[]);
             pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
         }
         Ok(())
@@ -183,15 +185,31 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(MultiShadowMaps::new(setup)?))
 }
 
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    Ok(screen_space_requirements(MultiSmSettings::from_params(params)?.shadow_map_size))
+}
+
+/// Sweeps of the multi-sm baseline.
+const PRESETS: &[ssm_core::Preset] = &[ssm_core::Preset {
+    name: "multi-sm-samples",
+    summary: "multi-sm with K = 1, 4, 16, 64, 256 shadow maps",
+    scenes: &["sphere-cube"],
+    varies: &["multi-sm.samples=1,4,16,64,256"],
+    ..ssm_core::Preset::DEFAULT
+}];
+
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "average of K hard shadow maps from stratified points on the light (baseline; converges as K grows)",
     paper: "Heckbert and Herf 1997, Simulating soft shadows with graphics hardware (the reference of Shen et al. 2011 and Buades et al. 2015)",
     kind: TechniqueKind::Realtime,
-    params: PARAMS,
-    requirements: ShadowMapSettings::screen_space_requirements,
+    params: MultiSmSettings::PARAMS,
+    requirements,
     create,
+    presets: PRESETS,
+    trade: Some("samples=1,4,16,64"),
+    uniforms: &[UniformCheck { wgsl_struct: "MultiSmSettings", wgsl_source: SHADER, imports: &[], rust: MultiSmSettingsUniform::LAYOUT }],
 };
 
 register_technique!(INFO);

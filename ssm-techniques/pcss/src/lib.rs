@@ -10,44 +10,59 @@
 //! separable and predicted variants exist.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{texture_entry, uniform_entry};
+use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamKind, ParamSpec, Result, ScreenPass, ShadowMapSettings, ShadowTechnique, TechniqueInfo, TechniqueKind,
-    TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    Frame, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings,
+    ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
+    register_technique, screen_space_requirements,
 };
-use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "pcss";
 
-/// Parameters of [`Pcss`].
-pub const PARAMS: &[ParamSpec] = &[
-    ShadowMapSettings::size_param(1024),
-    ParamSpec {
-        name: "blocker_kernel",
-        kind: ParamKind::Int { default: 7, min: 1, max: 64 },
-        doc: "samples per axis of the blocker search (n; n² taps per pixel)",
-    },
-    ParamSpec {
-        name: "pcf_kernel",
-        kind: ParamKind::Int { default: 15, min: 1, max: 128 },
-        doc: "samples per axis of the PCF filter (m; m² taps per pixel)",
-    },
-    ShadowMapSettings::RECEIVER_PLANE_PARAM,
-    ShadowMapSettings::BIAS_PARAMS[0],
-    ShadowMapSettings::BIAS_PARAMS[1],
-    ShadowMapSettings::BIAS_PARAMS[2],
-];
+/// The blocker search and filter shader.
+const SHADER: &str = include_str!("../../../shaders/pcss/pcss.wgsl");
 
-/// The kernel sizes, as `shaders/pcss/pcss.wgsl` reads them.
+/// Settings of [`Pcss`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct PcssSettings {
+    /// Side of the square shadow map, texels.
+    #[param(default = 1024, min = SHADOW_MAP_MIN_SIZE, max = SHADOW_MAP_MAX_SIZE)]
+    pub shadow_map_size: u32,
+    /// Samples per axis of the blocker search (n; n² taps per pixel).
+    #[param(default = 7, min = 1, max = 64)]
+    pub blocker_kernel: u32,
+    /// Samples per axis of the PCF filter (m; m² taps per pixel).
+    #[param(default = 15, min = 1, max = 128)]
+    pub pcf_kernel: u32,
+    /// What the taps are compared with.
+    #[param(flatten)]
+    pub receiver: ReceiverModel,
+    /// Depth bias and normal offset.
+    #[param(flatten)]
+    pub bias: ShadowMapBias,
+}
+
+/// The kernel sizes, as `shaders/pcss/pcss.wgsl` reads them (`PcssSettings`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct PcssSettingsUniform {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct PcssSettingsUniform {
     blocker_kernel: u32,
     pcf_kernel: u32,
     receiver_plane: u32,
     normal_offset: f32,
+}
+
+impl From<&PcssSettings> for PcssSettingsUniform {
+    fn from(settings: &PcssSettings) -> Self {
+        Self {
+            blocker_kernel: settings.blocker_kernel,
+            pcf_kernel: settings.pcf_kernel,
+            receiver_plane: u32::from(settings.receiver.receiver_plane),
+            normal_offset: settings.bias.normal_offset,
+        }
+    }
 }
 
 /// PCSS.
@@ -63,35 +78,18 @@ impl Pcss {
     /// # Errors
     /// A parameter or GPU error.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
-        let params = setup.params;
-        let map_settings = ShadowMapSettings::from_params(params)?;
-        let kernel = |name| params.int(name).map(|v| u32::try_from(v).unwrap_or(1));
-        let uniform = PcssSettingsUniform {
-            blocker_kernel: kernel("blocker_kernel")?,
-            pcf_kernel: kernel("pcf_kernel")?,
-            receiver_plane: u32::from(params.bool("receiver_plane")?),
-            normal_offset: map_settings.normal_offset,
-        };
+        let settings = PcssSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let depth_map = map_settings.depth_map(setup, "pcss_shadow_map")?;
-        let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("pcss_settings_uniform"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let map_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pcss_map_layout"),
-            entries: &[texture_entry(0), uniform_entry(1)],
-        });
-        let map_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pcss_map_bind_group"),
-            layout: &map_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
-                wgpu::BindGroupEntry { binding: 1, resource: settings_buffer.as_entire_binding() },
-            ],
-        });
-        let module = create_shader(setup.gpu, "pcss_filter_shader", include_str!("../../../shaders/pcss/pcss.wgsl"))?;
+        let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
+        let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
+        let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1)]);
+        let map_bind_group = bind_group(
+            device,
+            "pcss_map_bind_group",
+            &map_layout,
+            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), settings_buffer.as_entire_binding()],
+        );
+        let module = create_shader(setup.gpu, "pcss_filter_shader", SHADER)?;
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
         let search_and_filter = ScreenPass::new(
             setup,
@@ -117,15 +115,40 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(Pcss::new(setup)?))
 }
 
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    Ok(screen_space_requirements(PcssSettings::from_params(params)?.shadow_map_size))
+}
+
+/// Sweeps of the PCSS baseline.
+const PRESETS: &[ssm_core::Preset] = &[
+    ssm_core::Preset {
+        name: "pcss-kernels",
+        summary: "PCSS with the kernel pairs of Buades et al., Table 4 (7/15, 11/21, 29/41)",
+        scenes: &["leaves"],
+        varies: &["pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41"],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "shadow-map-size",
+        summary: "hard and PCSS against shadow-map resolution",
+        scenes: &["sphere-cube"],
+        varies: &["hard.shadow_map_size=256,512,1024,2048,4096", "pcss.shadow_map_size=256,512,1024,2048,4096"],
+        ..ssm_core::Preset::DEFAULT
+    },
+];
+
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "percentage-closer soft shadows: n×n blocker search, m×m PCF sized by the penumbra estimate (baseline)",
     paper: "Fernando 2005, Percentage-closer soft shadows (SIGGRAPH sketch)",
     kind: TechniqueKind::Realtime,
-    params: PARAMS,
-    requirements: ShadowMapSettings::screen_space_requirements,
+    params: PcssSettings::PARAMS,
+    requirements,
     create,
+    presets: PRESETS,
+    trade: Some("blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41"),
+    uniforms: &[UniformCheck { wgsl_struct: "PcssSettings", wgsl_source: SHADER, imports: &[], rust: PcssSettingsUniform::LAYOUT }],
 };
 
 register_technique!(INFO);

@@ -11,69 +11,75 @@
 //! passes after the depth map, as the paper's Table 1.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{labelled_view, render_texture, texture_entry, uniform_entry};
+use ssm_core::passes::{bind_group, bind_group_layout, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry};
 use ssm_core::readback::read_texture;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    ExtraImage, Frame, GpuContext, LightDepthMap, ParamKind, ParamSpec, ParamValues, Result, ScreenPass, ShadowMapSettings,
-    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
+    Choice, ExtraImage, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE,
+    SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
+    UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
-use wgpu::util::DeviceExt;
 
 /// The registered name.
 pub const NAME: &str = "sssm";
 
-/// Parameters of [`SeparableSoftShadowMaps`].
-pub const PARAMS: &[ParamSpec] = &[
-    ShadowMapSettings::size_param(1024),
-    ParamSpec {
-        name: "blocker_kernel",
-        kind: ParamKind::Int { default: 7, min: 1, max: 64 },
-        doc: "n: samples per axis of the blocker search window",
-    },
-    ParamSpec {
-        name: "blur_kernel",
-        kind: ParamKind::Int { default: 15, min: 1, max: 128 },
-        doc: "m: taps per axis of the screen-space blur",
-    },
-    ParamSpec {
-        name: "alpha",
-        kind: ParamKind::Float { default: 0.01, min: 0.0, max: 1.0 },
-        doc: "α: blocker rows are reused when light depths differ by less than this fraction of the scene's diagonal (0: never)",
-    },
-    ParamSpec {
-        name: "beta",
-        kind: ParamKind::Float { default: 0.01, min: 0.0, max: 1.0 },
-        doc: "β: blur rows are reused when normal-adjusted camera depths differ by less than this fraction of the scene's diagonal (0: never)",
-    },
-    ParamSpec {
-        name: "filter",
-        kind: ParamKind::Choice { default: "gaussian", options: &["gaussian", "mean"] },
-        doc: "blur weights (Sec. 4.4)",
-    },
-    ParamSpec {
-        name: "sigma",
-        kind: ParamKind::Float { default: 0.5, min: 0.05, max: 4.0 },
-        doc: "Gaussian standard deviation in units of the blur's half-width (the paper's N(0, 0.5))",
-    },
-    ShadowMapSettings::RECEIVER_PLANE_PARAM,
-    ParamSpec {
-        name: "bilateral_depth",
-        kind: ParamKind::Float { default: 0.005, min: 0.0, max: 1.0 },
-        doc: "blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur)",
-    },
-    ShadowMapSettings::BIAS_PARAMS[0],
-    ShadowMapSettings::BIAS_PARAMS[1],
-    ShadowMapSettings::BIAS_PARAMS[2],
-];
-
 /// WGSL files the SSSM passes import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("sssm/sssm_common.wgsl", include_str!("../../../shaders/sssm/sssm_common.wgsl"))];
+/// Step 1: hard shadow and horizontal partial blocker sums.
+const HORIZONTAL_BLOCKER_SHADER: &str = include_str!("../../../shaders/sssm/sssm_horizontal_blocker.wgsl");
+/// Step 2: blocker average, penumbra size, horizontal blur.
+const BLOCKER_BLUR_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur.wgsl");
+/// Step 3: vertical blur.
+const VERTICAL_BLUR_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur.wgsl");
+
+/// The blur's weights (Sec. 4.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum BlurFilter {
+    /// Gaussian weights of standard deviation `sigma` half-widths.
+    Gaussian,
+    /// Equal weights: the box filter PCSS applies.
+    Mean,
+}
+
+/// Settings of [`SeparableSoftShadowMaps`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct SssmSettings {
+    /// Side of the square shadow map, texels.
+    #[param(default = 1024, min = SHADOW_MAP_MIN_SIZE, max = SHADOW_MAP_MAX_SIZE)]
+    pub shadow_map_size: u32,
+    /// n: samples per axis of the blocker search window.
+    #[param(default = 7, min = 1, max = 64)]
+    pub blocker_kernel: u32,
+    /// m: taps per axis of the screen-space blur.
+    #[param(default = 15, min = 1, max = 128)]
+    pub blur_kernel: u32,
+    /// α: blocker rows are reused when light depths differ by less than this fraction of the scene's diagonal (0: never).
+    #[param(default = 0.01, min = 0.0, max = 1.0)]
+    pub alpha: f32,
+    /// β: blur rows are reused when normal-adjusted camera depths differ by less than this fraction of the scene's diagonal (0: never).
+    #[param(default = 0.01, min = 0.0, max = 1.0)]
+    pub beta: f32,
+    /// Blur weights (Sec. 4.4).
+    #[param(choice, default = "gaussian")]
+    pub filter: BlurFilter,
+    /// Gaussian standard deviation in units of the blur's half-width (the paper's N(0, 0.5)).
+    #[param(default = 0.5, min = 0.05, max = 4.0)]
+    pub sigma: f32,
+    /// What the blocker taps are compared with (as pcss's).
+    #[param(flatten)]
+    pub receiver: ReceiverModel,
+    /// Blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur).
+    #[param(default = 0.005, min = 0.0, max = 1.0)]
+    pub bilateral_depth: f32,
+    /// Depth bias and normal offset.
+    #[param(flatten)]
+    pub bias: ShadowMapBias,
+}
 
 /// `SssmSettings` of `shaders/sssm/sssm_common.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct SssmSettingsUniform {
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct SssmSettingsUniform {
     blocker_kernel: u32,
     blur_kernel: u32,
     gaussian: u32,
@@ -82,10 +88,29 @@ struct SssmSettingsUniform {
     beta: f32,
     sigma: f32,
     normal_offset: f32,
-    pixel_scale: f32,
-    light_half_size: f32,
     bilateral_depth: f32,
-    padding: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+impl From<&SssmSettings> for SssmSettingsUniform {
+    fn from(settings: &SssmSettings) -> Self {
+        Self {
+            blocker_kernel: settings.blocker_kernel,
+            blur_kernel: settings.blur_kernel,
+            gaussian: u32::from(settings.filter == BlurFilter::Gaussian),
+            receiver_plane: u32::from(settings.receiver.receiver_plane),
+            alpha: settings.alpha,
+            beta: settings.beta,
+            sigma: settings.sigma,
+            normal_offset: settings.bias.normal_offset,
+            bilateral_depth: settings.bilateral_depth,
+            _pad0: 0.0,
+            _pad1: 0.0,
+            _pad2: 0.0,
+        }
+    }
 }
 
 /// Separable soft shadow mapping.
@@ -94,30 +119,27 @@ pub struct SeparableSoftShadowMaps {
     horizontal_blocker: ScreenPass,
     blocker_blur: ScreenPass,
     vertical_blur: ScreenPass,
-    /// Per light: the three passes' own bind groups (the settings hold the light's size).
-    groups: Vec<[wgpu::BindGroup; 3]>,
+    /// The three passes' own bind groups (the light frame is the screen pass's group 0).
+    groups: [wgpu::BindGroup; 3],
     horizontal_blocker_view: wgpu::TextureView,
     horizontal_blur_view: wgpu::TextureView,
     reuse: wgpu::Texture,
 }
 
-impl SeparableSoftShadowMaps {
-    /// Builds the depth map, the intermediate targets and the three passes.
-    ///
-    /// # Errors
-    /// A parameter or GPU error.
-    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
-        let params = setup.params;
-        let map_settings = ShadowMapSettings::from_params(params)?;
-        let device = &setup.gpu.device;
-        let (width, height) = (setup.scene.width, setup.scene.height);
-        let depth_map = map_settings.depth_map(setup, "sssm_shadow_map")?;
+/// The intermediate targets between the three passes.
+struct Targets {
+    horizontal_blocker: wgpu::TextureView,
+    horizontal_blur: wgpu::TextureView,
+    reuse: wgpu::Texture,
+    reuse_view: wgpu::TextureView,
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let target = |label: &str| {
             let texture = render_texture(device, label, width, height, wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::empty());
             labelled_view(&texture, label)
         };
-        let horizontal_blocker_view = target("sssm_horizontal_blocker_target");
-        let horizontal_blur_view = target("sssm_horizontal_blur_target");
         let reuse = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("sssm_reuse_share"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -128,16 +150,75 @@ impl SeparableSoftShadowMaps {
             usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let reuse_view = labelled_view(&reuse, "sssm_reuse_share");
+        Self {
+            horizontal_blocker: target("sssm_horizontal_blocker_target"),
+            horizontal_blur: target("sssm_horizontal_blur_target"),
+            reuse_view: labelled_view(&reuse, "sssm_reuse_share"),
+            reuse,
+        }
+    }
+}
 
+impl SeparableSoftShadowMaps {
+    /// Builds the depth map, the intermediate targets and the three passes.
+    ///
+    /// # Errors
+    /// A parameter or GPU error.
+    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
+        let settings = SssmSettings::from_params(setup.params)?;
+        let device = &setup.gpu.device;
+        let depth_map = settings.bias.depth_map(setup, "sssm_shadow_map", settings.shadow_map_size)?;
+        let targets = Targets::new(device, setup.scene.width, setup.scene.height);
+        let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
+        let layouts = Self::layouts(device);
+        let groups = Self::bind_groups(setup, &layouts, (&settings_buffer, &depth_map), &targets);
+        let module = |label: &str, source: &str| create_shader_with_imports(setup.gpu, label, source, LOCAL_SHADERS);
+        let rgba = wgpu::ColorTargetState::from(wgpu::TextureFormat::Rgba32Float);
+        let [layout_a, layout_b, layout_c] = &layouts;
+        let horizontal_blocker = ScreenPass::new(
+            setup,
+            NAME,
+            "sssm_horizontal_blocker",
+            (&module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
+            Some(layout_a),
+            rgba.clone(),
+        )?;
+        let blocker_blur = ScreenPass::new(
+            setup,
+            NAME,
+            "sssm_blocker_and_horizontal_blur",
+            (&module("sssm_blocker_blur_shader", BLOCKER_BLUR_SHADER)?, "sssm_blocker_blur"),
+            Some(layout_b),
+            rgba,
+        )?;
+        let vertical_blur = ScreenPass::new(
+            setup,
+            NAME,
+            "sssm_vertical_blur",
+            (&module("sssm_vertical_blur_shader", VERTICAL_BLUR_SHADER)?, "sssm_vertical_blur"),
+            Some(layout_c),
+            VISIBILITY_FORMAT.into(),
+        )?;
+        Ok(Self {
+            depth_map,
+            horizontal_blocker,
+            blocker_blur,
+            vertical_blur,
+            groups,
+            horizontal_blocker_view: targets.horizontal_blocker,
+            horizontal_blur_view: targets.horizontal_blur,
+            reuse: targets.reuse,
+        })
+    }
+
+    /// The three passes' own layouts: camera, settings and depth map, then what each reads and writes.
+    fn layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 3] {
         let common = [uniform_entry(0), uniform_entry(1), texture_entry(2)];
         let layout = |label: &str, extra: &[wgpu::BindGroupLayoutEntry]| {
             let entries: Vec<wgpu::BindGroupLayoutEntry> = common.iter().chain(extra).copied().collect();
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+            bind_group_layout(device, label, &entries)
         };
-        let layout_a = layout("sssm_horizontal_blocker_layout", &[]);
-        let layout_b = layout("sssm_blocker_blur_layout", &[texture_entry(3)]);
-        let storage = wgpu::BindGroupLayoutEntry {
+        let reuse_storage = wgpu::BindGroupLayoutEntry {
             binding: 5,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: wgpu::BindingType::StorageTexture {
@@ -147,106 +228,42 @@ impl SeparableSoftShadowMaps {
             },
             count: None,
         };
-        let layout_c = layout("sssm_vertical_blur_layout", &[texture_entry(3), texture_entry(4), storage]);
+        [
+            layout("sssm_horizontal_blocker_layout", &[]),
+            layout("sssm_blocker_blur_layout", &[texture_entry(3)]),
+            layout("sssm_vertical_blur_layout", &[texture_entry(3), texture_entry(4), reuse_storage]),
+        ]
+    }
 
-        let diagonal = setup.scene.bounds.size().length();
-        let camera = &setup.cpu_scene.camera;
-        let gaussian = u32::from(params.choice("filter")? == "gaussian");
-        let kernel = |name| params.int(name).map(|v| u32::try_from(v).unwrap_or(1));
-        let (blocker_kernel, blur_kernel) = (kernel("blocker_kernel")?, kernel("blur_kernel")?);
-        let (alpha, beta, sigma) =
-            (params.float("alpha")? as f32 * diagonal, params.float("beta")? as f32 * diagonal, params.float("sigma")? as f32);
-        let receiver_plane = u32::from(params.bool("receiver_plane")?);
-        let bilateral_depth = params.float("bilateral_depth")? as f32 * diagonal;
-        let mut groups = Vec::new();
-        for (light_index, light_frame) in setup.scene.light_frames.iter().enumerate() {
-            let uniform = SssmSettingsUniform {
-                blocker_kernel,
-                blur_kernel,
-                gaussian,
-                receiver_plane,
-                alpha,
-                beta,
-                sigma,
-                normal_offset: map_settings.normal_offset,
-                pixel_scale: 2.0 * (camera.fov_y * 0.5).tan() / height as f32,
-                light_half_size: 0.5 * (light_frame.light.half_size.x + light_frame.light.half_size.y),
-                bilateral_depth,
-                padding: 0.0,
-            };
-            let settings_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(&format!("sssm_settings_uniform_{light_index}")),
-                contents: bytemuck::bytes_of(&uniform),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let group = |label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource<'_>]| {
-                let mut entries = vec![
-                    wgpu::BindGroupEntry { binding: 0, resource: setup.scene.camera_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: settings_buffer.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
-                ];
-                for (index, resource) in extra.iter().enumerate() {
-                    entries.push(wgpu::BindGroupEntry { binding: 3 + index as u32, resource: resource.clone() });
-                }
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&format!("{label}_{light_index}")),
-                    layout,
-                    entries: &entries,
-                })
-            };
-            groups.push([
-                group("sssm_horizontal_blocker_bind_group", &layout_a, &[]),
-                group("sssm_blocker_blur_bind_group", &layout_b, &[wgpu::BindingResource::TextureView(&horizontal_blocker_view)]),
-                group(
-                    "sssm_vertical_blur_bind_group",
-                    &layout_c,
-                    &[
-                        wgpu::BindingResource::TextureView(&horizontal_blocker_view),
-                        wgpu::BindingResource::TextureView(&horizontal_blur_view),
-                        wgpu::BindingResource::TextureView(&reuse_view),
-                    ],
-                ),
-            ]);
-        }
-        let module = |file: &str, source: &str| create_shader_with_imports(setup.gpu, file, source, LOCAL_SHADERS);
-        let rgba = wgpu::ColorTargetState::from(wgpu::TextureFormat::Rgba32Float);
-        let horizontal_blocker = ScreenPass::new(
-            setup,
-            NAME,
-            "sssm_horizontal_blocker",
-            (
-                &module("sssm_horizontal_blocker_shader", include_str!("../../../shaders/sssm/sssm_horizontal_blocker.wgsl"))?,
-                "sssm_horizontal_blocker",
+    fn bind_groups(
+        setup: &TechniqueSetup<'_>,
+        [layout_a, layout_b, layout_c]: &[wgpu::BindGroupLayout; 3],
+        (settings_buffer, depth_map): (&wgpu::Buffer, &LightDepthMap),
+        targets: &Targets,
+    ) -> [wgpu::BindGroup; 3] {
+        let device = &setup.gpu.device;
+        let group = |label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource<'_>]| {
+            let mut resources = vec![
+                setup.scene.camera_buffer.as_entire_binding(),
+                settings_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+            ];
+            resources.extend_from_slice(extra);
+            bind_group(device, label, layout, &resources)
+        };
+        [
+            group("sssm_horizontal_blocker_bind_group", layout_a, &[]),
+            group("sssm_blocker_blur_bind_group", layout_b, &[wgpu::BindingResource::TextureView(&targets.horizontal_blocker)]),
+            group(
+                "sssm_vertical_blur_bind_group",
+                layout_c,
+                &[
+                    wgpu::BindingResource::TextureView(&targets.horizontal_blocker),
+                    wgpu::BindingResource::TextureView(&targets.horizontal_blur),
+                    wgpu::BindingResource::TextureView(&targets.reuse_view),
+                ],
             ),
-            Some(&layout_a),
-            rgba.clone(),
-        )?;
-        let blocker_blur = ScreenPass::new(
-            setup,
-            NAME,
-            "sssm_blocker_and_horizontal_blur",
-            (&module("sssm_blocker_blur_shader", include_str!("../../../shaders/sssm/sssm_blocker_blur.wgsl"))?, "sssm_blocker_blur"),
-            Some(&layout_b),
-            rgba,
-        )?;
-        let vertical_blur = ScreenPass::new(
-            setup,
-            NAME,
-            "sssm_vertical_blur",
-            (&module("sssm_vertical_blur_shader", include_str!("../../../shaders/sssm/sssm_vertical_blur.wgsl"))?, "sssm_vertical_blur"),
-            Some(&layout_c),
-            VISIBILITY_FORMAT.into(),
-        )?;
-        Ok(Self {
-            depth_map,
-            horizontal_blocker,
-            blocker_blur,
-            vertical_blur,
-            groups,
-            horizontal_blocker_view,
-            horizontal_blur_view,
-            reuse,
-        })
+        ]
     }
 
     /// The reuse share per pixel of the last light rendered (-1 where nothing was computed).
@@ -258,9 +275,7 @@ impl SeparableSoftShadowMaps {
 
 impl ShadowTechnique for SeparableSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
-        let Some([group_a, group_b, group_c]) = self.groups.get(light) else {
-            return Err(ssm_core::Error::Technique { technique: NAME.into(), message: format!("no light {light}") });
-        };
+        let [group_a, group_b, group_c] = &self.groups;
         self.depth_map.encode(frame, light);
         self.horizontal_blocker.encode(frame, light, &self.horizontal_blocker_view, Some(group_a), Some(wgpu::Color::TRANSPARENT));
         self.blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(group_b), Some(wgpu::Color::TRANSPARENT));
@@ -288,9 +303,22 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(SeparableSoftShadowMaps::new(setup)?))
 }
 
-fn requirements(params: &ParamValues) -> Result<ssm_core::Requirements> {
-    ShadowMapSettings::screen_space_requirements(params)
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    Ok(screen_space_requirements(SssmSettings::from_params(params)?.shadow_map_size))
 }
+
+/// Buades et al.'s evaluations, as sweeps.
+const PRESETS: &[ssm_core::Preset] = &[ssm_core::Preset {
+    name: "sssm-table4",
+    summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse; both with the receiver-plane model (on leaves, the plant scene's nearest)",
+    scenes: &["leaves"],
+    varies: &[
+        "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+        "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+        "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
+    ],
+    ..ssm_core::Preset::DEFAULT
+}];
 
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -298,9 +326,17 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "separable soft shadow mapping: separable blocker search reusing rows (α) and separable screen-space blur (β)",
     paper: "Buades, Gumbau and Chover 2015, Separable soft shadow mapping (The Visual Computer)",
     kind: TechniqueKind::Realtime,
-    params: PARAMS,
+    params: SssmSettings::PARAMS,
     requirements,
     create,
+    presets: PRESETS,
+    trade: Some("blocker_kernel:blur_kernel=3:5,7:15,11:21,29:41"),
+    uniforms: &[UniformCheck {
+        wgsl_struct: "SssmSettings",
+        wgsl_source: HORIZONTAL_BLOCKER_SHADER,
+        imports: LOCAL_SHADERS,
+        rust: SssmSettingsUniform::LAYOUT,
+    }],
 };
 
 register_technique!(INFO);

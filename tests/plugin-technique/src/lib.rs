@@ -90,7 +90,8 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(PluginHard { depth_map, lookup, depth_map_group }))
 }
 
-register_technique!(TechniqueInfo {
+/// The registration.
+pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "plug-in example: a hard shadow map from ssm-core's LightDepthMap and ScreenPass",
     paper: "Williams 1978 (as a plug-in example)",
@@ -98,4 +99,9 @@ register_technique!(TechniqueInfo {
     params: PARAMS,
     requirements: |params| Ok(Requirements { gbuffer: true, max_texture_size: map_size(params)?, ..Requirements::NONE }),
     create,
-});
+    presets: &[],
+    trade: None,
+    uniforms: &[],
+};
+
+register_technique!(INFO);

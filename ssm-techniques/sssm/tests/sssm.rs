@@ -5,16 +5,16 @@
 
 use glam::Vec3;
 use ssm_core::metrics::compare;
-use ssm_integration_tests::{Rendered, gpu, parallel_square_exact, render};
 use ssm_scene::{Camera, Scene, builtin};
+use ssm_testing::{Rendered, gpu, mean_abs_difference, penumbra_mask, render, scene_from_manifest};
 
 const SIZE: (u32, u32) = (160, 120);
 
 fn reuse_share(scene: &Scene, settings: &[(&str, &str)]) -> (Rendered, f64) {
     let gpu = gpu();
-    let rendered = render(&gpu, scene, "sssm", settings, SIZE.0, SIZE.1).unwrap();
-    // The registry's technique, rendered again to read its diagnostics.
-    let info = ssm_core::Registry::global().unwrap().get("sssm").unwrap();
+    let rendered = render(&gpu, scene, &ssm_sssm::INFO, settings, SIZE.0, SIZE.1).unwrap();
+    // Rendered again to read its diagnostics.
+    let info = &ssm_sssm::INFO;
     let params = info.params_from(settings.iter().copied()).unwrap();
     let mut renderer = rendered.renderer;
     let mut technique = renderer.create_technique(info, &params).unwrap();
@@ -60,28 +60,15 @@ fn error_grows_with_the_thresholds() {
     // The direction of the paper's Tables 5 and 6.
     let scene = builtin("leaves").unwrap().build();
     let gpu = gpu();
-    let reference = render(&gpu, &scene, "reference", &[("samples", "12"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
-    let covered: Vec<bool> = reference.renderer.read_positions().unwrap().iter().map(|p| p[3] > 0.5).collect();
+    let reference = ssm_testing::reference(&gpu, &scene, 12, SIZE);
+    let covered = reference.coverage();
     let error = |threshold: &str| {
-        let rendered = render(&gpu, &scene, "sssm", &[("alpha", threshold), ("beta", threshold)], SIZE.0, SIZE.1).unwrap();
+        let rendered = render(&gpu, &scene, &ssm_sssm::INFO, &[("alpha", threshold), ("beta", threshold)], SIZE.0, SIZE.1).unwrap();
         compare(&reference.visibility, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).rmse
     };
     let (none, large) = (error("0"), error("0.1"));
     println!("leaves RMSE: alpha = beta = 0: {none:.4}, 0.1: {large:.4}");
     assert!(large > none, "reusing across depth gaps adds error: {none} vs {large}");
-}
-
-/// The pixels of `rendered` whose exact visibility on parallel-square lies strictly inside the
-/// penumbra (0.02 to 0.98), and that exact visibility.
-fn penumbra_pixels(rendered: &Rendered) -> Vec<(usize, f32)> {
-    let positions = rendered.renderer.read_positions().unwrap();
-    positions
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p[3] > 0.5 && p[1].abs() < 1e-3)
-        .map(|(i, p)| (i, parallel_square_exact(p[0], p[2])))
-        .filter(|(_, exact)| *exact > 0.02 && *exact < 0.98)
-        .collect()
 }
 
 /// With the mean filter, SSSM evaluates PCSS's n×n blocker search and m×m filter separably. On a
@@ -97,20 +84,19 @@ fn penumbra_pixels(rendered: &Rendered) -> Vec<(usize, f32)> {
 fn on_a_parallel_receiver_sssm_with_the_mean_filter_equals_pcss_over_the_penumbra() {
     let scene = top_down_parallel_square();
     let gpu = gpu();
-    let pcss = render(&gpu, &scene, "pcss", &[("blocker_kernel", "7"), ("pcf_kernel", "15")], SIZE.0, SIZE.1).unwrap();
-    let penumbra = penumbra_pixels(&pcss);
-    assert!(penumbra.len() > 1000, "{} penumbra pixels", penumbra.len());
+    let pcss = render(&gpu, &scene, &ssm_pcss::INFO, &[("blocker_kernel", "7"), ("pcf_kernel", "15")], SIZE.0, SIZE.1).unwrap();
+    let penumbra = penumbra_mask(&pcss.parallel_square_exact());
+    let count = penumbra.iter().filter(|p| **p).count();
+    assert!(count > 1000, "{count} penumbra pixels");
     let difference = |threshold: &str| {
         let settings = [("filter", "mean"), ("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", threshold), ("beta", threshold)];
         let (sssm, share) = reuse_share(&scene, &settings);
-        let mean = penumbra.iter().map(|(i, _)| (sssm.visibility[*i] - pcss.visibility[*i]).abs()).sum::<f32>() / penumbra.len() as f32;
-        (mean, share)
+        (mean_abs_difference(&sssm.visibility, &pcss.visibility, &penumbra), share)
     };
     let (direct, no_reuse) = difference("0");
     let (separable, reuse) = difference("0.01");
     println!(
-        "mean |sssm - pcss| over {} penumbra pixels: rows read directly {direct:.5} (reuse share {no_reuse:.3}), separable {separable:.5} (reuse share {reuse:.3})",
-        penumbra.len()
+        "mean |sssm - pcss| over {count} penumbra pixels: rows read directly {direct:.5} (reuse share {no_reuse:.3}), separable {separable:.5} (reuse share {reuse:.3})"
     );
     assert_eq!(no_reuse, 0.0);
     assert!(reuse > 0.5, "the separable path must run: reuse share {reuse}");
@@ -135,14 +121,8 @@ fn penumbra_widths(values: &[f32], (width, height): (u32, u32)) -> (usize, usize
 fn on_a_tilted_receiver_the_penumbra_has_the_exact_width_along_both_screen_axes() {
     let scene = builtin("parallel-square").unwrap().build();
     let gpu = gpu();
-    let sssm = render(&gpu, &scene, "sssm", &[("filter", "mean"), ("blur_kernel", "31")], SIZE.0, SIZE.1).unwrap();
-    let exact: Vec<f32> = sssm
-        .renderer
-        .read_positions()
-        .unwrap()
-        .iter()
-        .map(|p| if p[3] > 0.5 && p[1].abs() < 1e-3 { parallel_square_exact(p[0], p[2]) } else { 1.0 })
-        .collect();
+    let sssm = render(&gpu, &scene, &ssm_sssm::INFO, &[("filter", "mean"), ("blur_kernel", "31")], SIZE.0, SIZE.1).unwrap();
+    let exact = sssm.parallel_square_exact();
     let (exact_column, exact_row) = penumbra_widths(&exact, SIZE);
     let (column, row) = penumbra_widths(&sssm.visibility, SIZE);
     let (vertical, horizontal) = (column as f32 / exact_column as f32, row as f32 / exact_row as f32);
@@ -183,10 +163,9 @@ primitive = "plane"
 size = [30.0, 30.0]
 role = "receiver"
 "#;
-    let origin = std::path::Path::new("inline.toml");
-    let scene = ssm_scene::Manifest::parse(text, origin).unwrap().build(origin, std::path::Path::new(".")).unwrap();
+    let scene = scene_from_manifest(text);
     let gpu = gpu();
-    let reference = render(&gpu, &scene, "reference", &[("samples", "16"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+    let reference = ssm_testing::reference(&gpu, &scene, 16, SIZE);
     let normals = reference.renderer.read_normals().unwrap();
     let positions = reference.renderer.read_positions().unwrap();
     let (width, height) = (SIZE.0 as i32, SIZE.1 as i32);
@@ -202,7 +181,7 @@ role = "receiver"
         .collect();
     assert!(near_silhouette.len() > 300, "{} pixels", near_silhouette.len());
     let error = |bilateral: &str| {
-        let sssm = render(&gpu, &scene, "sssm", &[("bilateral_depth", bilateral)], SIZE.0, SIZE.1).unwrap();
+        let sssm = render(&gpu, &scene, &ssm_sssm::INFO, &[("bilateral_depth", bilateral)], SIZE.0, SIZE.1).unwrap();
         near_silhouette.iter().map(|i| (sssm.visibility[*i] - reference.visibility[*i]).abs()).sum::<f32>() / near_silhouette.len() as f32
     };
     let (plain, weighted) = (error("0"), error("0.005"));
@@ -219,13 +198,19 @@ fn kernels_wider_than_the_screen_and_zero_penumbrae_stay_in_range() {
     // A light 20 times the occluder on a 32×24 image: blocker windows and blurs far wider than the screen.
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.lights[0].half_size *= 20.0;
-    let wide =
-        render(&gpu, &scene, "sssm", &[("blocker_kernel", "64"), ("blur_kernel", "128"), ("alpha", "0.05"), ("beta", "0.05")], 32, 24)
-            .unwrap();
+    let wide = render(
+        &gpu,
+        &scene,
+        &ssm_sssm::INFO,
+        &[("blocker_kernel", "64"), ("blur_kernel", "128"), ("alpha", "0.05"), ("beta", "0.05")],
+        32,
+        24,
+    )
+    .unwrap();
     assert!(wide.visibility.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)));
     // A point light: zero penumbra everywhere, so the hard value is kept.
     scene.lights[0].half_size *= 0.0;
-    let hard = render(&gpu, &scene, "sssm", &[], 64, 48).unwrap();
+    let hard = render(&gpu, &scene, &ssm_sssm::INFO, &[], 64, 48).unwrap();
     let covered = hard.covered_visibility();
     assert!(covered.iter().all(|v| *v == 0.0 || *v == 1.0), "a zero penumbra keeps the hard shadow");
     assert!(covered.contains(&0.0) && covered.contains(&1.0));

@@ -1,39 +1,12 @@
-//! Reference images: every built-in scene with both baselines at 128×96,
-//! compared with the blessed 16-bit PNGs in `tests/reference/` within a
-//! tolerance. Re-bless after an intended change with
-//! `SSM_BLESS=1 cargo test --test images`, then look at the images before
-//! committing them.
+//! The image comparison of ssm-testing: a missing reference fails unless
+//! blessed, and a mismatch writes `-actual` and `-diff` images.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use ssm_integration_tests::{ImageTolerance, bless_requested, compare_with_reference, gpu, reference_directory, render};
-use ssm_scene::BUILTIN_SCENES;
+use ssm_testing::{ImageTolerance, compare_with_reference};
 
-const SIZE: (u32, u32) = (128, 96);
-
-/// Lavapipe is deterministic on one machine; across Mesa versions, edge
-/// pixels may move by one. A real regression moves far more.
 const TOLERANCE: ImageTolerance = ImageTolerance { mean: 0.002, pixel: 0.1, wrong_share: 0.005 };
-
-#[test]
-fn baselines_match_their_reference_images() {
-    let gpu = gpu();
-    let mut failures = Vec::new();
-    for entry in BUILTIN_SCENES {
-        let scene = entry.build();
-        for technique in ["hard", "pcss"] {
-            let rendered = render(&gpu, &scene, technique, &[], SIZE.0, SIZE.1).unwrap();
-            let name = format!("{}-{technique}", entry.name);
-            if let Err(message) =
-                compare_with_reference(&reference_directory(), &name, &rendered.visibility, SIZE, TOLERANCE, bless_requested())
-            {
-                failures.push(message);
-            }
-        }
-    }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
 
 #[test]
 fn a_missing_reference_fails_and_a_mismatch_writes_actual_and_diff() {

@@ -5,12 +5,11 @@
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use ssm_core::LightFrame;
 use ssm_core::metrics::compare;
-use ssm_core::reference::parallel_rectangle_visibility;
-use ssm_integration_tests::{gpu, render};
 use ssm_scene::{Scene, builtin};
+use ssm_testing::{gpu, render, scene_from_manifest};
 
 const SIZE: (u32, u32) = (160, 120);
 
@@ -24,20 +23,9 @@ fn parallel_square_error(settings: &[(&str, &str)]) -> f64 {
 /// parallel-square, against the exact visibility at the same G-buffer points.
 fn parallel_square_errors(settings: &[(&str, &str)]) -> (f64, f64) {
     let scene = builtin("parallel-square").unwrap().build();
-    let rendered = render(&gpu(), &scene, "atty", settings, SIZE.0, SIZE.1).unwrap();
-    let positions = rendered.renderer.read_positions().unwrap();
-    let light = &scene.lights[0];
-    let exact: Vec<f32> = positions
-        .iter()
-        .map(|p| {
-            if p[3] > 0.5 {
-                parallel_rectangle_visibility(light, Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5), Vec3::new(p[0], p[1], p[2]))
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let covered: Vec<bool> = positions.iter().map(|p| p[3] > 0.5).collect();
+    let rendered = render(&gpu(), &scene, &ssm_atty::INFO, settings, SIZE.0, SIZE.1).unwrap();
+    let exact = rendered.parallel_square_exact();
+    let covered = rendered.coverage();
     let mae = compare(&exact, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae_penumbra;
     let max = exact
         .iter()
@@ -55,13 +43,9 @@ fn parallel_square_tan_half() -> f32 {
     LightFrame::fit(&scene.lights[0], &scene.bounds()).tan_half.x
 }
 
-/// Penumbra MAE of `technique` against a 16×16-sample ground truth on `scene`.
-fn error_against_reference(scene: &Scene, technique: &str, settings: &[(&str, &str)]) -> f64 {
-    let gpu = gpu();
-    let reference = render(&gpu, scene, "reference", &[("samples", "16"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
-    let rendered = render(&gpu, scene, technique, settings, SIZE.0, SIZE.1).unwrap();
-    let covered: Vec<bool> = rendered.renderer.read_positions().unwrap().iter().map(|p| p[3] > 0.5).collect();
-    compare(&reference.visibility, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae_penumbra
+/// Penumbra MAE of `atty` with `settings` against a 16×16-sample ground truth on `scene`.
+fn error_against_reference(scene: &Scene, settings: &[(&str, &str)]) -> f64 {
+    ssm_testing::error_against_reference(scene, &ssm_atty::INFO, settings, 16, SIZE).mae_penumbra
 }
 
 /// Sec. 5.1.1: each micro-patch over- or under-estimates the occluder by at most half a texel.
@@ -127,15 +111,14 @@ fn fp16_accumulation_fails_at_high_resolution_and_fp32_does_not() {
 fn two_sided_darkens_where_the_back_faces_hide_more_and_is_more_accurate() {
     let sphere = builtin("floating-sphere").unwrap().build();
     let gpu = gpu();
-    let one = render(&gpu, &sphere, "atty", &[], SIZE.0, SIZE.1).unwrap();
-    let two = render(&gpu, &sphere, "atty", &[("two_sided", "true")], SIZE.0, SIZE.1).unwrap();
+    let one = render(&gpu, &sphere, &ssm_atty::INFO, &[], SIZE.0, SIZE.1).unwrap();
+    let two = render(&gpu, &sphere, &ssm_atty::INFO, &[("two_sided", "true")], SIZE.0, SIZE.1).unwrap();
     let receives: Vec<bool> = one.renderer.read_normals().unwrap().iter().map(|n| n[3] > 0.5).collect();
     let pairs: Vec<(f32, f32)> =
         one.visibility.iter().zip(&two.visibility).zip(&receives).filter(|(_, r)| **r).map(|((a, b), _)| (*a, *b)).collect();
     let lighter = pairs.iter().filter(|(a, b)| b > &(a + 1e-4)).count();
     let darkened = pairs.iter().filter(|(a, b)| b < &(a - 0.02)).count() as f64 / pairs.len() as f64;
-    let (error_one, error_two) =
-        (error_against_reference(&sphere, "atty", &[]), error_against_reference(&sphere, "atty", &[("two_sided", "true")]));
+    let (error_one, error_two) = (error_against_reference(&sphere, &[]), error_against_reference(&sphere, &[("two_sided", "true")]));
     println!(
         "floating-sphere: two-sided darkens {:.2}% of receiver pixels by more than 0.02; penumbra MAE one-sided {error_one:.4}, two-sided {error_two:.4}",
         darkened * 100.0
@@ -154,8 +137,8 @@ fn a_point_light_gives_the_hard_shadow() {
     let mut scene = builtin("floating-sphere").unwrap().build();
     scene.lights[0].half_size = Vec2::ZERO;
     let gpu = gpu();
-    let atty = render(&gpu, &scene, "atty", &[("occluder_map_size", "512"), ("ssm_size", "1024")], SIZE.0, SIZE.1).unwrap();
-    let exact = render(&gpu, &scene, "reference", &[("samples", "1"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+    let atty = render(&gpu, &scene, &ssm_atty::INFO, &[("occluder_map_size", "512"), ("ssm_size", "1024")], SIZE.0, SIZE.1).unwrap();
+    let exact = ssm_testing::reference(&gpu, &scene, 1, SIZE);
     let receives: Vec<bool> = atty.renderer.read_normals().unwrap().iter().map(|n| n[3] > 0.5).collect();
     let compared: Vec<(f32, f32)> =
         atty.visibility.iter().zip(&exact.visibility).zip(&receives).filter(|(_, r)| **r).map(|((a, e), _)| (*a, *e)).collect();
@@ -197,11 +180,10 @@ primitive = "plane"
 size = [10.0, 10.0]
 role = "receiver"
 "#;
-    let origin = std::path::Path::new("inline.toml");
-    let scene = ssm_scene::Manifest::parse(text, origin).unwrap().build(origin, std::path::Path::new(".")).unwrap();
+    let scene = scene_from_manifest(text);
     let (default, unbounded) = (
-        error_against_reference(&scene, "atty", &[("ssm_size", "128")]),
-        error_against_reference(&scene, "atty", &[("ssm_size", "128"), ("receiver_tolerance", "64")]),
+        error_against_reference(&scene, &[("ssm_size", "128")]),
+        error_against_reference(&scene, &[("ssm_size", "128"), ("receiver_tolerance", "64")]),
     );
     println!("platform: penumbra MAE with receiver_tolerance 2 (default) {default:.4}, 64 {unbounded:.4}");
     assert!(default < 0.5 * unbounded, "{default} vs {unbounded}");

@@ -1,0 +1,46 @@
+//! Every preset a technique declares (and the assembled `trade`) resolves:
+//! its scenes load, its varies name registered techniques and parameters
+//! with valid values, its x axis is one of them. A new technique's presets
+//! are checked without editing this file.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use ssm_bench::registry;
+use ssm_bench::sweep::{SweepPlan, preset, presets, trade_preset};
+use ssm_core::TechniqueKind;
+
+#[test]
+fn every_preset_resolves_against_the_registry() {
+    let registry = registry().unwrap();
+    let all = presets(registry).unwrap();
+    assert!(all.len() >= 8, "{} presets", all.len());
+    for spec in &all {
+        let plan = SweepPlan::new(registry, &spec.varies, &[]).unwrap_or_else(|e| panic!("preset {}: {e:#}", spec.name));
+        assert!(!plan.points.is_empty(), "preset {} has no point", spec.name);
+        assert!(spec.x_axis == "time" || plan.varied.contains(&spec.x_axis), "preset {}: x axis {} is not varied", spec.name, spec.x_axis);
+        assert!(!spec.scenes.is_empty(), "preset {} names no scene", spec.name);
+        for scene in &spec.scenes {
+            // Built-in names load; manifests are resolved from the repository's root.
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);
+            let spec_path = if ssm_scene::builtin(scene).is_ok() { scene.clone() } else { path.display().to_string() };
+            ssm_scene::Scene::load(&spec_path).unwrap_or_else(|e| panic!("preset {}: scene {scene}: {e}", spec.name));
+        }
+    }
+    assert!(preset(registry, "nope").unwrap_err().to_string().contains("trade"));
+}
+
+/// `trade` is assembled from what each technique declares: every real-time technique with a
+/// quality knob is in it, varied over its values.
+#[test]
+fn trade_takes_every_techniques_quality_knob() {
+    let registry = registry().unwrap();
+    let trade = trade_preset(registry);
+    for info in registry.iter().filter(|i| i.kind == TechniqueKind::Realtime) {
+        if let Some(knob) = info.trade {
+            assert!(trade.varies.contains(&format!("{}.{knob}", info.name)), "{} missing from {:?}", info.name, trade.varies);
+        }
+    }
+    let with_knobs = registry.iter().filter(|i| i.trade.is_some()).count();
+    assert!(with_knobs >= 5, "only {with_knobs} techniques declare a quality knob");
+}

@@ -1,0 +1,110 @@
+//! `pcss` on the analytic case, against `hard` and the ground truth, with and
+//! without the receiver plane, and against its blessed reference images.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use glam::Vec3;
+use ssm_scene::{BUILTIN_SCENES, builtin};
+use ssm_testing::{
+    ImageTolerance, at, bless_requested, compare_with_reference, error_against_reference, gpu, parallel_square_exact, pixel_of, render,
+};
+
+const WIDTH: u32 = 160;
+const HEIGHT: u32 = 120;
+
+#[test]
+fn parallel_square_umbra_and_lit_region() {
+    let gpu = gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let rendered = render(&gpu, &scene, &ssm_pcss::INFO, &[], WIDTH, HEIGHT).unwrap();
+    let umbra = at(&rendered, pixel_of(&scene, WIDTH, HEIGHT, Vec3::ZERO));
+    let lit = at(&rendered, pixel_of(&scene, WIDTH, HEIGHT, Vec3::new(2.5, 0.0, 0.0)));
+    assert!(umbra < 0.05, "umbra centre reads {umbra}");
+    assert!(lit > 0.95, "lit receiver reads {lit}");
+}
+
+#[test]
+fn pcss_follows_the_analytic_penumbra_and_hard_does_not() {
+    let gpu = gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let hard = render(&gpu, &scene, &ssm_hard::INFO, &[], WIDTH, HEIGHT).unwrap();
+    let pcss = render(&gpu, &scene, &ssm_pcss::INFO, &[("pcf_kernel", "24"), ("blocker_kernel", "12")], WIDTH, HEIGHT).unwrap();
+    // Along the x axis through the penumbra: the exact visibility rises from 0 at x = 0.5 to 1 at x = 1.5.
+    let (mut hard_error, mut pcss_error, mut samples) = (0.0, 0.0, 0);
+    for step in 0..=20 {
+        let x = 0.5 + step as f32 * 0.05;
+        let pixel = pixel_of(&scene, WIDTH, HEIGHT, Vec3::new(x, 0.0, 0.0));
+        let exact = parallel_square_exact(x, 0.0);
+        hard_error += (at(&hard, pixel) - exact).abs();
+        pcss_error += (at(&pcss, pixel) - exact).abs();
+        samples += 1;
+    }
+    let (hard_error, pcss_error) = (hard_error / samples as f32, pcss_error / samples as f32);
+    // Hard shadows are off by 0.25 on average across a linear ramp; PCSS on parallel planes is close to exact,
+    // up to the pixel footprint (about 0.05 world units here) and the regular-grid quantisation.
+    assert!(pcss_error < 0.08, "pcss penumbra error {pcss_error}");
+    assert!(pcss_error < hard_error * 0.5, "pcss {pcss_error} vs hard {hard_error}");
+    // Half-way through the penumbra, half the light is visible.
+    let middle = at(&pcss, pixel_of(&scene, WIDTH, HEIGHT, Vec3::new(1.0, 0.0, 0.0)));
+    assert!((middle - 0.5).abs() < 0.1, "pcss at the middle of the penumbra reads {middle}");
+}
+
+#[test]
+fn pcss_has_lower_penumbra_error_than_hard_on_parallel_square() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let hard = error_against_reference(&scene, &ssm_hard::INFO, &[], 16, (128, 96));
+    let pcss = error_against_reference(&scene, &ssm_pcss::INFO, &[], 16, (128, 96));
+    println!("parallel-square: hard mae_penumbra {:.4}, pcss {:.4}", hard.mae_penumbra, pcss.mae_penumbra);
+    assert!(pcss.mae_penumbra < hard.mae_penumbra * 0.6, "pcss {} vs hard {}", pcss.mae_penumbra, hard.mae_penumbra);
+    assert!(pcss.ssim > hard.ssim);
+}
+
+#[test]
+fn every_builtin_scene_casts_a_shadow_on_a_lit_receiver() {
+    let gpu = gpu();
+    for entry in BUILTIN_SCENES {
+        let rendered = render(&gpu, &entry.build(), &ssm_pcss::INFO, &[], WIDTH, HEIGHT).unwrap_or_else(|e| panic!("{}: {e}", entry.name));
+        let shadowed = rendered.visibility.iter().filter(|v| **v < 0.5).count();
+        let lit = rendered.visibility.iter().filter(|v| **v > 0.5).count();
+        assert!(shadowed > 50, "{}: only {shadowed} shadowed pixels", entry.name);
+        assert!(lit > shadowed, "{}: {lit} lit vs {shadowed} shadowed", entry.name);
+    }
+}
+
+#[test]
+fn the_receiver_plane_test_removes_self_shadowing_at_grazing_light() {
+    // A light 12 units to the side, 0.25 above a bare receiver: nothing occludes it.
+    let gpu = gpu();
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.instances.retain(|i| i.name == "ground");
+    scene.lights[0] =
+        ssm_scene::RectLight::try_facing(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), Vec3::Z, glam::Vec2::ONE, 1.0).unwrap();
+    let lit_share = |settings: &[(&str, &str)]| {
+        let rendered = render(&gpu, &scene, &ssm_pcss::INFO, settings, WIDTH, HEIGHT).unwrap();
+        let covered = rendered.covered_visibility();
+        covered.iter().filter(|v| **v > 0.95).count() as f32 / covered.len() as f32
+    };
+    let with_plane = lit_share(&[]);
+    let without_plane = lit_share(&[("receiver_plane", "false")]);
+    assert!(with_plane > 0.99, "with the receiver plane, {:.1}% of the bare receiver reads lit", with_plane * 100.0);
+    assert!(without_plane < 0.9, "without it, the receiver shadows itself: {:.1}% lit", without_plane * 100.0);
+}
+
+/// Every built-in scene at 128×96 against the blessed 16-bit PNGs in `tests/reference/`
+/// (re-bless with `SSM_BLESS=1 cargo test -p ssm-pcss`, then look at the images).
+#[test]
+fn every_builtin_scene_matches_its_reference_image() {
+    let gpu = gpu();
+    let directory = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference");
+    let tolerance = ImageTolerance { mean: 0.002, pixel: 0.1, wrong_share: 0.005 };
+    let failures: Vec<String> = BUILTIN_SCENES
+        .iter()
+        .filter_map(|entry| {
+            let rendered = render(&gpu, &entry.build(), &ssm_pcss::INFO, &[], 128, 96).unwrap();
+            let name = format!("{}-pcss", entry.name);
+            compare_with_reference(&directory, &name, &rendered.visibility, (128, 96), tolerance, bless_requested()).err()
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
