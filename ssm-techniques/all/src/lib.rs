@@ -31,4 +31,24 @@ mod tests {
             assert!(registry.get(name).is_ok(), "{name} is linked but not registered");
         }
     }
+
+    /// Every crate folder beside this one is in the list: a technique whose line was forgotten
+    /// would be missing from `ssm list`, the benches and the extremes matrix without a word.
+    #[test]
+    fn every_technique_folder_is_a_dependency() {
+        let techniques = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut folders: Vec<String> = std::fs::read_dir(&techniques)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .filter_map(|entry| entry.ok().map(|e| e.path()))
+            .filter(|path| path.join("Cargo.toml").is_file() && !path.ends_with("all"))
+            .filter_map(|path| std::fs::read_to_string(path.join("Cargo.toml")).ok())
+            .filter_map(|manifest| {
+                manifest.lines().find_map(|line| line.strip_prefix("name = \"").and_then(|rest| rest.strip_suffix('"')).map(|n| n.replace('-', "_")))
+            })
+            .collect();
+        folders.sort();
+        let mut linked: Vec<String> = CRATES.iter().map(|c| (*c).to_owned()).collect();
+        linked.sort();
+        assert_eq!(folders, linked, "add each technique crate to ssm-techniques/all/Cargo.toml");
+    }
 }
