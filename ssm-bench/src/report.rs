@@ -30,10 +30,12 @@ pub struct Measured {
 }
 
 impl Measured {
-    /// Median over frames of the GPU time (sum of the technique's passes).
+    /// Median over frames of the frame's time on the GPU: the sum of the technique's timed passes,
+    /// plus any CPU work inside the frame that the GPU waits for (a mid-frame readback's stall, a
+    /// paper's CPU step): [`FrameTimings::frame_ms`]. `None` without timestamps.
     #[must_use]
     pub fn gpu_ms_median(&self) -> Option<f64> {
-        median(&self.frames.iter().filter_map(|f| f.gpu_ms).collect::<Vec<_>>())
+        median(&self.frames.iter().filter(|f| f.gpu_ms.is_some()).map(FrameTimings::frame_ms).collect::<Vec<_>>())
     }
 
     /// Median over frames of the GPU time of the passes recorded for `light`.
@@ -43,15 +45,15 @@ impl Measured {
             .frames
             .iter()
             .filter(|f| f.gpu_ms.is_some())
-            .map(|f| f.passes.iter().filter(|p| p.light == light).map(|p| p.ms).sum())
+            .map(|f| f.passes.iter().chain(&f.cpu_scopes).filter(|p| p.light == light).map(|p| p.ms).sum())
             .collect();
         median(&per_frame)
     }
 
-    /// Smallest GPU time over frames.
+    /// Smallest frame time over frames (as [`Measured::gpu_ms_median`]).
     #[must_use]
     pub fn gpu_ms_min(&self) -> Option<f64> {
-        self.frames.iter().filter_map(|f| f.gpu_ms).reduce(f64::min)
+        self.frames.iter().filter(|f| f.gpu_ms.is_some()).map(FrameTimings::frame_ms).reduce(f64::min)
     }
 
     /// Median CPU wall time from recording to the GPU going idle.
@@ -73,17 +75,27 @@ impl Measured {
     }
 
     fn pass_medians_where(&self, keep: impl Fn(&ssm_core::PassTiming) -> bool) -> Vec<(String, f64)> {
+        // GPU passes by name, then CPU work inside the frame (readback stalls, a paper's CPU step) marked `(cpu)`.
+        let timed = |frame: &FrameTimings| -> Vec<(String, f64)> {
+            frame
+                .passes
+                .iter()
+                .filter(|p| keep(p))
+                .map(|p| (p.name.clone(), p.ms))
+                .chain(frame.cpu_scopes.iter().filter(|p| keep(p)).map(|p| (format!("{} (cpu)", p.name), p.ms)))
+                .collect()
+        };
         let mut names: Vec<String> = Vec::new();
-        for pass in self.frames.iter().flat_map(|f| &f.passes).filter(|p| keep(p)) {
-            if !names.contains(&pass.name) {
-                names.push(pass.name.clone());
+        for (name, _) in self.frames.iter().flat_map(timed) {
+            if !names.contains(&name) {
+                names.push(name);
             }
         }
         names
             .into_iter()
             .map(|name| {
                 let per_frame: Vec<f64> =
-                    self.frames.iter().map(|f| f.passes.iter().filter(|p| p.name == name && keep(p)).map(|p| p.ms).sum()).collect();
+                    self.frames.iter().map(|f| timed(f).into_iter().filter(|(n, _)| *n == name).map(|(_, ms)| ms).sum()).collect();
                 let ms = median(&per_frame).unwrap_or(f64::NAN);
                 (name, ms)
             })
@@ -212,6 +224,8 @@ pub struct Row {
     pub passes: Vec<(String, f64)>,
     /// Technique diagnostics.
     pub diagnostics: Vec<(String, f64)>,
+    /// Names of the technique's extra images (`<name>.png` beside its visibility).
+    pub extra_images: Vec<String>,
 }
 
 /// The leading columns of `results.csv`, in order; more follow.
@@ -269,6 +283,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         timing_source: measured.frames.first().map_or(TimingSource::CpuWallOnly, |f| f.source),
         passes: measured.pass_medians(),
         diagnostics: measured.diagnostics.clone(),
+        extra_images: measured.extra_images.iter().map(|e| e.name.clone()).collect(),
     }
 }
 
@@ -506,9 +521,14 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     for r in rows {
         match r.light {
             None => {
+                let extras: String = r
+                    .extra_images
+                    .iter()
+                    .map(|name| format!("<img src=\"{0}/{1}.png\" alt=\"{0} {1}\" title=\"{1}\">", escape(&r.technique), escape(name)))
+                    .collect();
                 let _ = writeln!(
                     out,
-                    "<figure><figcaption><code>{0}</code></figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"><img src=\"{0}/heatmap.png\" alt=\"{0} error\"></figure>",
+                    "<figure><figcaption><code>{0}</code></figcaption><img src=\"{0}/shaded.png\" alt=\"{0} shaded\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\"><img src=\"{0}/heatmap.png\" alt=\"{0} error\">{extras}</figure>",
                     escape(&r.technique)
                 );
             }

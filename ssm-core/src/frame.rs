@@ -144,12 +144,13 @@ impl<'a> Frame<'a> {
     /// Reads `buffer` (usage `MAP_READ`) back in the middle of the frame: what
     /// was recorded so far is submitted, the CPU waits for it and maps the
     /// buffer, and recording goes on in a new encoder (PVSM's tile grid). The
-    /// wait is timed on the CPU under `label`: it is part of the technique's cost.
+    /// mapping and copy, after the submitted work has finished, are timed on
+    /// the CPU under `label`: the stall's own cost. The wait for the submitted
+    /// passes is not, since their GPU time is already counted.
     ///
     /// # Errors
     /// [`Error::Readback`] if the GPU fails or the buffer cannot be mapped.
     pub fn read_back(&mut self, label: &str, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-        let start = std::time::Instant::now();
         let next = self
             .gpu
             .device
@@ -159,6 +160,8 @@ impl<'a> Frame<'a> {
         done.pop_debug_group();
         self.gpu.queue.submit([done.finish()]);
         self.encoder.push_debug_group(&self.group);
+        self.gpu.wait_idle().map_err(|e| Error::readback(label, crate::error::Reason(e)))?;
+        let start = std::time::Instant::now();
         let bytes = crate::readback::map_and_read(self.gpu, buffer, label)?;
         self.timer.cpu_scope(label, start.elapsed().as_secs_f64() * 1e3);
         Ok(bytes)

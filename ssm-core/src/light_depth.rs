@@ -4,7 +4,6 @@
 //! from one.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -47,6 +46,14 @@ pub struct DepthBiasUniform {
     pub values: [f32; 4],
 }
 
+impl DepthBiasUniform {
+    /// A constant bias (world units) and a slope factor for a map (or region) of `width` × `height` texels.
+    #[must_use]
+    pub fn new(constant_bias: f32, slope_bias: f32, width: u32, height: u32) -> Self {
+        Self { values: [constant_bias, slope_bias, width as f32, height as f32] }
+    }
+}
+
 /// A light-space map of linear depth (`R32Float`: distance along the light's
 /// normal of the nearest drawn surface, plus bias; [`NO_SURFACE`] where none).
 #[derive(Debug)]
@@ -82,17 +89,8 @@ impl LightDepthMap {
             render_texture(device, &format!("{label}_linear_depth"), desc.width, desc.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
         let depth =
             render_texture(device, &format!("{label}_depth"), desc.width, desc.height, Self::DEPTH_FORMAT, wgpu::TextureUsages::empty());
-        let bias = DepthBiasUniform { values: [desc.constant_bias, desc.slope_bias, desc.width as f32, desc.height as f32] };
-        let bias_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(&format!("{label}_bias_uniform")),
-            contents: bytemuck::bytes_of(&bias),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let bias_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(&format!("{label}_bias_bind_group")),
-            layout: gpu.uniform_layout(),
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: bias_buffer.as_entire_binding() }],
-        });
+        let bias_bind_group =
+            Self::bias_bind_group(gpu, label, &DepthBiasUniform::new(desc.constant_bias, desc.slope_bias, desc.width, desc.height));
         let pipeline = Self::pipeline(gpu, desc.cull_mode, desc.farthest)?;
         Ok(Self {
             linear_depth_view: labelled_view(&linear_depth, &format!("{label}_linear_depth")),
@@ -104,6 +102,13 @@ impl LightDepthMap {
             indices,
             farthest: desc.farthest,
         })
+    }
+
+    /// A bind group holding `bias`, for [`LightDepthMap::encode_region`].
+    #[must_use]
+    pub fn bias_bind_group(gpu: &GpuContext, label: &str, bias: &DepthBiasUniform) -> wgpu::BindGroup {
+        let buffer = crate::passes::uniform_buffer(&gpu.device, &format!("{label}_bias_uniform"), bias);
+        crate::passes::bind_group(&gpu.device, &format!("{label}_bias_bind_group"), gpu.uniform_layout(), &[buffer.as_entire_binding()])
     }
 
     /// The shared pipeline for one culling mode and depth order.
@@ -159,9 +164,25 @@ impl LightDepthMap {
     /// [`LightFrameUniform`](crate::LightFrameUniform) (a point on the light,
     /// a tile of it...).
     pub fn encode_with(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup) {
+        self.encode_region(frame, light_frame, &self.bias_bind_group, None, &self.label);
+    }
+
+    /// Records the pass into the top-left `width` × `height` texels of the map
+    /// only (the whole map is cleared first), through `light_frame`, with
+    /// another bias (a [`DepthBiasUniform`] of that region's size), labelled
+    /// and timed as `label`: one map of the largest size serves tiles of
+    /// several resolutions, one after the other.
+    pub fn encode_region(
+        &self,
+        frame: &mut Frame<'_>,
+        light_frame: &wgpu::BindGroup,
+        bias: &wgpu::BindGroup,
+        region: Option<(u32, u32)>,
+        label: &str,
+    ) {
         let scene = frame.scene;
         let mut pass = frame.render_pass(
-            &self.label,
+            label,
             &[color_attachment(&self.linear_depth_view, Some(wgpu::Color { r: f64::from(NO_SURFACE), g: 0.0, b: 0.0, a: 0.0 }))],
             Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
@@ -172,9 +193,14 @@ impl LightDepthMap {
                 stencil_ops: None,
             }),
         );
+        if let Some((width, height)) = region {
+            let (width, height) = (width.clamp(1, self.linear_depth.width()), height.clamp(1, self.linear_depth.height()));
+            pass.set_viewport(0.0, 0.0, width as f32, height as f32, 0.0, 1.0);
+            pass.set_scissor_rect(0, 0, width, height);
+        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);
-        pass.set_bind_group(1, &self.bias_bind_group, &[]);
+        pass.set_bind_group(1, bias, &[]);
         scene.draw(&mut pass, self.indices.clone());
     }
 }

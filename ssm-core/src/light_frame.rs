@@ -139,6 +139,30 @@ impl LightFrame {
         self.projection * self.view
     }
 
+    /// The uniform of the part of this frame whose shadow-map coordinates lie
+    /// in `[uv_min, uv_max]` (a tile of a virtual shadow map): its clip space
+    /// maps that rectangle onto the whole viewport, and its half-angle
+    /// tangents are the tile's share of the frame's, so that texel sizes
+    /// (slope bias, normal offset) are the tile's. Depth and every other field
+    /// are the frame's.
+    #[must_use]
+    pub fn tile_uniform(&self, uv_min: Vec2, uv_max: Vec2) -> LightFrameUniform {
+        let extent = (uv_max - uv_min).max(Vec2::splat(1e-9));
+        // NDC x = 2u − 1 and NDC y = 1 − 2v map to the tile's [-1, 1]: x' = (x − c_x w)/e_x, y' = (y − c_y w)/e_y.
+        let centre = Vec2::new(uv_min.x + uv_max.x - 1.0, 1.0 - (uv_min.y + uv_max.y));
+        let to_tile = Mat4::from_cols(
+            glam::Vec4::new(1.0 / extent.x, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 1.0 / extent.y, 0.0, 0.0),
+            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+            glam::Vec4::new(-centre.x / extent.x, -centre.y / extent.y, 0.0, 1.0),
+        );
+        let mut uniform = LightFrameUniform::from(self);
+        uniform.view_proj = (to_tile * self.view_proj()).to_cols_array_2d();
+        uniform.projection[0] = self.tan_half.x * extent.x;
+        uniform.projection[1] = self.tan_half.y * extent.y;
+        uniform
+    }
+
     /// Shadow-map texture coordinates (u right, v down) and linear depth of a
     /// world point; the CPU twin of `light_uv_depth` in `light_frame.wgsl`.
     #[must_use]
@@ -284,6 +308,24 @@ mod tests {
             LightFrame::fit_with_occluders(&light, &scene.bounds(), &receivers, &[Vec3::Y * 2.0]),
             LightFrame::fit(&light, &scene.bounds())
         );
+    }
+
+    /// A tile's clip space maps its part of the map onto the whole viewport.
+    #[test]
+    fn a_tile_frame_maps_its_rectangle_onto_the_viewport() {
+        let scene = builtin("parallel-square").unwrap().build();
+        let frame = LightFrame::fit(&scene.lights[0], &scene.bounds());
+        let (low, high) = (Vec2::new(0.25, 0.5), Vec2::new(0.5, 0.625));
+        let tile = frame.tile_uniform(low, high);
+        let view_proj = Mat4::from_cols_array_2d(&tile.view_proj);
+        for world in [Vec3::new(0.3, 0.0, 0.1), Vec3::new(-1.0, 1.0, 0.7), Vec3::new(-2.0, 0.5, 1.5)] {
+            let uvd = frame.uv_depth(world);
+            let ndc = view_proj.project_point3(world);
+            let tile_uv = Vec2::new(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+            let expected = (Vec2::new(uvd.x, uvd.y) - low) / (high - low);
+            assert!((tile_uv - expected).length() < 1e-4, "{world}: {tile_uv} vs {expected}");
+        }
+        assert!((tile.projection[0] - frame.tan_half.x * 0.25).abs() < 1e-6);
     }
 
     #[test]

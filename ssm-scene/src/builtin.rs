@@ -52,6 +52,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         summary: "300 thin quads at varied heights over the ground: occluder fusion and depth discontinuities (Buades et al.'s plant)",
         build: leaves,
     },
+    BuiltinScene {
+        name: "bar-grid",
+        summary: "70 thin bars 0.1 apart, parallel to a large floor under a small light, the camera low and looking along it: high-frequency hard shadows that alias in the distance (Shen et al., Fig. 11)",
+        build: bar_grid,
+    },
 ];
 
 /// Looks up a built-in scene by name.
@@ -155,6 +160,19 @@ fn leaves() -> Scene {
         let rotation = Quat::from_rotation_y(next() * std::f32::consts::TAU) * Quat::from_rotation_x((next() - 0.5) * 1.2);
         b.place(format!("leaf-{index}"), leaf, Mat4::from_rotation_translation(rotation, position), Role::Occluder);
     }
+    b.scene
+}
+
+fn bar_grid() -> Scene {
+    let mut b = SceneBuilder::new("bar-grid", downward_light(Vec3::new(0.0, 6.0, 0.0), 0.05)).ground(16.0);
+    let bar = b.mesh(cuboid("bar", Vec3::new(6.0, 0.02, 0.03)));
+    for index in 0..70 {
+        let z = -3.5 + index as f32 * 0.1;
+        b.place(format!("bar-{index}"), bar, Mat4::from_translation(Vec3::new(0.0, 3.0, z)), Role::Occluder);
+    }
+    // Low and narrow, so that the bars stay above the view and the floor recedes to a grazing angle.
+    b.scene.camera =
+        Camera { position: Vec3::new(0.0, 1.0, 6.0), target: Vec3::new(0.0, 0.0, -1.0), fov_y: 30f32.to_radians(), ..standard_camera() };
     b.scene
 }
 

@@ -43,7 +43,9 @@ mod tests {
             .filter(|path| path.join("Cargo.toml").is_file() && !path.ends_with("all"))
             .filter_map(|path| std::fs::read_to_string(path.join("Cargo.toml")).ok())
             .filter_map(|manifest| {
-                manifest.lines().find_map(|line| line.strip_prefix("name = \"").and_then(|rest| rest.strip_suffix('"')).map(|n| n.replace('-', "_")))
+                manifest
+                    .lines()
+                    .find_map(|line| line.strip_prefix("name = \"").and_then(|rest| rest.strip_suffix('"')).map(|n| n.replace('-', "_")))
             })
             .collect();
         folders.sort();

@@ -1,0 +1,155 @@
+// PVSM step 8 (Sec. 4.1, 4.2, 5.2), once per tile, one invocation per pixel: the filter h of the
+// pixel integrated over the part of the tile's shadow map it covers, each texel a quad of constant
+// depth whose weight is the exact area of its intersection with h (Eq. 2; h's vertical
+// half-axis is the map's, and each one-texel-wide column of the parallelogram is taken as an
+// axis-aligned box, as Sec. 4.2 does). The pixel's accumulator gets the visible covered area Σ c·o
+// and the covered area Σ c, so that tiles sharing a filter merge exactly (Sec. 5.2's V·A and A).
+
+// #import pvsm/pvsm_common.wgsl
+
+struct TileSettings {
+    // The tile's rectangle of the light frame's shadow-map coordinates.
+    uv_min: vec2<f32>,
+    uv_max: vec2<f32>,
+    // Texels of its map (the top-left part of the tile atlas).
+    size: vec2<f32>,
+    _pad0: f32,
+    _pad1: f32,
+};
+
+@group(2) @binding(2) var<storage, read> kernels: array<Kernel>;
+// Per pixel: (Σ c·o, Σ c).
+@group(2) @binding(3) var<storage, read_write> accumulated: array<vec2<f32>>;
+@group(3) @binding(0) var<uniform> tile: TileSettings;
+@group(3) @binding(1) var tile_map: texture_2d<f32>;
+
+// Most texel columns (and rows) one filter integrates: wider filters take every k-th texel, each
+// standing for a k×k block (the fixed-resolution mode and huge lights).
+const MAX_TEXELS_PER_AXIS: f32 = 96.0;
+
+// Σ c·o and Σ c of the filter (u, v_height) centred on `centre` (shadow-map coordinates) over this
+// tile, for a receiver at light depth `depth` with tangent plane (`position`, `normal`). A tile
+// finer than the pixel's predicted texel size `predicted` (a neighbour in the tile needed more) is
+// read at every k-th texel, k the ratio: the prediction says that many texels suffice, and a
+// pixel's cost stays about ρ² whatever the tile's resolution.
+fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec2<f32> {
+    let extent = tile.uv_max - tile.uv_min;
+    let scale = tile.size / extent;
+    // The filter in the tile's texel units.
+    let c = (centre - tile.uv_min) * scale;
+    let ux = abs(u.x) * scale.x;
+    let uy = select(u.y, -u.y, u.x < 0.0) * scale.y;
+    let vy = v_height * scale.y;
+    let x_low = max(c.x - ux, 0.0);
+    let x_high = min(c.x + ux, tile.size.x);
+    let reach_y = abs(uy) + vy;
+    if (x_low >= x_high || c.y + reach_y <= 0.0 || c.y - reach_y >= tile.size.y) {
+        return vec2<f32>(0.0);
+    }
+    let step = max(max(vec2<f32>(1.0), floor(predicted * scale)), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
+    let bias = scene_length(frame, settings.constant_bias);
+    let slope = select(0.0, uy / ux, ux > 1e-6);
+    var visible = 0.0;
+    var covered = 0.0;
+    var column = floor(x_low / step.x) * step.x;
+    loop {
+        if (column >= x_high) {
+            break;
+        }
+        let left = max(column, x_low);
+        let right = min(column + step.x, x_high);
+        let width = right - left;
+        if (width > 0.0) {
+            // This column of h, taken as an axis-aligned box at its middle's height.
+            let middle = 0.5 * (left + right);
+            let y_centre = c.y + (middle - c.x) * slope;
+            let bottom = max(y_centre - vy, 0.0);
+            let top = min(y_centre + vy, tile.size.y);
+            var row = floor(bottom / step.y) * step.y;
+            loop {
+                if (row >= top) {
+                    break;
+                }
+                var height = min(row + step.y, top) - max(row, bottom);
+                let texel = vec2<f32>(column, row) + 0.5 * step;
+                if (settings.point_samples != 0u) {
+                    // Classic PCF: the whole texel when its centre is inside the filter, else nothing.
+                    let inside = texel.x >= x_low && texel.x < x_high && texel.y >= y_centre - vy && texel.y < y_centre + vy;
+                    height = select(0.0, step.y, inside);
+                }
+                if (height > 0.0) {
+                    let z = textureLoad(tile_map, vec2<i32>(min(texel, tile.size - vec2<f32>(0.5))), 0).x;
+                    let uv = tile.uv_min + texel / scale;
+                    let compared = tap_receiver_depth(frame, position, normal, uv, depth, settings.receiver_plane != 0u);
+                    let area = select(width, step.x, settings.point_samples != 0u) * height;
+                    // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2).
+                    visible += select(0.0, area, compared <= z + bias);
+                    covered += area;
+                }
+                row += step.y;
+            }
+        }
+        column += step.x;
+    }
+    // In shadow-map coordinates, not texels: tiles of different resolutions merge by true area.
+    let texel_area = 1.0 / (scale.x * scale.y);
+    return vec2<f32>(visible, covered) * texel_area;
+}
+
+@compute @workgroup_size(8, 8)
+fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.viewport.xy);
+    if (any(id.xy >= size)) {
+        return;
+    }
+    let index = id.y * size.x + id.x;
+    let kernel = kernels[index];
+    if (kernel.flags != KERNEL_ACTIVE) {
+        return;
+    }
+    let point = screen_point_at(vec2<i32>(id.xy));
+    let lookup = offset_point(point.position, point.normal, kernel.offset);
+    let k = max(settings.supersampling, 1u);
+    if (k == 1u) {
+        accumulated[index] += integrate(kernel.centre, kernel.u_axis, kernel.v_height, kernel.depth, lookup, point.normal, kernel.texel);
+        return;
+    }
+    // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
+    // each filtered on its own; their sums add up, as their filters have the same area.
+    var sum = vec2<f32>(0.0);
+    for (var j = 0u; j < k; j++) {
+        for (var i = 0u; i < k; i++) {
+            let pixel = vec2<f32>(id.xy) + (vec2<f32>(f32(i), f32(j)) + 0.5) / f32(k);
+            let hit = tangent_point(point.position, point.normal, pixel);
+            if (hit.w == 0.0 || !in_front_of_light(frame, hit.xyz)) {
+                continue;
+            }
+            let sub_lookup = offset_point(hit.xyz, point.normal, kernel.offset);
+            let uvd = light_uv_depth(frame, sub_lookup);
+            sum += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, sub_lookup, point.normal, kernel.texel);
+        }
+    }
+    accumulated[index] += sum;
+}
+
+// The final visibility (Sec. 5.2's merge: V = Σ V·A / Σ A) into the framework's target.
+@group(3) @binding(2) var visibility: texture_storage_2d<r32float, read_write>;
+
+@compute @workgroup_size(8, 8)
+fn pvsm_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.viewport.xy);
+    if (any(id.xy >= size)) {
+        return;
+    }
+    let index = id.y * size.x + id.x;
+    let kernel = kernels[index];
+    var value = 1.0;
+    if (kernel.flags == KERNEL_DARK) {
+        value = 0.0;
+    } else if (kernel.flags == KERNEL_ACTIVE) {
+        let sums = accumulated[index];
+        // No tile under the filter at all cannot happen with a complete tiling; lit is the safe reading.
+        value = select(1.0, clamp(sums.x / sums.y, 0.0, 1.0), sums.y > 0.0);
+    }
+    textureStore(visibility, vec2<i32>(id.xy), vec4<f32>(value));
+}

@@ -1,0 +1,208 @@
+// PVSM steps 3 and 4 (Sec. 4, 4.2, 5.1, 5.2), one invocation per pixel:
+// - the average occluder depth from the low-resolution conservative map, in the region where the
+//   light seen from the pixel crosses the near plane (no occluder: fully lit, skipped from then on);
+// - the soft-shadowing filter s_α, the light's back-projection through the occluders' average
+//   plane (α = (z_y - z_o) z_n / (z_y z_o) in the paper's notation), as half-axes in shadow-map
+//   coordinates;
+// - the pixel's footprint φ warped onto the map through the receiver's tangent plane, and the
+//   anti-aliased filter h = M(φ) ⊗ s_α (the appendix's Gaussian convolution);
+// - the screen sizes n0, n1 of h along the map's axes (Eq. 4), the predicted texel sizes (Eq. 5),
+//   and the resolution they ask of every tile-grid cell the filter reads (the grid keeps the
+//   finest: the maximum of texels per unit, by atomicMax on the float's bits).
+
+// #import pvsm/pvsm_common.wgsl
+
+@group(2) @binding(2) var low_res_map: texture_2d<f32>;
+@group(2) @binding(3) var<storage, read_write> kernels: array<Kernel>;
+// Per grid cell, the finest resolution needed along u then v, as f32 bits (0: none).
+@group(2) @binding(4) var<storage, read_write> grid: array<atomic<u32>>;
+// [pixels with a filter, fully lit pixels]
+@group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, 2>;
+
+// The depth shadow-map taps at `uv` are compared with, for the pixel's point (settings' receiver model).
+fn compared_depth(point: ScreenPoint, uv: vec2<f32>, d: f32) -> f32 {
+    return tap_receiver_depth(frame, point.position, point.normal, uv, d, settings.receiver_plane != 0u);
+}
+
+// How much the pixel's tangent plane's depth changes over `half_texel` (shadow-map coordinates)
+// along both axes: the receiver's own depth spread within a texel of that size.
+fn plane_change(point: ScreenPoint, uv: vec2<f32>, d: f32, half_texel: vec2<f32>) -> f32 {
+    let here = tap_receiver_depth(frame, point.position, point.normal, uv, d, true);
+    let along_u = tap_receiver_depth(frame, point.position, point.normal, uv + vec2<f32>(half_texel.x, 0.0), d, true) - here;
+    let along_v = tap_receiver_depth(frame, point.position, point.normal, uv + vec2<f32>(0.0, half_texel.y), d, true) - here;
+    return abs(along_u) + abs(along_v);
+}
+
+// kdtree::MIN_TILE_SIZE: the fewest texels a tile's map has (checked by a test of the crate).
+const MIN_TILE_SIZE: f32 = 8.0;
+
+// Texels per side of the blocker search's region at the mip level its detection reads (every
+// pixel pays for it, lit or not: a coarser level only makes the test more conservative).
+const DETECTION_TEXELS: f32 = 4.0;
+
+// Shadow-map coordinates where the camera ray through `pixel` meets the pixel's tangent plane;
+// w = 0 where it does not.
+fn plane_uv(point: ScreenPoint, pixel: vec2<f32>) -> vec3<f32> {
+    let hit = tangent_point(point.position, point.normal, pixel);
+    if (hit.w == 0.0 || !in_front_of_light(frame, hit.xyz)) {
+        return vec3<f32>(0.0);
+    }
+    return vec3<f32>(light_uv_depth(frame, hit.xyz).xy, 1.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.viewport.xy);
+    if (any(id.xy >= size)) {
+        return;
+    }
+    let index = id.y * size.x + id.x;
+    var kernel: Kernel;
+    kernel.flags = 0u;
+    let point = screen_point_at(vec2<i32>(id.xy));
+    let trivial = trivial_visibility(point);
+    if (trivial >= 0.0) {
+        kernel.flags = select(0u, KERNEL_DARK, trivial == 0.0);
+        kernels[index] = kernel;
+        return;
+    }
+    let uvd = light_uv_depth(frame, point.position);
+    let d = uvd.z;
+
+    // Blocker search on the conservative map (Sec. 4, 5.2), in two parts.
+    // 1. Detection: every texel of the region where the light seen from the pixel crosses the near
+    //    plane, at the finest level of the map's minimum-depth mip chain where the region spans at
+    //    most DETECTION_TEXELS texels a side. A level's texel holds the nearest depth under it, so no
+    //    occluder of the conservative map is missed: a pixel with none is fully lit.
+    // 2. The average occluder depth: blocker_kernel² samples of the full-resolution level (the
+    //    minimum of a coarse texel would pull the average towards the light); the coarse blockers
+    //    stand in when the samples fall between occluders too thin to be hit.
+    let search = light_half_extent_uv(frame, frame.projection.z, d);
+    let base_size = vec2<f32>(textureDimensions(low_res_map, 0));
+    let levels = textureNumLevels(low_res_map);
+    let n = max(settings.blocker_kernel, 1u);
+    let span = max(2.0 * search * base_size, vec2<f32>(1.0));
+    let level = min(u32(max(ceil(log2(max(span.x, span.y) / DETECTION_TEXELS)), 0.0)), levels - 1u);
+    // The level's size from the base's: textureDimensions with a level argument reads the base
+    // level's size on lavapipe (Mesa 22.3), and loads past a level's edge return 0.
+    let level_size = vec2<f32>(max(textureDimensions(low_res_map, 0) >> vec2<u32>(level), vec2<u32>(1u)));
+    let texel = shadow_texel_size(frame, low_res_map, d);
+    // A texel's nearest depth of the receiver itself is its tangent plane's at the texel's nearest
+    // corner (and a conservative map adds up to a texel): the plane's change across half a texel,
+    // capped at a texel's worth so that a surface seen edge-on by the light still finds the rest of
+    // its own object in front of it.
+    let bias = scene_length(frame, settings.constant_bias) + texel;
+    let coarse_tolerance = bias + min(plane_change(point, uvd.xy, d, 0.5 / level_size), f32(1u << level) * texel);
+    let fine_tolerance = bias + min(plane_change(point, uvd.xy, d, 0.5 / base_size), texel);
+    let low = vec2<i32>(floor((uvd.xy - search) * level_size));
+    let high = vec2<i32>(floor((uvd.xy + search) * level_size));
+    let limit = vec2<i32>(level_size) - 1;
+    var coarse_sum = 0.0;
+    var coarse_count = 0.0;
+    for (var y = max(low.y, 0); y <= min(high.y, limit.y); y++) {
+        for (var x = max(low.x, 0); x <= min(high.x, limit.x); x++) {
+            let depth = textureLoad(low_res_map, vec2<i32>(x, y), i32(level)).x;
+            let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / level_size;
+            if (depth < compared_depth(point, uv, d) - coarse_tolerance) {
+                coarse_sum += depth;
+                coarse_count += 1.0;
+            }
+        }
+    }
+    var sum = 0.0;
+    var count = 0.0;
+    if (coarse_count > 0.0) {
+        for (var j = 0u; j < n; j++) {
+            for (var i = 0u; i < n; i++) {
+                let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
+                let depth = shadow_map_depth(low_res_map, uv);
+                if (depth < compared_depth(point, uv, d) - fine_tolerance) {
+                    sum += depth;
+                    count += 1.0;
+                }
+            }
+        }
+        if (count == 0.0) {
+            sum = coarse_sum;
+            count = coarse_count;
+        }
+    }
+    if (count == 0.0 && settings.prediction != 3u) {
+        // The conservative map guarantees no occluder was missed: fully lit (Sec. 5.2).
+        kernel.flags = KERNEL_LIT;
+        kernels[index] = kernel;
+        atomicAdd(&counters[1], 1u);
+        return;
+    }
+    // With prediction = fixed the pixel is still filtered (the single map decides), with no penumbra
+    // where no blocker was seen.
+    let average = select(d, sum / max(count, 1.0), count > 0.0);
+    // s_α: the light seen from the receiver through the plane at the average occluder depth.
+    let soft_filter = light_half_extent_uv(frame, average, d);
+
+    // φ: the pixel's half axes warped onto the map through its tangent plane (Fig. 5).
+    let pixel = vec2<f32>(id.xy) + 0.5;
+    let right = plane_uv(point, pixel + vec2<f32>(0.5, 0.0));
+    let left = plane_uv(point, pixel - vec2<f32>(0.5, 0.0));
+    let down = plane_uv(point, pixel + vec2<f32>(0.0, 0.5));
+    let up = plane_uv(point, pixel - vec2<f32>(0.0, 0.5));
+    var u_phi = vec2<f32>(0.0);
+    var v_phi = vec2<f32>(0.0);
+    if (right.z * left.z * down.z * up.z > 0.0) {
+        u_phi = 0.5 * (right.xy - left.xy);
+        v_phi = 0.5 * (down.xy - up.xy);
+    }
+    // h for the prediction always includes φ: a hard shadow needs at least one texel per pixel.
+    let h = convolve(vec2<f32>(soft_filter.x, 0.0), vec2<f32>(0.0, soft_filter.y), u_phi, v_phi);
+    if (settings.antialiasing != 0u) {
+        kernel.u_axis = h.xy;
+        kernel.v_height = h.z;
+    } else {
+        kernel.u_axis = vec2<f32>(soft_filter.x, 0.0);
+        kernel.v_height = soft_filter.y;
+    }
+
+    // Eq. 4: h's extents along the map's axes, in the pixel's own parametrisation (units of half a
+    // pixel per half axis: the full size in pixels).
+    let determinant = u_phi.x * v_phi.y - v_phi.x * u_phi.y;
+    var texel_size = vec2<f32>(1.0 / settings.fixed_size);
+    if (settings.prediction != 3u) {
+        var screen = vec2<f32>(1.0);
+        if (abs(determinant) > 1e-20) {
+            let inverse = mat2x2<f32>(v_phi.y, -u_phi.y, -v_phi.x, u_phi.x) * (1.0 / determinant);
+            screen = vec2<f32>(length(inverse * vec2<f32>(h.x, 0.0)), length(inverse * vec2<f32>(0.0, h.z)));
+        }
+        // Eq. 5: the texel size each axis needs, from the texels ρ says the filter must span.
+        let needed = vec2<f32>(texels_needed(settings.prediction, screen.x), texels_needed(settings.prediction, screen.y));
+        // No tile is coarser than MIN_TILE_SIZE texels over the whole map: a larger texel (a light
+        // hidden by an occluder at its plane) would push the normal offset past the light.
+        texel_size = clamp(2.0 * vec2<f32>(h.x, h.z) / needed, vec2<f32>(1e-7), vec2<f32>(1.0 / MIN_TILE_SIZE));
+        let resolution = 1.0 / texel_size;
+        // Every grid cell the filter (and the pixel's footprint) can read asks for this resolution.
+        let reach = vec2<f32>(abs(h.x) + abs(u_phi.x) + abs(v_phi.x), abs(h.y) + h.z + abs(u_phi.y) + abs(v_phi.y));
+        let cells = f32(settings.grid_size);
+        let low = vec2<i32>(clamp(floor((uvd.xy - reach) * cells), vec2<f32>(0.0), vec2<f32>(cells - 1.0)));
+        let high = vec2<i32>(clamp(floor((uvd.xy + reach) * cells), vec2<f32>(0.0), vec2<f32>(cells - 1.0)));
+        for (var y = low.y; y <= high.y; y++) {
+            for (var x = low.x; x <= high.x; x++) {
+                let cell = u32(y) * settings.grid_size + u32(x);
+                atomicMax(&grid[2u * cell], bitcast<u32>(resolution.x));
+                atomicMax(&grid[2u * cell + 1u], bitcast<u32>(resolution.y));
+            }
+        }
+    }
+    // The normal offset, in texels of the resolution asked for.
+    let world_texel = 2.0 * d * max(frame.projection.x * texel_size.x, frame.projection.y * texel_size.y);
+    // Never more than half-way to the occluders found (or to the near plane): a texel can be larger
+    // than the gap when an occluder nearly touches the light and widens the frame.
+    let clearance = select(d - frame.projection.z, d - average, count > 0.0);
+    kernel.offset = min(settings.normal_offset * world_texel, 0.5 * max(clearance, 0.0));
+    let lookup = offset_point(point.position, point.normal, kernel.offset);
+    let lookup_uvd = light_uv_depth(frame, lookup);
+    kernel.centre = lookup_uvd.xy;
+    kernel.depth = lookup_uvd.z;
+    kernel.texel = texel_size;
+    kernel.flags = KERNEL_ACTIVE;
+    kernels[index] = kernel;
+    atomicAdd(&counters[0], 1u);
+}

@@ -1,0 +1,45 @@
+// PVSM step 5 (Sec. 5.2): the pyramid of the shadow-map tile grid, built on the GPU (the paper
+// moves it off the CPU) in one workgroup: level 0 is the grid, each next level the maximum of four
+// cells of the one below, down to a single cell. The whole pyramid is then read back for the
+// kd-tree.
+
+struct PyramidSettings {
+    // Side of level 0, a power of two.
+    grid_size: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+@group(0) @binding(0) var<uniform> pyramid_settings: PyramidSettings;
+@group(0) @binding(1) var<storage, read> grid: array<u32>;
+// Every level, level 0 first, as resolutions along u and v.
+@group(0) @binding(2) var<storage, read_write> pyramid: array<vec2<f32>>;
+
+const THREADS: u32 = 256u;
+
+@compute @workgroup_size(256)
+fn pvsm_pyramid(@builtin(local_invocation_index) thread: u32) {
+    var side = pyramid_settings.grid_size;
+    for (var cell = thread; cell < side * side; cell += THREADS) {
+        pyramid[cell] = vec2<f32>(bitcast<f32>(grid[2u * cell]), bitcast<f32>(grid[2u * cell + 1u]));
+    }
+    var below = 0u;
+    loop {
+        storageBarrier();
+        workgroupBarrier();
+        if (side <= 1u) {
+            break;
+        }
+        let above = below + side * side;
+        let half = side / 2u;
+        for (var cell = thread; cell < half * half; cell += THREADS) {
+            let x = cell % half;
+            let y = cell / half;
+            let at = below + 2u * y * side + 2u * x;
+            pyramid[above + cell] = max(max(pyramid[at], pyramid[at + 1u]), max(pyramid[at + side], pyramid[at + side + 1u]));
+        }
+        below = above;
+        side = half;
+    }
+}

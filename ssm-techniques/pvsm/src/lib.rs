@@ -1,0 +1,926 @@
+//! Shen, Guennebaud, Yang and Feng, *Predicted Virtual Soft Shadow Maps with
+//! High Quality Filtering*, Computer Graphics Forum 30(2) (Eurographics
+//! 2011).
+//!
+//! The eight steps of the paper's Sec. 5.2, each a named, timed pass:
+//! 1. the G-buffer (shared);
+//! 2. a low-resolution shadow map rendered conservatively (`pvsm_low_res_map`),
+//!    and its minimum-depth mip chain (`pvsm_low_res_mips`);
+//! 3. per pixel, the average occluder depth, the soft-shadowing filter, the
+//!    pixel's warped footprint and the anti-aliased filter h (`pvsm_kernel_shape`);
+//! 4. in the same pass, the perceptual resolution prediction and its
+//!    accumulation into the shadow-map tile grid;
+//! 5. the grid's pyramid on the GPU (`pvsm_smtg_pyramid`), read back in the
+//!    middle of the frame (`pvsm_smtg_readback`, a CPU-timed stall);
+//! 6. the kd-tree on the CPU (`pvsm_kdtree`, [`kdtree`]);
+//! 7. per tile, a shadow map of the predicted resolution (`pvsm_tile_map`);
+//! 8. per tile, the texel-as-quad filtering of the pixels whose filter
+//!    reaches it (`pvsm_tile_filter`), merged per pixel, then the ratio
+//!    (`pvsm_resolve`).
+
+pub mod kdtree;
+pub mod prediction;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{UVec2, Vec2};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, compute_pipeline, readback_buffer, storage_buffer, storage_entry, texture_entry, uniform_buffer,
+    uniform_entry, visibility_storage_entry,
+};
+use ssm_core::shader::create_shader_with_imports;
+use ssm_core::{
+    Choice, DepthBiasUniform, Error, ExtraImage, Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc, LightFrameUniform,
+    ParamValues, Preset, ReceiverModel, Requirements, Result, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, UniformCheck, UniformStruct, register_technique,
+};
+
+pub use kdtree::{Pyramid, Tile, Tiling};
+pub use prediction::Prediction;
+
+/// The registered name.
+pub const NAME: &str = "pvsm";
+
+/// WGSL files the PVSM shaders import besides `common/`.
+const LOCAL_SHADERS: &[(&str, &str)] = &[("pvsm/pvsm_common.wgsl", include_str!("../../../shaders/pvsm/pvsm_common.wgsl"))];
+/// Step 2: the conservative low-resolution map.
+const CONSERVATIVE_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_conservative.wgsl");
+/// Steps 3–4: the kernel shape and the prediction.
+const KERNEL_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_kernel.wgsl");
+/// Step 5: the grid's pyramid.
+const PYRAMID_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_pyramid.wgsl");
+/// Step 2's minimum-depth mip chain.
+const MIPS_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_mips.wgsl");
+/// Step 8 and the merge.
+const FILTER_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_filter.wgsl");
+
+/// How the low-resolution map is rasterised conservatively (step 2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum Conservative {
+    /// The hardware's conservative rasterization where the adapter has it, else [`Conservative::Software`].
+    Auto,
+    /// Hasselgren et al. 2005's second algorithm: triangles enlarged by half a texel's diagonal, clipped to their bounding box.
+    Software,
+    /// The adapter's CONSERVATIVE_RASTERIZATION (refused with a typed error where it is missing).
+    Hardware,
+    /// Plain rasterization: an occluder thinner than a texel can be missed, and its shadow lost (for comparison).
+    Off,
+}
+
+/// How the filter weighs the shadow map's texels (Sec. 4.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum Integration {
+    /// Each texel a quad of constant depth, weighted by the area of its intersection with the filter (Eq. 2).
+    Quads,
+    /// Each texel a point at its centre, weighted fully inside the filter (classic PCF).
+    Points,
+}
+
+/// Settings of [`PredictedVirtualShadowMaps`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct PvsmSettings {
+    /// Side of the low-resolution shadow map rendered conservatively (step 2), which the blocker search and the fully-lit test read, texels.
+    #[param(default = 1024, min = 64, max = 8192)]
+    pub low_res_size: u32,
+    /// Conservative rasterization of the low-resolution map: auto (the hardware's where the adapter has it), software (Hasselgren et al. 2005, Alg. 2), hardware, or off (for comparison).
+    #[param(choice, default = "auto")]
+    pub conservative: Conservative,
+    /// Samples per axis of the average occluder depth on the low-resolution map (the detection of blockers reads every texel of the region at a coarser level of its minimum-depth mip chain).
+    #[param(default = 8, min = 1, max = 32)]
+    pub blocker_kernel: u32,
+    /// Side of the shadow-map tile grid (SMTG), cells; a power of two.
+    #[param(default = 64, min = 4, max = 256)]
+    pub grid_size: u32,
+    /// Largest side of a tile's shadow map, texels (clamped to the device's limit).
+    #[param(default = 4096, min = 64, max = 16384)]
+    pub max_tile_size: u32,
+    /// Most tiles per light and frame: past it, tiles get less resolution than predicted (reported in the diagnostics).
+    #[param(default = 64, min = 1, max = 256)]
+    pub max_tiles: u32,
+    /// ρ, the perceptual model (Sec. 5.1): dynamic, static, linear (Fig. 8(b)), or fixed (no prediction: one map of fixed_size², Fig. 8(c)).
+    #[param(choice, default = "dynamic")]
+    pub prediction: Prediction,
+    /// With prediction = fixed: side of the single map covering the light frame, texels (clamped to the device's limit).
+    #[param(default = 4096, min = 64, max = 16384)]
+    pub fixed_size: u32,
+    /// Analytic anisotropic anti-aliasing (Sec. 4.2): the filter convolved with the pixel's footprint on the map.
+    #[param(default = true)]
+    pub antialiasing: bool,
+    /// How texels are weighted (Sec. 4.1): quads (each texel's exact overlap with the filter, Eq. 2) or points (classic PCF, which bands where the penumbra's width changes quickly, Fig. 4).
+    #[param(choice, default = "quads")]
+    pub integration: Integration,
+    /// k: the filter evaluated at k×k points of each pixel and averaged (Fig. 11's supersampling; set antialiasing=false).
+    #[param(default = 1, min = 1, max = 32)]
+    pub supersampling: u32,
+    /// What the texels are compared with (as pcss's).
+    #[param(flatten)]
+    pub receiver: ReceiverModel,
+    /// Depth bias and normal offset (in texels of the resolution each pixel asks for).
+    #[param(flatten)]
+    pub bias: ShadowMapBias,
+}
+
+/// `PvsmSettings` of `shaders/pvsm/pvsm_common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct PvsmSettingsUniform {
+    grid_size: u32,
+    blocker_kernel: u32,
+    prediction: u32,
+    antialiasing: u32,
+    supersampling: u32,
+    receiver_plane: u32,
+    normal_offset: f32,
+    constant_bias: f32,
+    fixed_size: f32,
+    point_samples: u32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+impl From<&PvsmSettings> for PvsmSettingsUniform {
+    fn from(settings: &PvsmSettings) -> Self {
+        Self {
+            grid_size: settings.grid_size,
+            blocker_kernel: settings.blocker_kernel,
+            prediction: settings.prediction.code(),
+            antialiasing: u32::from(settings.antialiasing),
+            supersampling: settings.supersampling,
+            receiver_plane: u32::from(settings.receiver.receiver_plane),
+            normal_offset: settings.bias.normal_offset,
+            constant_bias: settings.bias.constant_bias,
+            fixed_size: settings.fixed_size as f32,
+            point_samples: u32::from(settings.integration == Integration::Points),
+            _pad1: 0.0,
+            _pad2: 0.0,
+        }
+    }
+}
+
+/// `RasterSettings` of `shaders/pvsm/pvsm_conservative.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct RasterSettingsUniform {
+    half_texel: [f32; 2],
+    size: [f32; 2],
+    enlarge: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+/// `PyramidSettings` of `shaders/pvsm/pvsm_pyramid.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct PyramidSettingsUniform {
+    grid_size: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+/// `TileSettings` of `shaders/pvsm/pvsm_filter.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct TileSettingsUniform {
+    uv_min: [f32; 2],
+    uv_max: [f32; 2],
+    size: [f32; 2],
+    _pad0: f32,
+    _pad1: f32,
+}
+
+impl From<&Tile> for TileSettingsUniform {
+    fn from(tile: &Tile) -> Self {
+        Self {
+            uv_min: tile.uv_min.to_array(),
+            uv_max: tile.uv_max.to_array(),
+            size: tile.size.as_vec2().to_array(),
+            _pad0: 0.0,
+            _pad1: 0.0,
+        }
+    }
+}
+
+/// The conservative low-resolution map and its minimum-depth mip chain.
+struct LowResMap {
+    texture: wgpu::Texture,
+    /// Level 0, rendered into.
+    level0: wgpu::TextureView,
+    depth: wgpu::TextureView,
+    /// Per level from 1: the group reading the level above and writing this one, and its size.
+    mips: Vec<(wgpu::BindGroup, u32)>,
+    /// Every level, for the blocker search.
+    all_levels: wgpu::TextureView,
+}
+
+impl LowResMap {
+    fn new(device: &wgpu::Device, side: u32, mip_layout: &wgpu::BindGroupLayout) -> Self {
+        let levels = side.max(1).ilog2() + 1;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("pvsm_low_res_map"),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            mip_level_count: levels,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: LightDepthMap::FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let level_view = |level: u32| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(&format!("pvsm_low_res_map_level{level}_view")),
+                base_mip_level: level,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let mips = (1..levels)
+            .map(|level| {
+                let group = bind_group(
+                    device,
+                    &format!("pvsm_low_res_mip{level}_bind_group"),
+                    mip_layout,
+                    &[wgpu::BindingResource::TextureView(&level_view(level - 1)), wgpu::BindingResource::TextureView(&level_view(level))],
+                );
+                (group, (side >> level).max(1))
+            })
+            .collect();
+        let depth = ssm_core::passes::render_texture(
+            device,
+            "pvsm_low_res_depth",
+            side,
+            side,
+            LightDepthMap::DEPTH_FORMAT,
+            wgpu::TextureUsages::empty(),
+        );
+        Self {
+            texture: texture.clone(),
+            level0: level_view(0),
+            depth: ssm_core::passes::labelled_view(&depth, "pvsm_low_res_depth"),
+            mips,
+            all_levels: ssm_core::passes::labelled_view(&texture, "pvsm_low_res_map_all_levels"),
+        }
+    }
+}
+
+/// Bytes of one `Kernel` of `pvsm_common.wgsl`.
+const KERNEL_BYTES: u64 = 48;
+
+/// The uniforms of one tile of one light, written when the kd-tree has decided it.
+struct TileSlot {
+    frame: wgpu::Buffer,
+    frame_group: wgpu::BindGroup,
+    bias: wgpu::Buffer,
+    bias_group: wgpu::BindGroup,
+    settings: wgpu::Buffer,
+    /// One per tile map size (`tile_maps`): the tile's settings and that map.
+    filter_groups: Vec<wgpu::BindGroup>,
+}
+
+/// The pipelines, made once.
+struct Pipelines {
+    low_res: wgpu::RenderPipeline,
+    mip: wgpu::ComputePipeline,
+    kernel: wgpu::ComputePipeline,
+    pyramid: wgpu::ComputePipeline,
+    filter: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+/// The buffers of the screen-space and grid passes.
+struct Buffers {
+    kernels: wgpu::Buffer,
+    accumulated: wgpu::Buffer,
+    grid: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    pyramid: wgpu::Buffer,
+    pyramid_readback: wgpu::Buffer,
+    pyramid_cells: u64,
+}
+
+/// What the last frame measured, for `diagnostics`.
+#[derive(Clone, Debug, Default)]
+struct LastFrame {
+    tilings: Vec<Tiling>,
+}
+
+/// Predicted virtual soft shadow maps.
+pub struct PredictedVirtualShadowMaps {
+    settings: PvsmSettings,
+    pipelines: Pipelines,
+    buffers: Buffers,
+    low_res: LowResMap,
+    low_res_group: wgpu::BindGroup,
+    gbuffer_group: wgpu::BindGroup,
+    kernel_group: wgpu::BindGroup,
+    pyramid_group: wgpu::BindGroup,
+    /// Per light: its tile slots, then its resolve group (binding its visibility target).
+    slots: Vec<Vec<TileSlot>>,
+    resolve_groups: Vec<wgpu::BindGroup>,
+    common_group: wgpu::BindGroup,
+    /// Tile maps of sides 64, 128, 256... up to the largest tile: a tile is rendered into the
+    /// smallest that holds it, so that clearing a map costs what the tile needs.
+    tile_maps: Vec<LightDepthMap>,
+    atlas_side: u32,
+    triangle_count: u32,
+    width: u32,
+    height: u32,
+    last: LastFrame,
+}
+
+impl PredictedVirtualShadowMaps {
+    /// Builds the maps, buffers and pipelines.
+    ///
+    /// # Errors
+    /// A parameter error (a tile grid that is not a power of two), a missing device feature, or a GPU error.
+    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
+        let settings = PvsmSettings::from_params(setup.params)?;
+        if !settings.grid_size.is_power_of_two() {
+            return Err(Error::Technique {
+                technique: NAME.into(),
+                message: format!("grid_size = {} is not a power of two", settings.grid_size),
+            });
+        }
+        let gpu = setup.gpu;
+        let device = &gpu.device;
+        let gbuffer = setup.shared.gbuffer(NAME)?;
+        let limit = device.limits().max_texture_dimension_2d;
+        let atlas_side = if settings.prediction == Prediction::Fixed { settings.fixed_size } else { settings.max_tile_size }.min(limit);
+        let (width, height) = (setup.scene.width, setup.scene.height);
+        let buffers = Self::buffers(device, &settings, width, height);
+        let settings_buffer = uniform_buffer(device, "pvsm_settings_uniform", &PvsmSettingsUniform::from(&settings));
+        let hardware = match settings.conservative {
+            Conservative::Hardware => true,
+            Conservative::Software | Conservative::Off => false,
+            Conservative::Auto => gpu.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION),
+        };
+        let raster = RasterSettingsUniform {
+            half_texel: [1.0 / settings.low_res_size as f32; 2],
+            size: [settings.low_res_size as f32; 2],
+            enlarge: u32::from(!hardware && settings.conservative != Conservative::Off),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        };
+        let layouts = Layouts::new(device);
+        let low_res = LowResMap::new(device, settings.low_res_size, &layouts.mip);
+        let low_res_group = bind_group(
+            device,
+            "pvsm_low_res_bind_group",
+            &layouts.low_res,
+            &[
+                setup.scene.vertex_buffer.as_entire_binding(),
+                setup.scene.index_buffer.as_entire_binding(),
+                uniform_buffer(device, "pvsm_raster_uniform", &raster).as_entire_binding(),
+            ],
+        );
+        let kernel_group = bind_group(
+            device,
+            "pvsm_kernel_bind_group",
+            &layouts.kernel,
+            &[
+                setup.scene.camera_buffer.as_entire_binding(),
+                settings_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&low_res.all_levels),
+                buffers.kernels.as_entire_binding(),
+                buffers.grid.as_entire_binding(),
+                buffers.counters.as_entire_binding(),
+            ],
+        );
+        let pyramid_settings = PyramidSettingsUniform { grid_size: settings.grid_size, _pad0: 0, _pad1: 0, _pad2: 0 };
+        let pyramid_group = bind_group(
+            device,
+            "pvsm_pyramid_bind_group",
+            &layouts.pyramid,
+            &[
+                uniform_buffer(device, "pvsm_pyramid_uniform", &pyramid_settings).as_entire_binding(),
+                buffers.grid.as_entire_binding(),
+                buffers.pyramid.as_entire_binding(),
+            ],
+        );
+        let common_group = bind_group(
+            device,
+            "pvsm_filter_common_bind_group",
+            &layouts.common,
+            &[
+                setup.scene.camera_buffer.as_entire_binding(),
+                settings_buffer.as_entire_binding(),
+                buffers.kernels.as_entire_binding(),
+                buffers.accumulated.as_entire_binding(),
+            ],
+        );
+        let tile_maps = tile_map_sides(atlas_side)
+            .into_iter()
+            .map(|side| {
+                LightDepthMap::new(
+                    gpu,
+                    setup.scene,
+                    &LightDepthMapDesc {
+                        label: &format!("pvsm_tile_map_{side}"),
+                        width: side,
+                        height: side,
+                        geometry: Geometry::All,
+                        cull_mode: None,
+                        farthest: false,
+                        // Each tile gets its own bias (its own texel size); see `TileSlot`.
+                        constant_bias: 0.0,
+                        slope_bias: 0.0,
+                    },
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let slots = (0..setup.scene.light_count())
+            .map(|light| Self::tile_slots(gpu, &layouts.tile, &tile_maps, light, settings.max_tiles))
+            .collect();
+        let resolve_groups = setup
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(light, output)| {
+                // Binding 2: the filter's tile resources hold 0 and 1 of the same group in the same module.
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&format!("pvsm_resolve_bind_group_{light}")),
+                    layout: &layouts.resolve,
+                    entries: &[wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(output) }],
+                })
+            })
+            .collect();
+        let pipelines = Pipelines::new(setup, &layouts, &gbuffer.layout, hardware)?;
+        Ok(Self {
+            settings,
+            pipelines,
+            buffers,
+            low_res,
+            low_res_group,
+            gbuffer_group: gbuffer.bind_group.clone(),
+            kernel_group,
+            pyramid_group,
+            slots,
+            resolve_groups,
+            common_group,
+            tile_maps,
+            atlas_side,
+            triangle_count: setup.scene.triangle_count,
+            width,
+            height,
+            last: LastFrame::default(),
+        })
+    }
+
+    fn buffers(device: &wgpu::Device, settings: &PvsmSettings, width: u32, height: u32) -> Buffers {
+        let pixels = u64::from(width) * u64::from(height);
+        // Every level of the pyramid: a geometric series of the grid's cells.
+        let mut pyramid_cells = 0u64;
+        let mut side = u64::from(settings.grid_size);
+        while side >= 1 {
+            pyramid_cells += side * side;
+            if side == 1 {
+                break;
+            }
+            side /= 2;
+        }
+        let cells = u64::from(settings.grid_size).pow(2);
+        Buffers {
+            kernels: storage_buffer(device, "pvsm_kernel_buffer", pixels * KERNEL_BYTES),
+            accumulated: storage_buffer(device, "pvsm_accumulated_buffer", pixels * 8),
+            grid: storage_buffer(device, "pvsm_smtg_buffer", cells * 8),
+            counters: storage_buffer(device, "pvsm_counters_buffer", 8),
+            pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * 8),
+            pyramid_readback: readback_buffer(device, "pvsm_smtg_pyramid_readback", pyramid_cells * 8),
+            pyramid_cells,
+        }
+    }
+
+    /// The uniforms and bind groups of `max_tiles` tiles of one light. Each light has its own:
+    /// the writes of a tile's uniforms land before the next submission, and a light's tiles are
+    /// recorded before the next light's readback submits them.
+    fn tile_slots(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, maps: &[LightDepthMap], light: usize, max_tiles: u32) -> Vec<TileSlot> {
+        let device = &gpu.device;
+        (0..max_tiles)
+            .map(|k| {
+                let label = format!("pvsm_tile_{light}_{k}");
+                let frame = uniform_buffer_writable(device, &format!("{label}_frame"), std::mem::size_of::<LightFrameUniform>() as u64);
+                let bias = uniform_buffer_writable(device, &format!("{label}_bias"), std::mem::size_of::<DepthBiasUniform>() as u64);
+                let settings =
+                    uniform_buffer_writable(device, &format!("{label}_settings"), std::mem::size_of::<TileSettingsUniform>() as u64);
+                TileSlot {
+                    frame_group: bind_group(
+                        device,
+                        &format!("{label}_frame_bind_group"),
+                        gpu.uniform_layout(),
+                        &[frame.as_entire_binding()],
+                    ),
+                    bias_group: bind_group(device, &format!("{label}_bias_bind_group"), gpu.uniform_layout(), &[bias.as_entire_binding()]),
+                    filter_groups: maps
+                        .iter()
+                        .map(|map| {
+                            bind_group(
+                                device,
+                                &format!("{label}_filter_bind_group_{}", map.linear_depth.width()),
+                                layout,
+                                &[settings.as_entire_binding(), wgpu::BindingResource::TextureView(&map.linear_depth_view)],
+                            )
+                        })
+                        .collect(),
+                    frame,
+                    bias,
+                    settings,
+                }
+            })
+            .collect()
+    }
+
+    fn dispatch(&self, frame: &mut Frame<'_>, label: &str, pipeline: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], light: usize) {
+        let light_group = &frame.scene.light_bind_groups[light];
+        let mut pass = frame.compute_pass(label);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, light_group, &[]);
+        pass.set_bind_group(1, &self.gbuffer_group, &[]);
+        for (index, group) in groups.iter().enumerate() {
+            pass.set_bind_group(2 + index as u32, *group, &[]);
+        }
+        pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+    }
+
+    /// Steps 5 and 6: the pyramid, its readback, the kd-tree.
+    fn tiling(&self, frame: &mut Frame<'_>) -> Result<Tiling> {
+        if self.settings.prediction == Prediction::Fixed {
+            let side = self.atlas_side;
+            return Ok(Tiling {
+                tiles: vec![Tile {
+                    uv_min: Vec2::ZERO,
+                    uv_max: Vec2::ONE,
+                    size: UVec2::splat(side),
+                    clamped: side < self.settings.fixed_size,
+                }],
+                cap_reached: false,
+            });
+        }
+        {
+            let mut pass = frame.compute_pass("pvsm_smtg_pyramid");
+            pass.set_pipeline(&self.pipelines.pyramid);
+            pass.set_bind_group(0, &self.pyramid_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        frame.copy_buffer_to_buffer(
+            "pvsm_smtg_copy",
+            &self.buffers.pyramid,
+            0,
+            &self.buffers.pyramid_readback,
+            0,
+            self.buffers.pyramid_cells * 8,
+        );
+        let bytes = frame.read_back("pvsm_smtg_readback", &self.buffers.pyramid_readback)?;
+        let values: Vec<Vec2> = bytemuck::pod_collect_to_vec::<u8, [f32; 2]>(&bytes).into_iter().map(Vec2::from_array).collect();
+        let pyramid = Pyramid::from_levels(self.settings.grid_size, &values)
+            .map_err(|message| Error::Technique { technique: NAME.into(), message })?;
+        let (max_tile, max_tiles) = (self.atlas_side, self.settings.max_tiles as usize);
+        Ok(frame.cpu_scope("pvsm_kdtree", || kdtree::tile(&pyramid, max_tile, max_tiles)))
+    }
+}
+
+/// The sides of the tile maps: 64, 128, ... below `largest`, then `largest`.
+fn tile_map_sides(largest: u32) -> Vec<u32> {
+    let mut sides: Vec<u32> = (6..15).map(|k| 1u32 << k).take_while(|side| *side < largest).collect();
+    sides.push(largest);
+    sides
+}
+
+/// A uniform buffer of `size` bytes written each frame.
+fn uniform_buffer_writable(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// The bind group layouts of the passes' own resources.
+struct Layouts {
+    low_res: wgpu::BindGroupLayout,
+    mip: wgpu::BindGroupLayout,
+    kernel: wgpu::BindGroupLayout,
+    pyramid: wgpu::BindGroupLayout,
+    common: wgpu::BindGroupLayout,
+    tile: wgpu::BindGroupLayout,
+    resolve: wgpu::BindGroupLayout,
+}
+
+impl Layouts {
+    fn new(device: &wgpu::Device) -> Self {
+        Self {
+            low_res: bind_group_layout(device, "pvsm_low_res_layout", &[storage_entry(0, true), storage_entry(1, true), uniform_entry(2)]),
+            mip: bind_group_layout(
+                device,
+                "pvsm_low_res_mip_layout",
+                &[
+                    texture_entry(0),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::StorageTexture {
+                            access: wgpu::StorageTextureAccess::WriteOnly,
+                            format: LightDepthMap::FORMAT,
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                        },
+                        count: None,
+                    },
+                ],
+            ),
+            kernel: bind_group_layout(
+                device,
+                "pvsm_kernel_layout",
+                &[
+                    uniform_entry(0),
+                    uniform_entry(1),
+                    texture_entry(2),
+                    storage_entry(3, false),
+                    storage_entry(4, false),
+                    storage_entry(5, false),
+                ],
+            ),
+            pyramid: bind_group_layout(device, "pvsm_pyramid_layout", &[uniform_entry(0), storage_entry(1, true), storage_entry(2, false)]),
+            common: bind_group_layout(
+                device,
+                "pvsm_filter_common_layout",
+                &[uniform_entry(0), uniform_entry(1), storage_entry(2, true), storage_entry(3, false)],
+            ),
+            tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1)]),
+            resolve: bind_group_layout(
+                device,
+                "pvsm_resolve_layout",
+                &[wgpu::BindGroupLayoutEntry { binding: 2, ..visibility_storage_entry(2) }],
+            ),
+        }
+    }
+}
+
+impl Pipelines {
+    fn new(setup: &TechniqueSetup<'_>, layouts: &Layouts, gbuffer_layout: &wgpu::BindGroupLayout, hardware: bool) -> Result<Self> {
+        let gpu = setup.gpu;
+        let device = &gpu.device;
+        let module = |label: &str, source: &str| create_shader_with_imports(gpu, label, source, LOCAL_SHADERS);
+        let conservative = module("pvsm_conservative_shader", CONSERVATIVE_SHADER)?;
+        let low_res_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pvsm_low_res_pipeline_layout"),
+            bind_group_layouts: &[Some(gpu.uniform_layout()), Some(&layouts.low_res)],
+            immediate_size: 0,
+        });
+        let low_res = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("pvsm_low_res_pipeline"),
+            layout: Some(&low_res_layout),
+            vertex: wgpu::VertexState {
+                module: &conservative,
+                entry_point: Some("pvsm_conservative_vertex"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { conservative: hardware, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: LightDepthMap::DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                // The light frame's depth is reversed: nearest wins with Greater.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &conservative,
+                entry_point: Some("pvsm_conservative_fragment"),
+                compilation_options: Default::default(),
+                targets: &[Some(LightDepthMap::FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let screen = [gpu.uniform_layout(), gbuffer_layout];
+        let kernel_module = module("pvsm_kernel_shader", KERNEL_SHADER)?;
+        let pyramid_module = module("pvsm_pyramid_shader", PYRAMID_SHADER)?;
+        let filter_module = module("pvsm_filter_shader", FILTER_SHADER)?;
+        let mip_module = module("pvsm_mips_shader", MIPS_SHADER)?;
+        Ok(Self {
+            low_res,
+            mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip]),
+            kernel: compute_pipeline(
+                device,
+                "pvsm_kernel_pipeline",
+                &kernel_module,
+                "pvsm_kernel",
+                &[screen[0], screen[1], &layouts.kernel],
+            ),
+            pyramid: compute_pipeline(device, "pvsm_pyramid_pipeline", &pyramid_module, "pvsm_pyramid", &[&layouts.pyramid]),
+            filter: compute_pipeline(
+                device,
+                "pvsm_tile_filter_pipeline",
+                &filter_module,
+                "pvsm_tile_filter",
+                &[screen[0], screen[1], &layouts.common, &layouts.tile],
+            ),
+            resolve: compute_pipeline(
+                device,
+                "pvsm_resolve_pipeline",
+                &filter_module,
+                "pvsm_resolve",
+                &[screen[0], screen[1], &layouts.common, &layouts.resolve],
+            ),
+        })
+    }
+}
+
+impl ShadowTechnique for PredictedVirtualShadowMaps {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, _output: &wgpu::TextureView) -> Result<()> {
+        let no_light = || Error::Technique { technique: NAME.into(), message: format!("no light {light}") };
+        let resolve_group = self.resolve_groups.get(light).ok_or_else(no_light)?.clone();
+        frame.clear_buffer("pvsm_clear_grid", &self.buffers.grid, 0, None);
+        frame.clear_buffer("pvsm_clear_counters", &self.buffers.counters, 0, None);
+        frame.clear_buffer("pvsm_clear_accumulated", &self.buffers.accumulated, 0, None);
+        // Step 2: the conservative low-resolution map.
+        {
+            let light_group = &frame.scene.light_bind_groups[light];
+            let mut pass = frame.render_pass(
+                "pvsm_low_res_map",
+                &[ssm_core::passes::color_attachment(
+                    &self.low_res.level0,
+                    Some(wgpu::Color { r: f64::from(ssm_core::NO_SURFACE), g: 0.0, b: 0.0, a: 0.0 }),
+                )],
+                Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.low_res.depth,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
+                    stencil_ops: None,
+                }),
+            );
+            pass.set_pipeline(&self.pipelines.low_res);
+            pass.set_bind_group(0, light_group, &[]);
+            pass.set_bind_group(1, &self.low_res_group, &[]);
+            pass.draw(0..self.triangle_count * 3, 0..1);
+        }
+        for (group, side) in &self.low_res.mips {
+            let mut pass = frame.compute_pass("pvsm_low_res_mips");
+            pass.set_pipeline(&self.pipelines.mip);
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
+        }
+        // Steps 3 and 4.
+        self.dispatch(frame, "pvsm_kernel_shape", &self.pipelines.kernel, &[&self.kernel_group], light);
+        // Steps 5 and 6.
+        let tiling = self.tiling(frame)?;
+        // Steps 7 and 8, tile by tile.
+        let light_frame = frame.scene.light_frames.get(light).ok_or_else(no_light)?;
+        let slots = self.slots.get(light).ok_or_else(no_light)?;
+        let constant_bias = self.settings.bias.constant_bias * light_frame.scene_diagonal;
+        for (tile, slot) in tiling.tiles.iter().zip(slots) {
+            let queue = &frame.gpu.queue;
+            queue.write_buffer(&slot.frame, 0, bytemuck::bytes_of(&light_frame.tile_uniform(tile.uv_min, tile.uv_max)));
+            let bias = DepthBiasUniform::new(constant_bias, self.settings.bias.slope_bias, tile.size.x, tile.size.y);
+            queue.write_buffer(&slot.bias, 0, bytemuck::bytes_of(&bias));
+            queue.write_buffer(&slot.settings, 0, bytemuck::bytes_of(&TileSettingsUniform::from(tile)));
+            let class = self
+                .tile_maps
+                .iter()
+                .position(|map| map.linear_depth.width() >= tile.size.max_element())
+                .unwrap_or(self.tile_maps.len() - 1);
+            let (Some(map), Some(filter_group)) = (self.tile_maps.get(class), slot.filter_groups.get(class)) else {
+                return Err(Error::Technique { technique: NAME.into(), message: "no tile map".into() });
+            };
+            map.encode_region(frame, &slot.frame_group, &slot.bias_group, Some((tile.size.x, tile.size.y)), "pvsm_tile_map");
+            self.dispatch(frame, "pvsm_tile_filter", &self.pipelines.filter, &[&self.common_group, filter_group], light);
+        }
+        self.dispatch(frame, "pvsm_resolve", &self.pipelines.resolve, &[&self.common_group, &resolve_group], light);
+        if self.last.tilings.len() <= light {
+            self.last.tilings.resize(light + 1, Tiling::default());
+        }
+        self.last.tilings[light] = tiling;
+        Ok(())
+    }
+
+    /// Tiles, their resolutions and texels, the share of pixels skipped as fully lit, the cap.
+    fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
+        let tiles: Vec<&Tile> = self.last.tilings.iter().flat_map(|t| &t.tiles).collect();
+        let texels: f64 = tiles.iter().map(|t| f64::from(t.size.x) * f64::from(t.size.y)).sum();
+        let mut out = vec![
+            ("pvsm_tiles".to_owned(), tiles.len() as f64),
+            ("pvsm_texels".to_owned(), texels),
+            ("pvsm_largest_tile".to_owned(), tiles.iter().map(|t| f64::from(t.size.max_element())).fold(0.0, f64::max)),
+            ("pvsm_tile_cap_reached".to_owned(), f64::from(u8::from(self.last.tilings.iter().any(|t| t.cap_reached)))),
+            ("pvsm_clamped_tiles".to_owned(), tiles.iter().filter(|t| t.clamped).count() as f64),
+        ];
+        for (index, tile) in tiles.iter().enumerate().take(16) {
+            out.push((format!("pvsm_tile{index}_size"), f64::from(tile.size.x.max(tile.size.y))));
+        }
+        if let Ok(bytes) = ssm_core::readback::read_buffer(gpu, &self.buffers.counters, 8, "PVSM counters") {
+            let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+            if let [filtered, lit] = counts[..] {
+                let total = f64::from(filtered) + f64::from(lit);
+                if total > 0.0 {
+                    out.push(("pvsm_lit_skipped".to_owned(), f64::from(lit) / total));
+                }
+            }
+        }
+        out
+    }
+
+    /// `tiles`: each pixel shaded by the tile its filter's centre falls in (Fig. 10's inset), of the
+    /// last light; `low_res_coverage`: the texels of the conservative low-resolution map that hold a
+    /// surface (1) or none (0).
+    fn extra_images(&mut self, gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
+        let bytes = ssm_core::readback::read_buffer(gpu, &self.buffers.kernels, self.buffers.kernels.size(), "PVSM kernels")?;
+        let words: Vec<[u32; 12]> = bytemuck::pod_collect_to_vec(&bytes);
+        let tiles = self.last.tilings.last().map(|t| t.tiles.clone()).unwrap_or_default();
+        let values = words
+            .iter()
+            .map(|kernel| {
+                let centre = Vec2::new(f32::from_bits(kernel[0]), f32::from_bits(kernel[1]));
+                if kernel[6] & 1 == 0 {
+                    return 0.0;
+                }
+                tiles
+                    .iter()
+                    .position(|t| centre.cmpge(t.uv_min).all() && centre.cmplt(t.uv_max).all())
+                    .map_or(0.0, |index| (index + 1) as f32 / tiles.len() as f32)
+            })
+            .collect();
+        let side = self.settings.low_res_size;
+        let depth: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&ssm_core::readback::read_texture(gpu, &self.low_res.texture, 4, "PVSM low-res map")?);
+        let coverage = depth.iter().map(|d| f32::from(u8::from(*d < ssm_core::NO_SURFACE))).collect();
+        Ok(vec![
+            ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values },
+            ExtraImage { name: "low_res_coverage".into(), width: side, height: side, values: coverage },
+        ])
+    }
+}
+
+fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(PredictedVirtualShadowMaps::new(setup)?))
+}
+
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    let settings = PvsmSettings::from_params(params)?;
+    let features =
+        if settings.conservative == Conservative::Hardware { wgpu::Features::CONSERVATIVE_RASTERIZATION } else { wgpu::Features::empty() };
+    // Tile maps are clamped to the device's limit; only the low-resolution map must fit.
+    Ok(Requirements { gbuffer: true, features, max_texture_size: settings.low_res_size, ..Requirements::NONE })
+}
+
+/// Shen et al.'s evaluations, as sweeps.
+const PRESETS: &[Preset] = &[
+    Preset {
+        name: "pvsm-fig10",
+        summary: "Shen et al., Fig. 10: tiles, texels and frame time as the light grows from nearly a point (softer shadows need fewer tiles and render faster); plot with --error time, or read pvsm_tiles and pvsm_texels in sweep.csv",
+        scenes: &["leaves"],
+        varies: &["scene.light_scale=0.02,0.1,0.25,0.5,1,2", "pvsm.prediction=dynamic"],
+        x_axis: "scene.light_scale",
+        y_axis: "time",
+        ..Preset::DEFAULT
+    },
+    Preset {
+        name: "pvsm-fig11",
+        summary: "Shen et al., Fig. 11: analytic anti-aliasing against 8×8 and 32×32 screen-space supersampling (a 1024² map: prediction=fixed, fixed_size=1024); compare the error of each against the 32×32 image",
+        scenes: &["bar-grid"],
+        varies: &["pvsm.antialiasing:supersampling=true:1,false:1,false:8,false:32", "pvsm.prediction:fixed_size=fixed:1024"],
+        ..Preset::DEFAULT
+    },
+    Preset {
+        name: "pvsm-prediction",
+        summary: "Shen et al., Fig. 8: the perceptual models (dynamic, static, linear) against a single fixed 4096² map",
+        scenes: &["leaves"],
+        varies: &["pvsm.prediction=dynamic,static,linear,fixed"],
+        ..Preset::DEFAULT
+    },
+];
+
+/// The registration.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: NAME,
+    summary: "predicted virtual soft shadow maps: perceptual resolution prediction, kd-tree tiles, texel-as-quad filtering, analytic anisotropic anti-aliasing",
+    paper: "Shen, Guennebaud, Yang and Feng 2011, Predicted Virtual Soft Shadow Maps with High Quality Filtering (CGF 30(2), Eurographics)",
+    kind: TechniqueKind::Realtime,
+    params: PvsmSettings::PARAMS,
+    requirements,
+    create,
+    presets: PRESETS,
+    trade: Some("max_tile_size=512,1024,2048,4096"),
+    uniforms: &[
+        UniformCheck { wgsl_struct: "PvsmSettings", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: PvsmSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "RasterSettings", wgsl_source: CONSERVATIVE_SHADER, imports: &[], rust: RasterSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "PyramidSettings", wgsl_source: PYRAMID_SHADER, imports: &[], rust: PyramidSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_SHADER, imports: LOCAL_SHADERS, rust: TileSettingsUniform::LAYOUT },
+    ],
+};
+
+register_technique!(INFO);
+
+#[cfg(test)]
+mod tests {
+    /// The kernel shader bounds predicted texels by the coarsest tile the kd-tree makes.
+    #[test]
+    fn the_shaders_smallest_tile_is_the_kd_trees() {
+        let line = format!("const MIN_TILE_SIZE: f32 = {}.0;", super::kdtree::MIN_TILE_SIZE);
+        assert!(super::KERNEL_SHADER.contains(&line), "pvsm_kernel.wgsl lacks `{line}`");
+    }
+}

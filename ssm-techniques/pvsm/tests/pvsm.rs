@@ -1,0 +1,249 @@
+//! `pvsm` (Shen et al. 2011) against the exact answer and its own paper's claims.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use glam::{Vec2, Vec3};
+use ssm_core::metrics::compare;
+use ssm_core::{LightFrame, Renderer, Requirements};
+use ssm_scene::{Scene, builtin};
+use ssm_testing::{Rendered, gpu, mean_abs_difference, render, scene_from_manifest};
+
+const SIZE: (u32, u32) = (160, 120);
+
+/// Renders `pvsm` with `settings`, then once more to read its diagnostics and extra images.
+fn run(scene: &Scene, settings: &[(&str, &str)], size: (u32, u32)) -> (Rendered, Vec<(String, f64)>, Vec<ssm_core::ExtraImage>) {
+    let gpu = gpu();
+    let info = &ssm_pvsm::INFO;
+    let params = info.params_from(settings.iter().copied()).unwrap();
+    let needs = (info.requirements)(&params).unwrap().union(Requirements { gbuffer: true, ..Requirements::NONE });
+    let mut renderer = Renderer::new(&gpu, scene, size.0, size.1, &needs).unwrap();
+    let mut technique = renderer.create_technique(info, &params).unwrap();
+    renderer.render(technique.as_mut(), info.name).unwrap();
+    let visibility = renderer.read_visibility(0, info.name).unwrap();
+    let diagnostics = technique.diagnostics(&renderer.gpu);
+    let extra = technique.extra_images(&renderer.gpu).unwrap();
+    (Rendered { renderer, visibility }, diagnostics, extra)
+}
+
+fn value(diagnostics: &[(String, f64)], key: &str) -> f64 {
+    diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v).unwrap_or_else(|| panic!("no diagnostic {key} in {diagnostics:?}"))
+}
+
+/// The goal of the issue: on parallel-square (a receiver parallel to the occluder and the light,
+/// where the paper's planar-occluder model is exact) the penumbra MAE against the exact visibility
+/// is at most 0.02. At 320×240: the prediction asks for fewer texels for fewer pixels, so small
+/// images are the harder case.
+#[test]
+fn parallel_square_is_within_two_hundredths_of_the_exact_visibility() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let (rendered, diagnostics, _) = run(&scene, &[], (320, 240));
+    let exact = rendered.parallel_square_exact();
+    let metrics = compare(&exact, &rendered.visibility, &rendered.coverage(), 320, 240);
+    println!("parallel-square: penumbra MAE {:.4}, {} tiles", metrics.mae_penumbra, value(&diagnostics, "pvsm_tiles"));
+    assert!(metrics.mae_penumbra <= 0.02, "{}", metrics.mae_penumbra);
+    assert!(value(&diagnostics, "pvsm_tiles") >= 1.0 && value(&diagnostics, "pvsm_tile_cap_reached") == 0.0);
+}
+
+/// A light of size zero: every filter is the pixel's footprint, and the result is the hard shadow
+/// at the predicted resolution: the same as `hard`'s on all but the pixels along the shadow's edge
+/// (anti-aliased there).
+#[test]
+fn a_point_light_gives_the_hard_shadow() {
+    let mut scene = builtin("floating-sphere").unwrap().build();
+    scene.lights[0].half_size = Vec2::ZERO;
+    let (pvsm, _, _) = run(&scene, &[], SIZE);
+    let hard = render(&gpu(), &scene, &ssm_hard::INFO, &[("shadow_map_size", "4096")], SIZE.0, SIZE.1).unwrap();
+    let receivers = pvsm.coverage();
+    let total = receivers.iter().filter(|c| **c).count() as f32;
+    let wrong =
+        pvsm.visibility.iter().zip(&hard.visibility).zip(&receivers).filter(|((p, h), c)| **c && (*p - *h).abs() > 0.5).count() as f32;
+    let soft = pvsm.visibility.iter().zip(&receivers).filter(|(v, c)| **c && **v > 0.02 && **v < 0.98).count() as f32;
+    println!(
+        "point light: {:.2}% of pixels on the other side of 0.5 than hard, {:.2}% between 0 and 1",
+        wrong / total * 100.0,
+        soft / total * 100.0
+    );
+    assert!(wrong / total < 0.01, "{wrong} of {total}");
+    assert!(soft / total < 0.02, "a point light has only anti-aliased edges: {soft} of {total}");
+}
+
+/// Fig. 10's claim: softer shadows need lower resolutions, so fewer texels and tiles are rendered.
+/// On the parallel square only the penumbra's width changes with the light (no self-shadowing
+/// terminator asks for its own resolution); 64² tiles make the tiling visible at this image size.
+#[test]
+fn softer_shadows_need_fewer_texels_and_tiles() {
+    let mut small = builtin("parallel-square").unwrap().build();
+    let mut large = small.clone();
+    small.lights[0].half_size *= 0.05;
+    large.lights[0].half_size *= 2.0;
+    let measure = |scene: &Scene| {
+        let diagnostics = run(scene, &[("max_tile_size", "64")], (320, 240)).1;
+        (value(&diagnostics, "pvsm_texels"), value(&diagnostics, "pvsm_tiles"))
+    };
+    let ((small_texels, small_tiles), (large_texels, large_tiles)) = (measure(&small), measure(&large));
+    println!(
+        "parallel square: {small_texels} texels in {small_tiles} tiles with a light a twentieth the size, {large_texels} in {large_tiles} with one twice the size"
+    );
+    assert!(large_texels < 0.5 * small_texels, "{large_texels} vs {small_texels}");
+    assert!(large_tiles < small_tiles, "{large_tiles} vs {small_tiles}");
+}
+
+/// A light so small that the prediction asks for more than the tile cap allows: the tiles stop at
+/// the cap, the diagnostics say so, and the image is still finite and in range (checked on readback).
+#[test]
+fn the_tile_cap_bounds_the_tiles_and_is_reported() {
+    let mut scene = builtin("sphere-cube").unwrap().build();
+    scene.lights[0].half_size *= 1e-3;
+    let (_, diagnostics, _) = run(&scene, &[("max_tiles", "3"), ("max_tile_size", "256")], SIZE);
+    assert!(value(&diagnostics, "pvsm_tiles") <= 3.0, "{diagnostics:?}");
+    assert_eq!(value(&diagnostics, "pvsm_tile_cap_reached"), 1.0, "{diagnostics:?}");
+}
+
+/// Nothing in shadow: the grid stays empty, no tile is rendered, everything reads lit.
+#[test]
+fn nothing_in_shadow_renders_no_tile() {
+    let scene = scene_from_manifest(
+        "[camera]\nposition = [0.0, 5.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n[[light]]\ncentre = [0.0, 4.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.0, 1.0]\n[[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrole = \"receiver\"\n",
+    );
+    let (rendered, diagnostics, _) = run(&scene, &[], SIZE);
+    assert_eq!(value(&diagnostics, "pvsm_tiles"), 0.0);
+    assert!(rendered.covered_visibility().iter().all(|v| *v == 1.0));
+}
+
+/// A thin bar along the light's v axis, half a texel of a 64² low-resolution map wide, centred on a
+/// texel boundary so that plain rasterization covers no texel centre, over the ground (or alone).
+/// Returns the scene and the bar's x; the bar is moved until its centre lies on the boundary
+/// u = 35/64 of the frame the scene's bounds give (which move with it when there is no ground).
+fn thin_bar(with_ground: bool) -> (Scene, f32) {
+    let ground = if with_ground { "[[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrole = \"receiver\"\n" } else { "" };
+    let build = |x: f32| {
+        scene_from_manifest(&format!(
+            "[camera]\nposition = [0.0, 5.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n[[light]]\ncentre = [0.0, 4.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.02, 0.02]\n[[object]]\nprimitive = \"box\"\nsize = [0.04, 0.04, 3.0]\ntranslate = [{x}, 1.5, 0.0]\nrole = \"occluder\"\n{ground}"
+        ))
+    };
+    let mut x = 0.3;
+    for _ in 0..8 {
+        let scene = build(x);
+        let frame = LightFrame::fit(&scene.lights[0], &scene.bounds());
+        let u = |x: f32| frame.uv_depth(Vec3::new(x, 1.52, 0.0)).x * 64.0;
+        // u is affine in x at a fixed depth.
+        x += (35.0 - u(x)) / (u(x + 0.01) - u(x)) * 0.01;
+    }
+    (build(x), x)
+}
+
+/// Step 2 (Hasselgren et al. 2005, Alg. 2): every texel the thin pole touches is covered in the
+/// conservative low-resolution map, and nothing farther than a texel from it; where the adapter
+/// has hardware conservative rasterization, both give the same coverage.
+#[test]
+fn the_conservative_map_covers_every_texel_a_thin_occluder_touches() {
+    // The bar alone: only its texels are covered.
+    let (scene, x) = thin_bar(false);
+    let size = 64u32;
+    let frame = LightFrame::fit(&scene.lights[0], &scene.bounds());
+    let coverage = |mode: &str| {
+        let (_, _, extra) = run(&scene, &[("low_res_size", "64"), ("conservative", mode)], (64, 48));
+        extra.into_iter().find(|e| e.name == "low_res_coverage").unwrap().values
+    };
+    // The bar's top face as the light sees it: a rectangle in shadow-map coordinates.
+    let corners = [Vec3::new(x - 0.02, 1.52, -1.5), Vec3::new(x + 0.02, 1.52, 1.5)].map(|c| frame.uv_depth(c));
+    let (low, high) = (corners[0].truncate().min(corners[1].truncate()), corners[0].truncate().max(corners[1].truncate()));
+    let touched = |x: u32, y: u32| {
+        let (a, b) = (Vec2::new(x as f32, y as f32) / size as f32, Vec2::new(x as f32 + 1.0, y as f32 + 1.0) / size as f32);
+        a.x < high.x && b.x > low.x && a.y < high.y && b.y > low.y
+    };
+    let near = |x: u32, y: u32| {
+        let centre = (Vec2::new(x as f32, y as f32) + 0.5) / size as f32;
+        let gap = (low - centre).max(centre - high).max(Vec2::ZERO) * size as f32;
+        gap.max_element() <= 1.5
+    };
+    let software = coverage("software");
+    let plain = coverage("off");
+    let (mut missed, mut stray, mut plain_missed) = (0, 0, 0);
+    for y in 0..size {
+        for x in 0..size {
+            let index = (y * size + x) as usize;
+            // The ground covers everything except near the map's border: look only where the pole is.
+            if touched(x, y) {
+                missed += usize::from(software[index] == 0.0);
+                plain_missed += usize::from(plain[index] == 0.0);
+            }
+            if software[index] == 1.0 && !near(x, y) {
+                stray += 1;
+            }
+        }
+    }
+    println!("thin pole: {missed} touched texels missed by the conservative map, {plain_missed} by plain rasterization; {stray} stray");
+    assert_eq!(missed, 0);
+    assert_eq!(stray, 0);
+    if gpu().features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION) {
+        assert_eq!(coverage("hardware"), software, "hardware and software conservative rasterization disagree");
+    } else {
+        println!("this adapter has no CONSERVATIVE_RASTERIZATION: only the software path was checked");
+    }
+}
+
+/// Sec. 5.2: without conservative rasterization, a pole thinner than a low-resolution texel can be
+/// missed by the blocker search, its pixels skipped as fully lit, and its shadow lost; with it, the
+/// shadow is there.
+#[test]
+fn a_thin_occluder_still_casts_its_shadow() {
+    let (scene, _) = thin_bar(true);
+    let gpu = gpu();
+    let size = (320, 240);
+    let truth = ssm_testing::reference(&gpu, &scene, 8, size);
+    let shadowed: Vec<bool> = truth.visibility.iter().map(|v| *v < 0.5).collect();
+    let count = shadowed.iter().filter(|s| **s).count();
+    assert!(count > 20, "{count} shadowed pixels in the ground truth");
+    let lit_share = |mode: &str| {
+        let (rendered, _, _) = run(&scene, &[("low_res_size", "64"), ("conservative", mode)], size);
+        rendered.visibility.iter().zip(&shadowed).filter(|(v, s)| **s && **v > 0.9).count() as f32 / count as f32
+    };
+    let (conservative, plain) = (lit_share("software"), lit_share("off"));
+    println!("thin pole's shadow read as lit: {:.1}% conservative, {:.1}% plain", conservative * 100.0, plain * 100.0);
+    assert!(conservative < 0.1, "{conservative}");
+    assert!(plain > conservative + 0.2, "plain rasterization loses the shadow: {plain} vs {conservative}");
+}
+
+/// Fig. 4: on a receiver whose penumbra widens quickly, plain point-sampled PCF bands (the result
+/// steps with the filter's size); integrating each texel as a quad does not.
+#[test]
+fn texels_as_quads_do_not_band_where_plain_pcf_does() {
+    // A tilted receiver: the occluder-receiver distance, hence the penumbra's width, grows across it.
+    let scene = scene_from_manifest(
+        "[camera]\nposition = [0.0, 6.0, 0.01]\ntarget = [0.0, 0.0, 0.0]\nfov_y_degrees = 50.0\n[[light]]\ncentre = [0.0, 5.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.5, 1.5]\n[[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 3.0, 0.0]\nrole = \"occluder\"\n[[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrotate_degrees = [0.0, 0.0, 20.0]\nrole = \"receiver\"\n",
+    );
+    let gpu = gpu();
+    let truth = ssm_testing::reference(&gpu, &scene, 16, SIZE);
+    let covered = truth.coverage();
+    let error = |integration: &str| {
+        let (rendered, _, _) = run(&scene, &[("integration", integration), ("prediction", "fixed"), ("fixed_size", "128")], SIZE);
+        compare(&truth.visibility, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae_penumbra
+    };
+    let (quads, points) = (error("quads"), error("points"));
+    println!("quickly varying penumbra, 128² map: penumbra MAE {quads:.4} with quads, {points:.4} with points");
+    assert!(quads < 0.8 * points, "{quads} vs {points}");
+}
+
+/// Fig. 11: analytic anisotropic anti-aliasing against screen-space supersampling on a large grid
+/// parallel to the floor (a 1024² map). The analytic filter's distance to 32×32 supersampling is
+/// less than half the plain filter's. (8×8 supersampling is nearer still here: each of its samples
+/// already integrates texels as quads, so it does not alias as the paper's point-sampled 8×8 does;
+/// it costs 64 filter evaluations a pixel against one.)
+#[test]
+fn analytic_anti_aliasing_comes_near_heavy_supersampling() {
+    let scene = builtin("bar-grid").unwrap().build();
+    let fixed = [("prediction", "fixed"), ("fixed_size", "1024")];
+    let with = |extra: &[(&'static str, &'static str)]| {
+        let settings: Vec<(&str, &str)> = fixed.iter().chain(extra).copied().collect();
+        run(&scene, &settings, SIZE).0
+    };
+    let reference = with(&[("antialiasing", "false"), ("supersampling", "32")]);
+    let mask = reference.coverage();
+    let analytic = mean_abs_difference(&with(&[]).visibility, &reference.visibility, &mask);
+    let plain = mean_abs_difference(&with(&[("antialiasing", "false")]).visibility, &reference.visibility, &mask);
+    let eight = mean_abs_difference(&with(&[("antialiasing", "false"), ("supersampling", "8")]).visibility, &reference.visibility, &mask);
+    println!("grid, mean |x - 32×32|: analytic {analytic:.4}, none {plain:.4}, 8×8 {eight:.4}");
+    assert!(analytic < 0.5 * plain, "{analytic} vs {plain}");
+}
