@@ -37,17 +37,17 @@ struct PvsmSettings {
 
 // One pixel's filter, from the kernel-shape pass (step 3), for the tile passes (step 8).
 struct Kernel {
-    // Shadow-map coordinates of the lookup point (the filter's centre).
+    // Shadow-map coordinates of the pixel's point (before the normal offset).
     centre: vec2<f32>,
     // The filter h as a parallelogram (Sec. 4.2): half-axis u (any direction) and half-axis v,
     // vertical (only its height), in shadow-map coordinates.
     u_axis: vec2<f32>,
     v_height: f32,
-    // Light depth of the lookup point.
+    // Light depth of the pixel's point.
     depth: f32,
     // KERNEL_* flags.
     flags: u32,
-    // The lookup point's normal offset, world units.
+    // The largest normal offset the lookup point may get, world units.
     offset: f32,
     // The texel size the prediction asked for along each axis (shadow-map coordinates): tiles finer
     // than that (a neighbour needed more) are integrated at about this resolution.

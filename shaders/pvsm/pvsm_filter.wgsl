@@ -47,7 +47,6 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
         return vec2<f32>(0.0);
     }
     let step = max(max(vec2<f32>(1.0), floor(predicted * scale)), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
-    let bias = scene_length(frame, settings.constant_bias);
     let slope = select(0.0, uy / ux, ux > 1e-6);
     var visible = 0.0;
     var covered = 0.0;
@@ -82,8 +81,9 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
                     let uv = tile.uv_min + texel / scale;
                     let compared = tap_receiver_depth(frame, position, normal, uv, depth, settings.receiver_plane != 0u);
                     let area = select(width, step.x, settings.point_samples != 0u) * height;
-                    // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2).
-                    visible += select(0.0, area, compared <= z + bias);
+                    // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2); the
+                    // tile map's depths carry the depth bias already.
+                    visible += select(0.0, area, compared <= z);
                     covered += area;
                 }
                 row += step.y;
@@ -108,10 +108,16 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let point = screen_point_at(vec2<i32>(id.xy));
-    let lookup = offset_point(point.position, point.normal, kernel.offset);
+    // The normal offset, in this tile's texels at the pixel's depth (a coarser predicted texel would
+    // move the point past nearby occluders), within the kernel's bound.
+    let tile_texel = (tile.uv_max - tile.uv_min) / tile.size;
+    let world_texel = 2.0 * kernel.depth * max(frame.projection.x * tile_texel.x, frame.projection.y * tile_texel.y);
+    let offset = min(settings.normal_offset * world_texel, kernel.offset);
     let k = max(settings.supersampling, 1u);
     if (k == 1u) {
-        accumulated[index] += integrate(kernel.centre, kernel.u_axis, kernel.v_height, kernel.depth, lookup, point.normal, kernel.texel);
+        let lookup = offset_point(point.position, point.normal, offset);
+        let uvd = light_uv_depth(frame, lookup);
+        accumulated[index] += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, lookup, point.normal, kernel.texel);
         return;
     }
     // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
@@ -124,7 +130,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
             if (hit.w == 0.0 || !in_front_of_light(frame, hit.xyz)) {
                 continue;
             }
-            let sub_lookup = offset_point(hit.xyz, point.normal, kernel.offset);
+            let sub_lookup = offset_point(hit.xyz, point.normal, offset);
             let uvd = light_uv_depth(frame, sub_lookup);
             sum += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, sub_lookup, point.normal, kernel.texel);
         }

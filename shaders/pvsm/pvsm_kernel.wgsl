@@ -191,16 +191,13 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
-    // The normal offset, in texels of the resolution asked for.
-    let world_texel = 2.0 * d * max(frame.projection.x * texel_size.x, frame.projection.y * texel_size.y);
-    // Never more than half-way to the occluders found (or to the near plane): a texel can be larger
-    // than the gap when an occluder nearly touches the light and widens the frame.
+    // The normal offset is applied per tile, in that tile's texels (pvsm_filter.wgsl); here, its
+    // bound: never more than half-way to the occluders found (or to the near plane), since a texel
+    // can be larger than the gap (an occluder nearly touching the light widens the frame).
     let clearance = select(d - frame.projection.z, d - average, count > 0.0);
-    kernel.offset = min(settings.normal_offset * world_texel, 0.5 * max(clearance, 0.0));
-    let lookup = offset_point(point.position, point.normal, kernel.offset);
-    let lookup_uvd = light_uv_depth(frame, lookup);
-    kernel.centre = lookup_uvd.xy;
-    kernel.depth = lookup_uvd.z;
+    kernel.offset = 0.5 * max(clearance, 0.0);
+    kernel.centre = uvd.xy;
+    kernel.depth = d;
     kernel.texel = texel_size;
     kernel.flags = KERNEL_ACTIVE;
     kernels[index] = kernel;

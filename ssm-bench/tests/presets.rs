@@ -23,7 +23,7 @@ fn every_preset_resolves_against_the_registry() {
         for scene in &spec.scenes {
             // Built-in names load; manifests are resolved from the repository's root.
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);
-            let spec_path = if ssm_scene::builtin(scene).is_ok() { scene.clone() } else { path.display().to_string() };
+            let spec_path = if ssm_scene::parse_builtin(scene).is_some() { scene.clone() } else { path.display().to_string() };
             ssm_scene::Scene::load(&spec_path).unwrap_or_else(|e| panic!("preset {}: scene {scene}: {e}", spec.name));
         }
     }

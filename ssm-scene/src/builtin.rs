@@ -11,22 +11,106 @@ use crate::mesh::Mesh;
 use crate::primitives::{cuboid, plane, sphere};
 use crate::scene::{Instance, Role, Scene};
 
-/// A built-in scene's name and what it exercises.
+/// A built-in scene's name, what it exercises, and its parameters.
 #[derive(Clone, Copy, Debug)]
 pub struct BuiltinScene {
-    /// Name used on the command line and in manifests.
+    /// Name used on the command line.
     pub name: &'static str,
     /// One line saying what it is and what it tests.
     pub summary: &'static str,
-    build: fn() -> Scene,
+    /// Its parameters, set as `name:param=value,param=value` (none for most scenes).
+    pub params: &'static [BuiltinParam],
+    build: fn(&BuiltinArgs) -> Scene,
+}
+
+/// One numeric parameter of a built-in scene.
+#[derive(Clone, Copy, Debug)]
+pub struct BuiltinParam {
+    /// Its name.
+    pub name: &'static str,
+    /// What it sets.
+    pub doc: &'static str,
+    /// Its value when not set.
+    pub default: f64,
+    /// Smallest accepted value.
+    pub min: f64,
+    /// Largest accepted value.
+    pub max: f64,
+}
+
+/// The values of a built-in scene's parameters for one build.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BuiltinArgs {
+    values: Vec<(&'static str, f64)>,
+}
+
+impl BuiltinArgs {
+    /// The value of `name`.
+    ///
+    /// # Panics
+    /// If the scene declares no such parameter (a bug in the scene's builder).
+    #[must_use]
+    pub fn get(&self, name: &str) -> f64 {
+        self.values.iter().find(|(n, _)| *n == name).map(|(_, v)| *v).unwrap_or_else(|| panic!("undeclared built-in parameter `{name}`"))
+    }
 }
 
 impl BuiltinScene {
-    /// Builds the scene.
+    /// Builds the scene with its default parameters.
     #[must_use]
     pub fn build(&self) -> Scene {
-        (self.build)()
+        (self.build)(&self.defaults())
     }
+
+    /// The default value of every parameter.
+    #[must_use]
+    pub fn defaults(&self) -> BuiltinArgs {
+        BuiltinArgs { values: self.params.iter().map(|p| (p.name, p.default)).collect() }
+    }
+
+    /// Builds the scene with `assignments` (`param=value`, comma-separated; empty: the defaults).
+    /// The scene's origin records the assignments, `builtin:<name>:<assignments>`.
+    ///
+    /// # Errors
+    /// [`SceneError::BuiltinParameter`] for an unknown parameter, a value that is not a finite
+    /// number, or one outside the parameter's range.
+    pub fn build_with(&self, assignments: &str) -> Result<Scene> {
+        let problem = |problem: String| SceneError::BuiltinParameter { scene: format!("{}:{assignments}", self.name), problem };
+        let mut args = self.defaults();
+        for assignment in assignments.split(',').map(str::trim).filter(|a| !a.is_empty()) {
+            let Some((name, value)) = assignment.split_once('=') else {
+                return Err(problem(format!("`{assignment}` is not `param=value`")));
+            };
+            let known = || self.params.iter().map(|p| p.name).collect::<Vec<_>>().join(", ");
+            let Some(param) = self.params.iter().find(|p| p.name == name.trim()) else {
+                let known = if self.params.is_empty() { "none".to_owned() } else { known() };
+                return Err(problem(format!("unknown parameter `{}`; its parameters: {known}", name.trim())));
+            };
+            let value: f64 = value.trim().parse().map_err(|_| problem(format!("{}: `{}` is not a number", param.name, value.trim())))?;
+            if !value.is_finite() || value < param.min || value > param.max {
+                return Err(problem(format!("{} = {value} is outside {}..={}", param.name, param.min, param.max)));
+            }
+            if let Some(slot) = args.values.iter_mut().find(|(n, _)| *n == param.name) {
+                slot.1 = value;
+            }
+        }
+        let mut scene = (self.build)(&args);
+        if !assignments.trim().is_empty() {
+            scene.origin = PathBuf::from(format!("builtin:{}:{}", self.name, assignments.trim()));
+        }
+        Ok(scene)
+    }
+}
+
+/// A built-in scene from `name` or `name:param=value,...`; `None` when the name before the colon
+/// is no built-in scene's (a file path, say).
+///
+/// # Errors
+/// As [`BuiltinScene::build_with`].
+pub fn parse_builtin(spec: &str) -> Option<Result<(&'static BuiltinScene, Scene)>> {
+    let (name, assignments) = spec.split_once(':').unwrap_or((spec, ""));
+    let entry = BUILTIN_SCENES.iter().find(|s| s.name == name)?;
+    Some(entry.build_with(assignments).map(|scene| (entry, scene)))
 }
 
 /// Every built-in scene, in a stable order.
@@ -34,28 +118,56 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     BuiltinScene {
         name: "parallel-square",
         summary: "1x1 square light at y=4, 1x1 occluder square at y=2, 8x8 receiver at y=0: the analytic case of Atty et al. (Sec. 5.2)",
-        build: parallel_square,
+        params: &[],
+        build: |_| parallel_square(),
     },
-    BuiltinScene { name: "floating-sphere", summary: "a closed sphere floating above a receiver plane", build: floating_sphere },
+    BuiltinScene {
+        name: "floating-sphere",
+        summary: "a closed sphere floating above a receiver plane",
+        params: &[],
+        build: |_| floating_sphere(),
+    },
     BuiltinScene {
         name: "contact",
         summary: "a box and a sphere resting on the plane: contact hardening, occluder touching receiver",
-        build: contact,
+        params: &[],
+        build: |_| contact(),
     },
     BuiltinScene {
         name: "sphere-cube",
         summary: "a 5x5x5 cube of small spheres above a plane: overlapping penumbrae (Forest et al., Fig. 1)",
+        params: &[
+            BuiltinParam { name: "spheres", doc: "spheres along each side of the cube", default: 5.0, min: 1.0, max: 40.0 },
+            BuiltinParam { name: "segments", doc: "segments around each sphere (half as many rings)", default: 16.0, min: 4.0, max: 256.0 },
+        ],
         build: sphere_cube,
     },
     BuiltinScene {
         name: "leaves",
         summary: "300 thin quads at varied heights over the ground: occluder fusion and depth discontinuities (Buades et al.'s plant)",
-        build: leaves,
+        params: &[],
+        build: |_| leaves(),
     },
     BuiltinScene {
         name: "bar-grid",
         summary: "70 thin bars 0.1 apart, parallel to a large floor under a small light, the camera low and looking along it: high-frequency hard shadows that alias in the distance (Shen et al., Fig. 11)",
-        build: bar_grid,
+        params: &[],
+        build: |_| bar_grid(),
+    },
+    BuiltinScene {
+        name: "forest",
+        summary: "instanced trees (a trunk and a crown of leaf cards) on a grid over the ground, the triangle count a parameter: a large, complex scene (Shen et al., Table 2)",
+        params: &[
+            BuiltinParam {
+                name: "triangles",
+                doc: "triangles in all, ground included (leaf cards are added to reach it)",
+                default: 20_000.0,
+                min: 100.0,
+                max: 20_000_000.0,
+            },
+            BuiltinParam { name: "trees", doc: "trees, on a square grid 2 units apart", default: 16.0, min: 1.0, max: 4096.0 },
+        ],
+        build: forest,
     },
 ];
 
@@ -130,13 +242,19 @@ fn contact() -> Scene {
     b.scene
 }
 
-fn sphere_cube() -> Scene {
+fn sphere_cube(args: &BuiltinArgs) -> Scene {
     let mut b = SceneBuilder::new("sphere-cube", downward_light(Vec3::new(0.0, 4.5, 0.0), 1.0)).ground(8.0);
-    let ball = b.mesh(sphere("small-sphere", 0.11, 16, 8));
-    for i in 0..5 {
-        for j in 0..5 {
-            for k in 0..5 {
-                let offset = Vec3::new(i as f32 - 2.0, j as f32 - 2.0, k as f32 - 2.0) * 0.3;
+    let (count, segments) = (args.get("spheres") as u32, args.get("segments") as u32);
+    // The cube keeps its 1.2-unit side whatever the count: spheres shrink as they multiply.
+    let spacing = 1.2 / count.saturating_sub(1).max(1) as f32;
+    // 0.11 at the default 5 (0.3 apart), and the same share of the spacing otherwise.
+    let radius = if count == 1 { 0.11 } else { 0.44 / (count - 1) as f32 };
+    let ball = b.mesh(sphere("small-sphere", radius, segments, (segments / 2).max(2)));
+    let middle = (count as f32 - 1.0) * 0.5;
+    for i in 0..count {
+        for j in 0..count {
+            for k in 0..count {
+                let offset = (Vec3::new(i as f32, j as f32, k as f32) - Vec3::splat(middle)) * spacing;
                 b.place(format!("sphere-{i}-{j}-{k}"), ball, Mat4::from_translation(Vec3::new(0.0, 1.6, 0.0) + offset), Role::Occluder);
             }
         }
@@ -176,6 +294,70 @@ fn bar_grid() -> Scene {
     b.scene
 }
 
+/// `parts` transformed and joined into one mesh (the transforms rigid or uniformly scaled).
+fn merged(name: &str, parts: &[(&Mesh, Mat4)]) -> Mesh {
+    let mut mesh = Mesh { name: name.into(), positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
+    for (part, transform) in parts {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(part.positions.iter().map(|p| transform.transform_point3(*p)));
+        mesh.normals.extend(part.normals.iter().map(|n| transform.transform_vector3(*n).normalize_or(Vec3::Y)));
+        mesh.indices.extend(part.indices.iter().map(|i| base + i));
+    }
+    mesh
+}
+
+fn forest(args: &BuiltinArgs) -> Scene {
+    let trees = args.get("trees") as u32;
+    let side = (f64::from(trees).sqrt().ceil() as u32).max(1);
+    let extent = side as f32 * 2.0;
+    let mut b =
+        SceneBuilder::new("forest", downward_light(Vec3::new(0.0, 6.0 + extent * 0.5, 0.0), 1.0 + extent * 0.1)).ground(extent + 4.0);
+    let trunk = cuboid("trunk", Vec3::new(0.12, 1.2, 0.12));
+    let card = plane("leaf", Vec2::new(0.25, 0.12));
+    let trunk_triangles = (trunk.indices.len() / 3) as f64;
+    let per_tree = ((args.get("triangles") - 2.0) / f64::from(trees) - trunk_triangles).max(2.0);
+    let cards = (per_tree / 2.0).floor().max(1.0) as u32;
+    // A fixed xorshift sequence: the scene is the same on every machine and every run.
+    let mut state = 0x2545_F491_u32;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    // Three crowns, instanced over the grid with different turns and sizes.
+    let variants: Vec<usize> = (0..3)
+        .map(|variant| {
+            let mut parts = vec![(&trunk, Mat4::from_translation(Vec3::new(0.0, 0.6, 0.0)))];
+            let leaves: Vec<Mat4> = (0..cards)
+                .map(|_| {
+                    // Uniform in a ball of radius 0.8 centred 1.8 up: the crown.
+                    let direction = Vec3::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 2.0 - 1.0).normalize_or(Vec3::Y);
+                    let position = Vec3::new(0.0, 1.8, 0.0) + direction * 0.8 * next().cbrt();
+                    let rotation = Quat::from_rotation_y(next() * std::f32::consts::TAU) * Quat::from_rotation_x((next() - 0.5) * 2.0);
+                    Mat4::from_rotation_translation(rotation, position)
+                })
+                .collect();
+            parts.extend(leaves.iter().map(|t| (&card, *t)));
+            b.mesh(merged(&format!("tree-{variant}"), &parts))
+        })
+        .collect();
+    for index in 0..trees {
+        let (column, row) = (index % side, index / side);
+        let centre = Vec3::new(column as f32 * 2.0 - extent * 0.5 + 1.0, 0.0, row as f32 * 2.0 - extent * 0.5 + 1.0);
+        let jitter = Vec3::new(next() - 0.5, 0.0, next() - 0.5) * 0.6;
+        let transform = Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.8 + 0.4 * next()),
+            Quat::from_rotation_y(next() * std::f32::consts::TAU),
+            centre + jitter,
+        );
+        b.place(format!("tree-{index}"), variants[index as usize % variants.len()], transform, Role::Both);
+    }
+    b.scene.camera =
+        Camera { position: Vec3::new(0.0, 3.0 + extent * 0.5, 4.0 + extent * 0.9), target: Vec3::new(0.0, 1.0, 0.0), ..standard_camera() };
+    b.scene
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,6 +384,34 @@ mod tests {
         assert_eq!((receiver.min, receiver.max), (Vec3::new(-4.0, 0.0, -4.0), Vec3::new(4.0, 0.0, 4.0)));
         assert_eq!(scene.camera.position, Vec3::new(0.0, 5.0, 6.0));
         assert!((scene.camera.fov_y.to_degrees() - 45.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn parameters_are_parsed_checked_and_recorded() {
+        let (entry, scene) = parse_builtin("forest:triangles=50000, trees=9").unwrap().unwrap();
+        assert_eq!(entry.name, "forest");
+        let triangles: usize = scene.instances.iter().map(|i| scene.meshes[i.mesh].indices.len() / 3).sum();
+        assert!((triangles as f64 - 50_000.0).abs() < 50_000.0 * 0.01, "{triangles} triangles");
+        assert_eq!(scene.instances.len(), 10, "nine trees and the ground");
+        assert_eq!(scene.origin.to_str(), Some("builtin:forest:triangles=50000, trees=9"));
+        scene.validate().unwrap();
+        let default = builtin("forest").unwrap().build();
+        let default_triangles: usize = default.instances.iter().map(|i| default.meshes[i.mesh].indices.len() / 3).sum();
+        assert!((default_triangles as f64 - 20_000.0).abs() < 200.0, "{default_triangles}");
+        let cube = parse_builtin("sphere-cube:spheres=3").unwrap().unwrap().1;
+        assert_eq!(cube.instances.len(), 27 + 1);
+        for (spec, needle) in [
+            ("forest:leaves=3", "unknown parameter `leaves`; its parameters: triangles, trees"),
+            ("forest:trees=many", "`many` is not a number"),
+            ("forest:trees=0", "trees = 0 is outside 1..=4096"),
+            ("forest:trees=nan", "outside"),
+            ("forest:trees", "is not `param=value`"),
+            ("leaves:size=2", "its parameters: none"),
+        ] {
+            let error = parse_builtin(spec).unwrap().unwrap_err().to_string();
+            assert!(error.contains(needle) && error.contains(spec.split(':').next().unwrap()), "{spec}: {error}");
+        }
+        assert!(parse_builtin("models/thing.toml").is_none());
     }
 
     #[test]

@@ -162,6 +162,14 @@ pub enum SceneError {
         /// The names that exist, comma-separated.
         known: String,
     },
+    /// A built-in scene's parameter is unknown, not a number, or out of its range.
+    #[error("built-in scene `{scene}`: {problem}")]
+    BuiltinParameter {
+        /// The scene, as given (`forest:triangles=...`).
+        scene: String,
+        /// What is wrong, naming the parameter and what it accepts.
+        problem: String,
+    },
 }
 
 /// Shorthand for results of this crate.

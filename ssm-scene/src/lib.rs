@@ -23,7 +23,7 @@ mod scene;
 use std::path::Path;
 
 pub use adjacency::{Adjacency, Edge, NO_FACE};
-pub use builtin::{BUILTIN_SCENES, BuiltinScene, builtin};
+pub use builtin::{BUILTIN_SCENES, BuiltinArgs, BuiltinParam, BuiltinScene, builtin, parse_builtin};
 pub use camera::Camera;
 pub use error::{Result, SceneError};
 pub use light::RectLight;
@@ -44,13 +44,15 @@ pub enum SceneSource {
 }
 
 impl Scene {
-    /// Loads a scene from a built-in name, a `.toml` manifest, or a model file.
+    /// Loads a scene from a built-in name (with parameters: `forest:triangles=800000,trees=64`), a
+    /// `.toml` manifest, or a model file.
     ///
     /// # Errors
     /// Any [`SceneError`]; the scene is validated before it is returned.
     pub fn load(spec: &str) -> Result<(Self, SceneSource)> {
-        if let Ok(builtin) = builtin::builtin(spec) {
-            return Ok((builtin.build(), SceneSource::Builtin(builtin)));
+        if let Some(parsed) = builtin::parse_builtin(spec) {
+            let (builtin, scene) = parsed?;
+            return Ok((scene, SceneSource::Builtin(builtin)));
         }
         let path = Path::new(spec);
         let extension = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();

@@ -886,6 +886,15 @@ const PRESETS: &[Preset] = &[
         ..Preset::DEFAULT
     },
     Preset {
+        name: "pvsm-table2",
+        summary: "Shen et al., Table 2: a 782 K-triangle forest under a small and a large light (1:8, as 10 and 80), adaptive against one fixed 4096² map and against 64 hard maps (multi-sm); frame time",
+        scenes: &["forest:triangles=782000,trees=64"],
+        varies: &["scene.light_scale=0.25,2", "pvsm.prediction=dynamic,fixed", "multi-sm.samples=64"],
+        x_axis: "scene.light_scale",
+        y_axis: "time",
+        ..Preset::DEFAULT
+    },
+    Preset {
         name: "pvsm-prediction",
         summary: "Shen et al., Fig. 8: the perceptual models (dynamic, static, linear) against a single fixed 4096² map",
         scenes: &["leaves"],
