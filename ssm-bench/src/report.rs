@@ -226,6 +226,8 @@ pub struct Row {
     pub diagnostics: Vec<(String, f64)>,
     /// Names of the technique's extra images (`<name>.png` beside its visibility).
     pub extra_images: Vec<String>,
+    /// Those of them the HTML report draws over the visibility image.
+    pub overlays: Vec<String>,
 }
 
 /// The leading columns of `results.csv`, in order; more follow.
@@ -284,6 +286,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         passes: measured.pass_medians(),
         diagnostics: measured.diagnostics.clone(),
         extra_images: measured.extra_images.iter().map(|e| e.name.clone()).collect(),
+        overlays: measured.extra_images.iter().filter(|e| e.overlay).map(|e| e.name.clone()).collect(),
     }
 }
 
@@ -472,7 +475,7 @@ fn escape(text: &str) -> String {
 #[must_use]
 pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &str) -> String {
     let mut out = String::from(
-        "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>ssm compare</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\ntable { border-collapse: collapse; font-size: 0.9em; }\nth, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }\nth:first-child, th:nth-child(2), td:first-child, td:nth-child(2) { text-align: left; }\nfigure { margin: 1.2em 0; }\nfigure img { width: 32%; image-rendering: pixelated; border: 1px solid #ddd; }\n.legend { font-size: 0.9em; color: #555; }\n</style>\n</head>\n<body data-images-loaded=\"0\">\n",
+        "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>ssm compare</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\ntable { border-collapse: collapse; font-size: 0.9em; }\nth, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }\nth:first-child, th:nth-child(2), td:first-child, td:nth-child(2) { text-align: left; }\nfigure { margin: 1.2em 0; }\nfigure img { width: 32%; image-rendering: pixelated; border: 1px solid #ddd; vertical-align: top; }\n.overlay { position: relative; display: inline-block; width: 32%; vertical-align: top; }\n.overlay img { width: 100%; }\n.overlay img + img { position: absolute; left: 0; top: 0; opacity: 0.5; }\n.legend { font-size: 0.9em; color: #555; }\n</style>\n</head>\n<body data-images-loaded=\"0\">\n",
     );
     let _ = writeln!(
         out,
@@ -524,7 +527,19 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
                 let extras: String = r
                     .extra_images
                     .iter()
-                    .map(|name| format!("<img src=\"{0}/{1}.png\" alt=\"{0} {1}\" title=\"{1}\">", escape(&r.technique), escape(name)))
+                    .map(|name| {
+                        let image = format!("<img src=\"{0}/{1}.png\" alt=\"{0} {1}\" title=\"{1}\">", escape(&r.technique), escape(name));
+                        if r.overlays.contains(name) {
+                            // Over the visibility, half transparent (Shen et al.'s Fig. 10 inset).
+                            format!(
+                                "<span class=\"overlay\" title=\"{1} over the visibility\"><img src=\"{0}/visibility.png\" alt=\"{0} visibility\">{image}</span>",
+                                escape(&r.technique),
+                                escape(name)
+                            )
+                        } else {
+                            image
+                        }
+                    })
                     .collect();
                 let _ = writeln!(
                     out,

@@ -150,6 +150,9 @@ pub struct ExtraImage {
     pub height: u32,
     /// Values, row-major from the top-left; the PNG maps [0, 1] to black–white.
     pub values: Vec<f32>,
+    /// Shown over the visibility image in `ssm compare`'s HTML report (a map of regions of the
+    /// frame, such as PVSM's tiles); it then has the frame's size.
+    pub overlay: bool,
 }
 
 /// What a registered technique is for the tools that compare them.

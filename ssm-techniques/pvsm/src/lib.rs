@@ -849,8 +849,8 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             bytemuck::pod_collect_to_vec(&ssm_core::readback::read_texture(gpu, &self.low_res.texture, 4, "PVSM low-res map")?);
         let coverage = depth.iter().map(|d| f32::from(u8::from(*d < ssm_core::NO_SURFACE))).collect();
         Ok(vec![
-            ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values },
-            ExtraImage { name: "low_res_coverage".into(), width: side, height: side, values: coverage },
+            ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values, overlay: true },
+            ExtraImage { name: "low_res_coverage".into(), width: side, height: side, values: coverage, overlay: false },
         ])
     }
 }

@@ -295,7 +295,7 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
 
     fn extra_images(&mut self, gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
         let values = self.reuse_share(gpu)?.into_iter().map(|v| v.max(0.0)).collect();
-        Ok(vec![ExtraImage { name: "reuse_share".into(), width: self.reuse.width(), height: self.reuse.height(), values }])
+        Ok(vec![ExtraImage { name: "reuse_share".into(), width: self.reuse.width(), height: self.reuse.height(), values, overlay: false }])
     }
 }
 
