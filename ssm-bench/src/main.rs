@@ -22,7 +22,7 @@ struct Cli {
 enum Command {
     /// List the registered techniques with their parameters, requirements and whether this adapter runs them.
     List,
-    /// List the built-in scenes.
+    /// List the built-in scenes and their parameters (`--scene forest:triangles=800000`).
     Scenes,
     /// Render a scene with one or more techniques and write images and timings.
     Render(RenderArgs),
@@ -203,6 +203,9 @@ fn scenes() -> Result<()> {
     for scene in BUILTIN_SCENES {
         let built = scene.build();
         say!("{:<16} {:>7} triangles  {}", scene.name, built.triangle_count(), scene.summary);
+        for param in scene.params {
+            say!("{:<26}{}:{}={}  ({} to {}) {}", "", scene.name, param.name, param.default, param.min, param.max, param.doc);
+        }
     }
     Ok(())
 }

@@ -103,11 +103,16 @@ impl Measured {
     }
 }
 
+/// The diagnostic every technique gets: the GPU memory (MiB) its buffers and textures hold after
+/// its frames, measured by wgpu's allocation counters.
+pub const MEMORY_DIAGNOSTIC: &str = "memory_mib";
+
 /// Renders `info` with `params`: one warm-up frame, then `frames` timed frames; reads every light's visibility and the shaded image.
 ///
 /// # Errors
 /// Technique or GPU errors, or visibility outside [0, 1].
 pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &ParamValues, frames: u32) -> Result<Measured> {
+    let memory_before = renderer.gpu.allocated_bytes();
     let mut technique = renderer.create_technique(info, params)?;
     // Pipeline compilation and first-use allocation are not the technique's cost.
     renderer.render(technique.as_mut(), info.name)?;
@@ -115,10 +120,13 @@ pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &P
     for _ in 0..frames.max(1) {
         timings.push(renderer.render(technique.as_mut(), info.name)?);
     }
+    // What the technique holds after its frames, lazily allocated maps included.
+    let memory_mib = (renderer.gpu.allocated_bytes() - memory_before) as f64 / f64::from(1u32 << 20);
     let visibility =
         (0..renderer.scene.light_count()).map(|light| renderer.read_visibility(light, info.name)).collect::<Result<Vec<_>>>()?;
     let shaded = renderer.shade()?;
-    let diagnostics = technique.diagnostics(&renderer.gpu);
+    let mut diagnostics = technique.diagnostics(&renderer.gpu);
+    diagnostics.push((MEMORY_DIAGNOSTIC.to_owned(), memory_mib));
     let extra_images = technique.extra_images(&renderer.gpu)?;
     Ok(Measured { info, params: params.clone(), frames: timings, diagnostics, visibility, shaded, extra_images })
 }

@@ -177,6 +177,10 @@ fn list_and_scenes_name_everything() {
     let scenes = String::from_utf8_lossy(&ssm(&["scenes"]).stdout).into_owned();
     for entry in ssm_scene::BUILTIN_SCENES {
         assert!(scenes.contains(entry.name), "{scenes}");
+        for param in entry.params {
+            let line = format!("{}:{}={}  ({} to {})", entry.name, param.name, param.default, param.min, param.max);
+            assert!(scenes.contains(&line), "`{line}` missing from:\n{scenes}");
+        }
     }
 }
 
@@ -196,6 +200,10 @@ fn bad_arguments_fail_with_one_line() {
     assert_one_line_error(&render(first.name, &format!("{}.{param}=many", first.name)), "not a valid value");
     assert_one_line_error(&render(first.name, &format!("{}.{other_param}=1", second.name)), "not among --technique");
     assert_one_line_error(&ssm(&["render", "--scene", "no-such-scene", "--technique", first.name, "--out", out]), "unknown built-in scene");
+    assert_one_line_error(
+        &ssm(&["render", "--scene", "sphere-cube:spheres=1000", "--technique", first.name, "--out", out]),
+        "built-in scene `sphere-cube:spheres=1000`: spheres = 1000 is outside 1..=40",
+    );
     assert_one_line_error(
         &ssm(&["render", "--scene", "parallel-square", "--technique", first.name, "--width", "0", "--out", out]),
         "invalid",

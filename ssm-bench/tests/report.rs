@@ -224,3 +224,24 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }
+
+/// Every measured technique reports the GPU memory it holds, and it follows what it allocates:
+/// `hard` at 1024² holds four times what it holds at 512² (its maps are all there is).
+#[test]
+fn the_memory_a_technique_holds_is_reported() {
+    let gpu = ssm_core::GpuContext::new().unwrap();
+    let registry = ssm_bench::registry().unwrap();
+    let hard = registry.get("hard").unwrap();
+    let scene = ssm_scene::builtin("parallel-square").unwrap().build();
+    let defaults = ssm_core::ParamValues::defaults(hard.name, hard.params);
+    let mut renderer = ssm_core::Renderer::new(&gpu, &scene, 64, 48, &(hard.requirements)(&defaults).unwrap()).unwrap();
+    let mut memory = |size: &str| {
+        let mut params = defaults.clone();
+        params.set("shadow_map_size", size).unwrap();
+        let measured = ssm_bench::report::measure(&mut renderer, hard, &params, 1).unwrap();
+        measured.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).map(|(_, v)| *v).unwrap()
+    };
+    let (small, large) = (memory("512"), memory("1024"));
+    println!("hard: {small} MiB at 512², {large} MiB at 1024²");
+    assert!(small > 0.0 && (large / small - 4.0).abs() < 0.1, "{small} MiB, {large} MiB");
+}

@@ -199,6 +199,14 @@ impl GpuContext {
         self.errors.lock().map(|mut list| std::mem::take(&mut *list)).unwrap_or_default()
     }
 
+    /// GPU memory held by live buffers and textures, bytes (wgpu's allocation counters: the
+    /// memory bound to them, whatever the backend's allocator rounds up to).
+    #[must_use]
+    pub fn allocated_bytes(&self) -> i64 {
+        let counters = self.device.get_internal_counters();
+        (counters.hal.buffer_memory.read() + counters.hal.texture_memory.read()) as i64
+    }
+
     /// Blocks until the GPU has finished everything submitted so far.
     ///
     /// # Errors

@@ -351,72 +351,49 @@ impl PredictedVirtualShadowMaps {
         let atlas_side = if settings.prediction == Prediction::Fixed { settings.fixed_size } else { settings.max_tile_size }.min(limit);
         let (width, height) = (setup.scene.width, setup.scene.height);
         let buffers = Self::buffers(device, &settings, width, height);
-        let settings_buffer = uniform_buffer(device, "pvsm_settings_uniform", &PvsmSettingsUniform::from(&settings));
         let hardware = match settings.conservative {
             Conservative::Hardware => true,
             Conservative::Software | Conservative::Off => false,
             Conservative::Auto => gpu.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION),
         };
-        let raster = RasterSettingsUniform {
-            half_texel: [1.0 / settings.low_res_size as f32; 2],
-            size: [settings.low_res_size as f32; 2],
-            enlarge: u32::from(!hardware && settings.conservative != Conservative::Off),
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
-        };
         let layouts = Layouts::new(device);
         let low_res = LowResMap::new(device, settings.low_res_size, &layouts.mip);
-        let low_res_group = bind_group(
-            device,
-            "pvsm_low_res_bind_group",
-            &layouts.low_res,
-            &[
-                setup.scene.vertex_buffer.as_entire_binding(),
-                setup.scene.index_buffer.as_entire_binding(),
-                uniform_buffer(device, "pvsm_raster_uniform", &raster).as_entire_binding(),
-            ],
-        );
-        let kernel_group = bind_group(
-            device,
-            "pvsm_kernel_bind_group",
-            &layouts.kernel,
-            &[
-                setup.scene.camera_buffer.as_entire_binding(),
-                settings_buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&low_res.all_levels),
-                buffers.kernels.as_entire_binding(),
-                buffers.grid.as_entire_binding(),
-                buffers.counters.as_entire_binding(),
-            ],
-        );
-        let pyramid_settings = PyramidSettingsUniform { grid_size: settings.grid_size, _pad0: 0, _pad1: 0, _pad2: 0 };
-        let pyramid_group = bind_group(
-            device,
-            "pvsm_pyramid_bind_group",
-            &layouts.pyramid,
-            &[
-                uniform_buffer(device, "pvsm_pyramid_uniform", &pyramid_settings).as_entire_binding(),
-                buffers.grid.as_entire_binding(),
-                buffers.pyramid.as_entire_binding(),
-            ],
-        );
-        let common_group = bind_group(
-            device,
-            "pvsm_filter_common_bind_group",
-            &layouts.common,
-            &[
-                setup.scene.camera_buffer.as_entire_binding(),
-                settings_buffer.as_entire_binding(),
-                buffers.kernels.as_entire_binding(),
-                buffers.accumulated.as_entire_binding(),
-            ],
-        );
-        let tile_maps = tile_map_sides(atlas_side)
+        let groups = StepGroups::new(setup, &settings, &layouts, &buffers, &low_res, hardware);
+        let tile_maps = Self::tile_maps(setup, atlas_side)?;
+        let slots = (0..setup.scene.light_count())
+            .map(|light| Self::tile_slots(gpu, &layouts.tile, &tile_maps, light, settings.max_tiles))
+            .collect();
+        let resolve_groups = Self::resolve_groups(setup, &layouts.resolve);
+        let pipelines = Pipelines::new(setup, &layouts, &gbuffer.layout, hardware)?;
+        Ok(Self {
+            settings,
+            pipelines,
+            buffers,
+            low_res,
+            low_res_group: groups.low_res,
+            gbuffer_group: gbuffer.bind_group.clone(),
+            kernel_group: groups.kernel,
+            pyramid_group: groups.pyramid,
+            slots,
+            resolve_groups,
+            common_group: groups.common,
+            tile_maps,
+            atlas_side,
+            triangle_count: setup.scene.triangle_count,
+            width,
+            height,
+            last: LastFrame::default(),
+        })
+    }
+
+    /// Step 7's depth maps: one per power-of-two side up to the atlas's, each tile drawn into the
+    /// smallest that holds it.
+    fn tile_maps(setup: &TechniqueSetup<'_>, atlas_side: u32) -> Result<Vec<LightDepthMap>> {
+        tile_map_sides(atlas_side)
             .into_iter()
             .map(|side| {
                 LightDepthMap::new(
-                    gpu,
+                    setup.gpu,
                     setup.scene,
                     &LightDepthMapDesc {
                         label: &format!("pvsm_tile_map_{side}"),
@@ -431,43 +408,24 @@ impl PredictedVirtualShadowMaps {
                     },
                 )
             })
-            .collect::<Result<Vec<_>>>()?;
-        let slots = (0..setup.scene.light_count())
-            .map(|light| Self::tile_slots(gpu, &layouts.tile, &tile_maps, light, settings.max_tiles))
-            .collect();
-        let resolve_groups = setup
+            .collect()
+    }
+
+    /// The resolve pass's output per light (binding 2: the filter's tile resources hold 0 and 1 of
+    /// the same group in the same module).
+    fn resolve_groups(setup: &TechniqueSetup<'_>, layout: &wgpu::BindGroupLayout) -> Vec<wgpu::BindGroup> {
+        setup
             .outputs
             .iter()
             .enumerate()
             .map(|(light, output)| {
-                // Binding 2: the filter's tile resources hold 0 and 1 of the same group in the same module.
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                setup.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&format!("pvsm_resolve_bind_group_{light}")),
-                    layout: &layouts.resolve,
+                    layout,
                     entries: &[wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(output) }],
                 })
             })
-            .collect();
-        let pipelines = Pipelines::new(setup, &layouts, &gbuffer.layout, hardware)?;
-        Ok(Self {
-            settings,
-            pipelines,
-            buffers,
-            low_res,
-            low_res_group,
-            gbuffer_group: gbuffer.bind_group.clone(),
-            kernel_group,
-            pyramid_group,
-            slots,
-            resolve_groups,
-            common_group,
-            tile_maps,
-            atlas_side,
-            triangle_count: setup.scene.triangle_count,
-            width,
-            height,
-            last: LastFrame::default(),
-        })
+            .collect()
     }
 
     fn buffers(device: &wgpu::Device, settings: &PvsmSettings, width: u32, height: u32) -> Buffers {
@@ -597,6 +555,82 @@ fn uniform_buffer_writable(device: &wgpu::Device, label: &str, size: u64) -> wgp
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
+}
+
+/// The bind groups of steps 2 to 5 and 8 that do not change per light or tile.
+struct StepGroups {
+    low_res: wgpu::BindGroup,
+    kernel: wgpu::BindGroup,
+    pyramid: wgpu::BindGroup,
+    common: wgpu::BindGroup,
+}
+
+impl StepGroups {
+    fn new(
+        setup: &TechniqueSetup<'_>,
+        settings: &PvsmSettings,
+        layouts: &Layouts,
+        buffers: &Buffers,
+        low_res: &LowResMap,
+        hardware: bool,
+    ) -> Self {
+        let device = &setup.gpu.device;
+        let settings_buffer = uniform_buffer(device, "pvsm_settings_uniform", &PvsmSettingsUniform::from(settings));
+        let raster = RasterSettingsUniform {
+            half_texel: [1.0 / settings.low_res_size as f32; 2],
+            size: [settings.low_res_size as f32; 2],
+            enlarge: u32::from(!hardware && settings.conservative != Conservative::Off),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        };
+        let low_res_group = bind_group(
+            device,
+            "pvsm_low_res_bind_group",
+            &layouts.low_res,
+            &[
+                setup.scene.vertex_buffer.as_entire_binding(),
+                setup.scene.index_buffer.as_entire_binding(),
+                uniform_buffer(device, "pvsm_raster_uniform", &raster).as_entire_binding(),
+            ],
+        );
+        let kernel = bind_group(
+            device,
+            "pvsm_kernel_bind_group",
+            &layouts.kernel,
+            &[
+                setup.scene.camera_buffer.as_entire_binding(),
+                settings_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&low_res.all_levels),
+                buffers.kernels.as_entire_binding(),
+                buffers.grid.as_entire_binding(),
+                buffers.counters.as_entire_binding(),
+            ],
+        );
+        let pyramid_settings = PyramidSettingsUniform { grid_size: settings.grid_size, _pad0: 0, _pad1: 0, _pad2: 0 };
+        let pyramid = bind_group(
+            device,
+            "pvsm_pyramid_bind_group",
+            &layouts.pyramid,
+            &[
+                uniform_buffer(device, "pvsm_pyramid_uniform", &pyramid_settings).as_entire_binding(),
+                buffers.grid.as_entire_binding(),
+                buffers.pyramid.as_entire_binding(),
+            ],
+        );
+        let common = bind_group(
+            device,
+            "pvsm_filter_common_bind_group",
+            &layouts.common,
+            &[
+                setup.scene.camera_buffer.as_entire_binding(),
+                settings_buffer.as_entire_binding(),
+                buffers.kernels.as_entire_binding(),
+                buffers.accumulated.as_entire_binding(),
+            ],
+        );
+        Self { low_res: low_res_group, kernel, pyramid, common }
+    }
 }
 
 /// The bind group layouts of the passes' own resources.
