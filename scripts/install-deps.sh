@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what ssm needs beyond a Rust toolchain on a Debian or Ubuntu
-# machine: a Vulkan driver (without a GPU, Mesa's software rasteriser
+# machine: a C++ compiler (g++: the meshopt crate builds meshoptimizer's C++
+# decoders), a Vulkan driver (without a GPU, Mesa's software rasteriser
 # lavapipe, package mesa-vulkan-drivers) and, with --for-tests, Chromium for
 # the report test. Prints the exact command when it cannot install (not root
 # and no sudo).
@@ -14,6 +15,10 @@ die() { echo "install-deps: $*" >&2; exit 1; }
 command -v cargo >/dev/null 2>&1 || die "cargo is missing: install Rust with rustup (https://rustup.rs), then re-run"
 
 packages=()
+# The cc crate compiles C++ with $CXX, else `c++` (which g++ provides).
+if ! command -v "${CXX:-c++}" >/dev/null 2>&1; then
+    packages+=(g++)
+fi
 # Any Vulkan ICD will do (a GPU driver or lavapipe).
 if ! compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null && ! compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null; then
     packages+=(mesa-vulkan-drivers)
@@ -23,7 +28,7 @@ if [ "${1:-}" = "--for-tests" ] && ! command -v chromium >/dev/null 2>&1; then
 fi
 [ ${#packages[@]} -eq 0 ] && exit 0
 
-command -v apt-get >/dev/null 2>&1 || die "missing ${packages[*]} and this is not a Debian-like system: install Mesa's Vulkan drivers (or your GPU's) and Chromium"
+command -v apt-get >/dev/null 2>&1 || die "missing ${packages[*]} and this is not a Debian-like system: install a C++ compiler, Mesa's Vulkan drivers (or your GPU's) and Chromium"
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then
     command -v sudo >/dev/null 2>&1 || die "run as root: apt-get update && apt-get install -y ${packages[*]}"

@@ -27,8 +27,10 @@ struct PvsmSettings {
     // 1: each texel a point sample, weighted fully when its centre is inside the filter (classic
     // PCF, Fig. 4(a)); 0: each texel a quad weighted by its exact overlap (Eq. 2, Fig. 4(c)).
     point_samples: u32,
-    _pad1: f32,
-    _pad2: f32,
+    // 1: a tile finer than the pixel's predicted texel is read at every k-th texel (k the ratio);
+    // 0: at every texel (the paper).
+    predicted_stride: u32,
+    _pad: f32,
 };
 
 // Every screen-space pass binds the camera and the settings first in its own group.

@@ -28,10 +28,10 @@ struct TileSettings {
 const MAX_TEXELS_PER_AXIS: f32 = 96.0;
 
 // Σ c·o and Σ c of the filter (u, v_height) centred on `centre` (shadow-map coordinates) over this
-// tile, for a receiver at light depth `depth` with tangent plane (`position`, `normal`). A tile
-// finer than the pixel's predicted texel size `predicted` (a neighbour in the tile needed more) is
-// read at every k-th texel, k the ratio: the prediction says that many texels suffice, and a
-// pixel's cost stays about ρ² whatever the tile's resolution.
+// tile, for a receiver at light depth `depth` with tangent plane (`position`, `normal`). With
+// settings.predicted_stride, a tile finer than the pixel's predicted texel size `predicted` (a
+// neighbour in the tile needed more) is read at every k-th texel, k the ratio: the prediction says
+// that many texels suffice, and a pixel's cost stays about ρ² whatever the tile's resolution.
 fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec2<f32> {
     let extent = tile.uv_max - tile.uv_min;
     let scale = tile.size / extent;
@@ -46,7 +46,8 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
     if (x_low >= x_high || c.y + reach_y <= 0.0 || c.y - reach_y >= tile.size.y) {
         return vec2<f32>(0.0);
     }
-    let step = max(max(vec2<f32>(1.0), floor(predicted * scale)), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
+    let stride = select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u);
+    let step = max(max(vec2<f32>(1.0), stride), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
     let slope = select(0.0, uy / ux, ux > 1e-6);
     var visible = 0.0;
     var covered = 0.0;

@@ -26,6 +26,29 @@ pub enum SceneError {
         /// Its extension, possibly empty.
         extension: String,
     },
+    /// The file is valid, or may be, but uses something the loader does not decode
+    /// (glTF 1.0, a compression extension, UTF-16 text...).
+    #[error("{}: {what} is not supported: {hint}", file.display())]
+    Unsupported {
+        /// The file.
+        file: PathBuf,
+        /// What the file uses, as `glTF 1.0` or `the glTF extension KHR_draco_mesh_compression`.
+        what: String,
+        /// What to do instead, as `convert the file to glTF 2.0`.
+        hint: String,
+    },
+    /// A file that the model file refers to (a glTF buffer) cannot be read.
+    #[error("{}: {element} refers to `{}`, which cannot be read: {source}", file.display(), referenced.display())]
+    MissingReference {
+        /// The model file.
+        file: PathBuf,
+        /// The element holding the reference, as `buffer 0`.
+        element: String,
+        /// The file it refers to, resolved against the model's folder.
+        referenced: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
     /// The file is not valid in its format (truncated, wrong types, missing buffers...).
     #[error("{}: invalid {format} file: {message}", file.display())]
     Malformed {

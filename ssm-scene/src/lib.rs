@@ -13,10 +13,13 @@ mod adjacency;
 mod builtin;
 mod camera;
 mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 mod light;
 mod loaders;
 mod manifest;
 mod mesh;
+mod polygon;
 pub mod primitives;
 mod scene;
 

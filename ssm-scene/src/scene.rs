@@ -218,9 +218,43 @@ fn validate_instance(file: &Path, instance: &Instance, mesh_count: usize) -> Res
     if !instance.transform.is_finite() {
         return Err(SceneError::InvalidTransform { file: file.into(), instance: instance.name.clone(), problem: "not finite" });
     }
-    let det = Mat3::from_mat4(instance.transform).determinant();
-    if !(det.abs() > 1e-12 && det.is_finite()) {
+    // Singular, or too nearly so for normals to be transformed. Judged relative to the axes'
+    // lengths, so that a tiny uniform scale (glTF's dequantisation, millimetre units) is fine.
+    let linear = Mat3::from_mat4(instance.transform);
+    let axes = linear.x_axis.length() * linear.y_axis.length() * linear.z_axis.length();
+    if !(axes > 0.0 && (linear.determinant() / axes).abs() > 1e-6 && normal_matrix(instance.transform).is_finite()) {
         return Err(SceneError::InvalidTransform { file: file.into(), instance: instance.name.clone(), problem: "singular" });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec4;
+
+    use super::*;
+
+    fn instance(transform: Mat4) -> Instance {
+        Instance { name: "i".into(), mesh: 0, transform, role: Role::Both }
+    }
+
+    #[test]
+    fn a_tiny_uniform_scale_is_valid_but_a_flattening_one_is_singular() {
+        let file = Path::new("f");
+        // gltfpack dequantises 14-bit positions of a 0.1-wide model with a scale of about 6e-6 (determinant 2e-16).
+        assert!(validate_instance(file, &instance(Mat4::from_scale(Vec3::splat(6e-6))), 1).is_ok());
+        // Axes that are almost parallel flatten the model onto a plane, whatever their length.
+        let sheared = Mat4::from_cols(Vec4::X, Vec4::new(1.0, 1e-8, 0.0, 0.0), Vec4::Z, Vec4::W);
+        assert!(validate_instance(file, &instance(sheared), 1).is_err());
+        assert!(validate_instance(file, &instance(sheared * Mat4::from_scale(Vec3::splat(1e3))), 1).is_err());
+        assert!(validate_instance(file, &instance(Mat4::from_scale(Vec3::ZERO)), 1).is_err());
+        assert!(
+            validate_instance(
+                file,
+                &instance(Mat4::from_cols_array(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])),
+                1
+            )
+            .is_err()
+        );
+    }
 }

@@ -2,7 +2,11 @@
 //!
 //! Each returns a [`LoadedModel`]: meshes in object space, their placements
 //! and any cameras the file defines. Materials, textures and animations are
-//! not decoded: shadows need geometry only.
+//! not decoded: shadows need geometry only. The OBJ and PLY parsers are our
+//! own, and the glTF loader deserializes the `gltf` crate's document model one
+//! element at a time and decodes the buffers itself, so that every malformed
+//! input is a typed error naming the file and the element (each module says
+//! what it takes from the usual crate, or why it does not use it).
 
 mod gltf;
 mod obj;
@@ -38,6 +42,9 @@ pub struct Placement {
     pub node_name: String,
 }
 
+/// A format's parser: the file's path (for messages) and its bytes.
+type Parser = fn(&Path, &[u8]) -> Result<LoadedModel>;
+
 /// Loads a model file, picking the format from the extension.
 ///
 /// # Errors
@@ -46,15 +53,19 @@ pub struct Placement {
 /// element for anything malformed.
 pub fn load_model(path: &Path) -> Result<LoadedModel> {
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { file: path.into(), source })?;
-    let model = match extension.as_str() {
-        "gltf" | "glb" => guard(path, "glTF", || gltf::load(path, &bytes))?,
-        "obj" => guard(path, "OBJ", || obj::load(path, &bytes))?,
-        "ply" => guard(path, "PLY", || ply::load(path, &bytes))?,
-        _ => {
-            return Err(SceneError::UnsupportedFormat { file: path.into(), extension });
-        }
+    let (format, load): (&'static str, Parser) = match extension.as_str() {
+        "gltf" | "glb" => ("glTF", gltf::load),
+        "obj" => ("OBJ", obj::load),
+        "ply" => ("PLY", ply::load),
+        _ => return Err(SceneError::UnsupportedFormat { file: path.into(), extension }),
     };
+    let io = |source| SceneError::Io { file: path.into(), source };
+    // A device or a pipe (`/dev/zero`) would be read forever.
+    if !std::fs::metadata(path).map_err(io)?.is_file() {
+        return Err(io(std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a regular file")));
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    let model = guard(path, format, || load(path, &bytes))?;
     for mesh in &model.meshes {
         mesh.validate(path)?;
     }

@@ -75,6 +75,17 @@ pub enum Integration {
     Points,
 }
 
+/// Which texels of a tile a pixel's filter reads (step 8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum FilterTexels {
+    /// Every texel under the filter, at the tile's resolution (the paper); at most 96 per axis.
+    Tile,
+    /// Every k-th, each standing for a k×k block, k the ratio of the pixel's predicted texel to the
+    /// tile's: a pixel's cost stays about ρ² in a tile a neighbour made finer, but occluders thinner
+    /// than a block can fall between the samples.
+    Predicted,
+}
+
 /// Settings of [`PredictedVirtualShadowMaps`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
 pub struct PvsmSettings {
@@ -108,6 +119,9 @@ pub struct PvsmSettings {
     /// How texels are weighted (Sec. 4.1): quads (each texel's exact overlap with the filter, Eq. 2) or points (classic PCF, which bands where the penumbra's width changes quickly, Fig. 4).
     #[param(choice, default = "quads")]
     pub integration: Integration,
+    /// Which texels of a tile the filter reads: tile (every one, the paper) or predicted (every k-th, k the ratio of the pixel's predicted texel to the tile's; cheaper where a neighbour made the tile finer).
+    #[param(choice, default = "tile")]
+    pub filter_texels: FilterTexels,
     /// k: the filter evaluated at k×k points of each pixel and averaged (Fig. 11's supersampling; set antialiasing=false).
     #[param(default = 1, min = 1, max = 32)]
     pub supersampling: u32,
@@ -133,8 +147,8 @@ pub struct PvsmSettingsUniform {
     constant_bias: f32,
     fixed_size: f32,
     point_samples: u32,
-    _pad1: f32,
-    _pad2: f32,
+    predicted_stride: u32,
+    _pad: f32,
 }
 
 impl From<&PvsmSettings> for PvsmSettingsUniform {
@@ -150,8 +164,8 @@ impl From<&PvsmSettings> for PvsmSettingsUniform {
             constant_bias: settings.bias.constant_bias,
             fixed_size: settings.fixed_size as f32,
             point_samples: u32::from(settings.integration == Integration::Points),
-            _pad1: 0.0,
-            _pad2: 0.0,
+            predicted_stride: u32::from(settings.filter_texels == FilterTexels::Predicted),
+            _pad: 0.0,
         }
     }
 }
