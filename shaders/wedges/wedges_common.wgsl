@@ -13,10 +13,11 @@ const WORKGROUP: u32 = 256u;
 // silhouettes are grouped round-robin into at most this many).
 const MAX_SILHOUETTE_BUFFERS: u32 = 64u;
 // Vertices drawn per silhouette half-edge: a shadow-volume side quad (two
-// triangles), and a penumbra wedge as two half-wedges of eight triangles.
+// triangles), and a penumbra wedge (eight triangles); per cap face, the near
+// and far caps.
 const SIDE_VERTICES: u32 = 6u;
 const CAP_VERTICES: u32 = 6u;
-const WEDGE_VERTICES: u32 = 48u;
+const WEDGE_VERTICES: u32 = 24u;
 // u32 offset of the first group's draw arguments in the indirect buffer (after two dispatches).
 const DRAW_ARGUMENTS: u32 = 8u;
 // u32s of indirect arguments per group: draws of the sides, caps and wedges, and the blend's dispatch.
@@ -45,7 +46,7 @@ struct WedgesSettings {
     near_fraction: f32,
     // Slack of Lengyel's bounding-plane rejection, a fraction of the scene's diagonal.
     plane_tolerance: f32,
-    // Camera depth subtracted from the G-buffer's when it is copied for the volumes (NDC units).
+    // Camera depth the G-buffer's is moved by, to the surface's side facing the light, when it is copied for the volumes (NDC units).
     depth_bias: f32,
     _pad2: f32,
 };
@@ -85,7 +86,8 @@ struct EdgeRecord {
 // through the light's centre, a and b. The wedge is split by that plane into
 // an inner half (towards the umbra) and an outer half; each is the convex
 // polyhedron a', b' (the edge clipped to the geometric near plane), and its
-// far points on the plane at the frame's far depth.
+// far points on the plane past the frame's far depth. A fallback wedge keeps
+// in split0, split1, outer0, outer1 the corners of its far rectangle.
 struct WedgeRecord {
     // xyz: a; w: parameter along a -> b where the wedge's spine starts.
     a: vec4<f32>,

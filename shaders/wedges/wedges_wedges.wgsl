@@ -1,14 +1,16 @@
 // The penumbra wedges of one silhouette buffer (Forest et al., Sec. 3.1 and
-// 4.2-4.3): every silhouette half-edge's wedge is drawn as two half-wedges
-// (inner, towards the umbra, and outer), their back faces only, so that each
-// pixel whose view ray crosses a half-wedge runs one fragment. The fragment
-// takes the G-buffer's point p and
+// 4.2-4.3): every silhouette half-edge's wedge is drawn as its convex
+// polyhedron (the edge, the two tangent planes, the two side planes, the far
+// plane), back faces only, so that each pixel whose view ray crosses it runs
+// one fragment. The fragment takes the G-buffer's point p and
 //
-// 1. rejects p outside the half-wedge's three bounding planes (Lengyel 2005's
-//    quick test) or on the other side of the split plane;
+// 1. finds its half-wedge by the split plane (the shadow-volume side through
+//    the light's centre): inner, towards the umbra, or outer (Fig. 8), and
+//    rejects p outside that half's three bounding planes, its tangent plane
+//    and the two side planes (Lengyel 2005's quick test, Fig. 7);
 // 2. clips the edge to the part between the light's plane and p (Lengyel's
-//    local near plane), in homogeneous light-plane coordinates so that a
-//    point nearly level with p stays exact;
+//    local near plane, Fig. 9), in homogeneous light-plane coordinates so
+//    that a point nearly level with p stays exact;
 // 3. projects it from p onto the light, normalised to [-1, 1]^2 (the light's
 //    left and bottom borders at -1, right and top at 1, Sec. 4.2), and, for
 //    each of the four radial parts (the quadrants around the light's centre,
@@ -25,7 +27,7 @@
 // the fragments shaded (added; a counter in a storage buffer would be a side
 // effect, which turns off early depth testing). Back faces are depth-tested
 // against the scene (GreaterEqual, not written): a surface behind the whole
-// half-wedge is rejected before shading.
+// wedge is rejected before shading.
 
 // #import common/light_frame.wgsl
 // #import common/camera.wgsl
@@ -40,21 +42,21 @@
 @group(3) @binding(0) var gbuffer_position: texture_2d<f32>;
 @group(3) @binding(1) var gbuffer_normal: texture_2d<f32>;
 
-// Fragment kind bits.
-const KIND_INNER: u32 = 1u;
+// Fragment kind: a fallback wedge (no bounding planes).
 const KIND_FALLBACK: u32 = 2u;
 
 struct WedgeVarying {
     @builtin(position) clip: vec4<f32>,
     // The half-edge.
     @location(0) @interpolate(flat) index: u32,
-    // KIND_INNER, KIND_FALLBACK.
+    // KIND_FALLBACK, or 0.
     @location(1) @interpolate(flat) kind: u32,
-    // The half-wedge's bounding planes (unit normal, offset), inside where dot(normal, p) >= offset:
-    // the tangent plane, and the side planes at a' and b'.
-    @location(2) @interpolate(flat) bound: vec4<f32>,
-    @location(3) @interpolate(flat) side0: vec4<f32>,
-    @location(4) @interpolate(flat) side1: vec4<f32>,
+    // Bounding planes (unit normal, offset), inside where dot(normal, p) >= offset: the
+    // inner and outer tangent planes, and the side planes at a' and b'.
+    @location(2) @interpolate(flat) inner: vec4<f32>,
+    @location(3) @interpolate(flat) outer: vec4<f32>,
+    @location(4) @interpolate(flat) side0: vec4<f32>,
+    @location(5) @interpolate(flat) side1: vec4<f32>,
 };
 
 // The plane through three points, oriented so that `inside` is on its positive side.
@@ -72,44 +74,45 @@ fn oriented_plane(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, inside: vec3<f32>
     return vec4<f32>(normal, dot(normal, p0));
 }
 
-// Corners (into a', b', M0, M1, F0, F1) of the eight triangles of a half-wedge.
-const HALF_WEDGE_TRIANGLES = array<vec3<u32>, 8>(
-    // The tangent plane: a', b', F1, F0.
-    vec3<u32>(0u, 1u, 5u), vec3<u32>(0u, 5u, 4u),
-    // The split plane: a', b', M1, M0.
+// Corners (into a', b', Fi0, Fi1, Fo0, Fo1) of the eight triangles of a wedge.
+const WEDGE_TRIANGLES = array<vec3<u32>, 8>(
+    // The inner tangent plane: a', b', Fi1, Fi0.
     vec3<u32>(0u, 1u, 3u), vec3<u32>(0u, 3u, 2u),
+    // The outer tangent plane: a', b', Fo1, Fo0.
+    vec3<u32>(0u, 1u, 5u), vec3<u32>(0u, 5u, 4u),
     // The side planes.
-    vec3<u32>(0u, 4u, 2u), vec3<u32>(1u, 3u, 5u),
-    // The far plane: F0, F1, M1, M0.
-    vec3<u32>(4u, 5u, 3u), vec3<u32>(4u, 3u, 2u),
+    vec3<u32>(0u, 2u, 4u), vec3<u32>(1u, 3u, 5u),
+    // The far plane: Fi0, Fi1, Fo1, Fo0.
+    vec3<u32>(2u, 3u, 5u), vec3<u32>(2u, 5u, 4u),
 );
+
+const NO_PLANE = vec4<f32>(0.0, 0.0, 0.0, -1e30);
 
 @vertex
 fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
     let index = vertex / WEDGE_VERTICES;
-    let local = vertex % WEDGE_VERTICES;
-    let inner = local < WEDGE_VERTICES / 2u;
-    let triangle = (local % (WEDGE_VERTICES / 2u)) / 3u;
-    let corner = local % 3u;
+    let triangle = (vertex % WEDGE_VERTICES) / 3u;
+    let corner = vertex % 3u;
     let record = half_edges[index];
     let flags = bitcast<u32>(record.outer1.w);
     var out: WedgeVarying;
     out.index = index;
-    out.kind = select(0u, KIND_INNER, inner);
-    out.bound = vec4<f32>(0.0, 0.0, 0.0, -1e30);
-    out.side0 = out.bound;
-    out.side1 = out.bound;
+    out.kind = 0u;
+    out.inner = NO_PLANE;
+    out.outer = NO_PLANE;
+    out.side0 = NO_PLANE;
+    out.side1 = NO_PLANE;
     // Outside the clip volume: no fragment.
     out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
     if ((flags & WEDGE_EMPTY) != 0u) {
         return out;
     }
+    let a = record.a.xyz;
+    let b = record.b.xyz;
     if ((flags & WEDGE_FALLBACK) != 0u) {
         out.kind = KIND_FALLBACK;
         // The screen-space bounding box of the fallback hull: the clipped edge and the far rectangle.
-        if (inner && triangle < 2u) {
-            let a = record.a.xyz;
-            let b = record.b.xyz;
+        if (triangle < 2u) {
             let hull = array<vec3<f32>, 6>(
                 mix(a, b, record.a.w), mix(a, b, record.b.w), record.split0.xyz, record.split1.xyz, record.outer0.xyz, record.outer1.xyz,
             );
@@ -132,27 +135,17 @@ fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
             }
             low = clamp(low, vec2<f32>(-1.0), vec2<f32>(1.0));
             high = clamp(high, vec2<f32>(-1.0), vec2<f32>(1.0));
-            // Two triangles wound as back faces (clockwise on screen).
-            let rectangle = array<vec2<f32>, 6>(
-                low, vec2<f32>(low.x, high.y), high,
-                low, high, vec2<f32>(high.x, low.y),
-            );
+            // Two triangles wound as back faces (clockwise on screen), at the far depth.
+            let rectangle = array<vec2<f32>, 6>(low, vec2<f32>(low.x, high.y), high, low, high, vec2<f32>(high.x, low.y));
             out.clip = vec4<f32>(rectangle[triangle * 3u + corner], 1.0, 1.0);
         }
         return out;
     }
-    let a = record.a.xyz;
-    let b = record.b.xyz;
     var points = array<vec3<f32>, 6>(
-        mix(a, b, record.a.w),
-        mix(a, b, record.b.w),
-        record.split0.xyz,
-        record.split1.xyz,
-        select(record.outer0.xyz, record.inner0.xyz, inner),
-        select(record.outer1.xyz, record.inner1.xyz, inner),
+        mix(a, b, record.a.w), mix(a, b, record.b.w), record.inner0.xyz, record.inner1.xyz, record.outer0.xyz, record.outer1.xyz,
     );
     let centroid = (points[0] + points[1] + points[2] + points[3] + points[4] + points[5]) / 6.0;
-    var corners = HALF_WEDGE_TRIANGLES[triangle];
+    var corners = WEDGE_TRIANGLES[triangle];
     let p0 = points[corners.x];
     let p1 = points[corners.y];
     let p2 = points[corners.z];
@@ -161,9 +154,10 @@ fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
         corners = corners.xzy;
     }
     out.clip = camera.view_proj * vec4<f32>(points[corners[corner]], 1.0);
-    out.bound = oriented_plane(points[0], points[1], points[4], centroid);
-    out.side0 = oriented_plane(points[0], points[4], points[2], centroid);
-    out.side1 = oriented_plane(points[1], points[5], points[3], centroid);
+    out.inner = oriented_plane(points[0], points[1], points[2], centroid);
+    out.outer = oriented_plane(points[0], points[1], points[4], centroid);
+    out.side0 = oriented_plane(points[0], points[2], points[4], centroid);
+    out.side1 = oriented_plane(points[1], points[3], points[5], centroid);
     return out;
 }
 
@@ -294,20 +288,20 @@ fn wedges_wedge_fragment(in: WedgeVarying) -> WedgeTargets {
         discard;
     }
     let p = position.xyz;
-    let fallback = (in.kind & KIND_FALLBACK) != 0u;
-    // Lengyel's quick rejection: outside any bounding plane of the half-wedge.
-    let tolerance = scene_length(frame, settings.plane_tolerance);
-    if (!fallback && (outside(in.bound, p, tolerance) || outside(in.side0, p, tolerance) || outside(in.side1, p, tolerance))) {
-        discard;
-    }
     let record = half_edges[in.index];
     let a = record.a.xyz;
     let b = record.b.xyz;
     let c = frame.centre.xyz;
-    // Inner half-wedge: p on the umbra's side of the shadow-volume side (computed identically for both halves).
+    // The half-wedge: p on the umbra's side of the shadow-volume side is in the inner half.
     let split = dot(cross(a - c, b - c), p - c);
     let inner = split < 0.0;
-    if (split == 0.0 || (!fallback && inner != ((in.kind & KIND_INNER) != 0u))) {
+    if (split == 0.0) {
+        discard;
+    }
+    // Lengyel's quick rejection: outside any of the half-wedge's three bounding planes.
+    let tolerance = scene_length(frame, settings.plane_tolerance);
+    let bound = select(in.outer, in.inner, inner);
+    if (outside(bound, p, tolerance) || outside(in.side0, p, tolerance) || outside(in.side1, p, tolerance)) {
         discard;
     }
     let n = frame.normal.xyz;

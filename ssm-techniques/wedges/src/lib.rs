@@ -61,7 +61,7 @@ const BLEND_SHADER: &str = include_str!("../../../shaders/wedges/wedges_blend.wg
 /// Most silhouette buffers (`MAX_SILHOUETTE_BUFFERS` in the WGSL).
 pub const MAX_SILHOUETTE_BUFFERS: u32 = 64;
 /// Label-propagation rounds recorded per frame; rounds after the labels settle dispatch nothing.
-pub const MAX_LABEL_ROUNDS: u32 = 32;
+pub const MAX_LABEL_ROUNDS: u32 = 16;
 /// Format of the shadow volumes' depth-stencil target.
 pub const STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
 /// Format of the silhouette buffer's seven parameter targets: full-precision floats (the paper packed 8 bits).
@@ -124,7 +124,7 @@ pub struct WedgesSettingsUniform {
 const NEAR_FRACTION: f32 = 1e-6;
 /// Slack of the bounding-plane rejection, a fraction of the scene's diagonal (it only lets more fragments through).
 const PLANE_TOLERANCE: f32 = 1e-5;
-/// Camera depth (NDC) the G-buffer's depth is moved towards the camera by for the volumes: 16 units of 2^-24.
+/// Camera depth (NDC) the G-buffer's depth is moved by, to the surface's side facing the light, for the volumes: 16 units of 2^-24.
 const DEPTH_BIAS: f32 = 16.0 / 16_777_216.0;
 
 impl From<&WedgesSettings> for WedgesSettingsUniform {
@@ -204,7 +204,11 @@ fn storage_entry(binding: u32, read_only: bool, visibility: wgpu::ShaderStages) 
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
@@ -295,12 +299,11 @@ impl PenumbraWedges {
             })
             .collect();
 
-        let (depth_copy_pipeline, depth_copy_group) = depth_copy(gpu, &gbuffer.depth_view, &settings_buffer)?;
+        let (depth_copy_pipeline, depth_copy_group) = depth_copy(gpu, gbuffer, (&settings_buffer, &setup.scene.camera_buffer))?;
         let umbra_mask = render_texture(device, "wedges_umbra_mask", width, height, UMBRA_MASK_FORMAT, wgpu::TextureUsages::empty());
         let umbra_mask_view = labelled_view(&umbra_mask, "wedges_umbra_mask");
         let blend_layout = blend_layout(device);
-        let mut blend_resources: Vec<wgpu::BindingResource<'_>> =
-            silhouette_views.iter().map(wgpu::BindingResource::TextureView).collect();
+        let mut blend_resources: Vec<wgpu::BindingResource<'_>> = silhouette_views.iter().map(wgpu::BindingResource::TextureView).collect();
         blend_resources.push(final_buffer.as_entire_binding());
         blend_resources.push(settings_buffer.as_entire_binding());
         blend_resources.push(wgpu::BindingResource::TextureView(&umbra_mask_view));
@@ -315,8 +318,14 @@ impl PenumbraWedges {
             &[gpu.uniform_layout(), gpu.gbuffer_layout(), &blend_layout],
         );
         let umbra_mask_pipeline = umbra_mask_pipeline(gpu, &blend_module);
-        let resolve =
-            ScreenPass::new(setup, NAME, "wedges_resolve", (&blend_module, "wedges_resolve"), Some(&blend_layout), VISIBILITY_FORMAT.into())?;
+        let resolve = ScreenPass::new(
+            setup,
+            NAME,
+            "wedges_resolve",
+            (&blend_module, "wedges_resolve"),
+            Some(&blend_layout),
+            VISIBILITY_FORMAT.into(),
+        )?;
 
         let adjacency = setup.shared.adjacency(NAME)?;
         let casting = CastingMesh::prepare(adjacency);
@@ -371,7 +380,11 @@ fn check_limits(gpu: &GpuContext) -> Result<()> {
     Ok(())
 }
 
-fn depth_copy(gpu: &GpuContext, depth_view: &wgpu::TextureView, settings: &wgpu::Buffer) -> Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
+fn depth_copy(
+    gpu: &GpuContext,
+    gbuffer: &ssm_core::GBuffer,
+    (settings, camera): (&wgpu::Buffer, &wgpu::Buffer),
+) -> Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
     let device = &gpu.device;
     let layout = bind_group_layout(
         device,
@@ -388,24 +401,38 @@ fn depth_copy(gpu: &GpuContext, depth_view: &wgpu::TextureView, settings: &wgpu:
                 count: None,
             },
             uniform_entry(1),
+            texture_entry(2),
+            texture_entry(3),
+            uniform_entry(4),
         ],
     );
     let group = bind_group(
         device,
         "wedges_depth_copy_bind_group",
         &layout,
-        &[wgpu::BindingResource::TextureView(depth_view), settings.as_entire_binding()],
+        &[
+            wgpu::BindingResource::TextureView(&gbuffer.depth_view),
+            settings.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&gbuffer.position_view),
+            wgpu::BindingResource::TextureView(&gbuffer.normal_view),
+            camera.as_entire_binding(),
+        ],
     );
     let module = create_shader_with_imports(gpu, "wedges_depth_copy_shader", DEPTH_COPY_SHADER, LOCAL_SHADERS)?;
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("wedges_depth_copy_pipeline_layout"),
-        bind_group_layouts: &[Some(&layout)],
+        bind_group_layouts: &[Some(gpu.uniform_layout()), Some(&layout)],
         immediate_size: 0,
     });
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("wedges_depth_copy_pipeline"),
         layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("fullscreen_vertex"), compilation_options: Default::default(), buffers: &[] },
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("fullscreen_vertex"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(wgpu::DepthStencilState {
             format: STENCIL_FORMAT,
@@ -541,7 +568,9 @@ impl MeshPasses {
         let light = gpu.uniform_layout();
         let plain = [light, &mesh_layout];
         let writes_arguments = [light, &mesh_layout, &indirect_layout];
-        let pipeline = |entry: &str, layouts: &[&wgpu::BindGroupLayout]| compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts);
+        let pipeline = |entry: &str, layouts: &[&wgpu::BindGroupLayout]| {
+            compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts)
+        };
         let silhouettes = SilhouettePasses {
             reset: pipeline("wedges_reset", &writes_arguments),
             classify_faces: pipeline("wedges_classify_faces", &plain),
@@ -561,7 +590,8 @@ impl MeshPasses {
         };
 
         let vertex = wgpu::ShaderStages::VERTEX;
-        let volume_layout = bind_group_layout(device, "wedges_volume_layout", &(0..5).map(|b| storage_entry(b, true, vertex)).collect::<Vec<_>>());
+        let volume_layout =
+            bind_group_layout(device, "wedges_volume_layout", &(0..5).map(|b| storage_entry(b, true, vertex)).collect::<Vec<_>>());
         let volume_group = bind_group(
             device,
             "wedges_volume_bind_group",
@@ -583,8 +613,12 @@ impl MeshPasses {
             "wedges_wedge_layout",
             &[storage_entry(0, true, wgpu::ShaderStages::VERTEX_FRAGMENT), uniform_entry(1)],
         );
-        let wedge_group =
-            bind_group(device, "wedges_wedge_bind_group", &wedge_layout, &[half_edges.as_entire_binding(), settings_buffer.as_entire_binding()]);
+        let wedge_group = bind_group(
+            device,
+            "wedges_wedge_bind_group",
+            &wedge_layout,
+            &[half_edges.as_entire_binding(), settings_buffer.as_entire_binding()],
+        );
         let wedge_pipeline = wedge_pipeline(gpu, &wedge_layout)?;
         Ok(Self {
             silhouettes,
@@ -669,7 +703,12 @@ fn wedge_pipeline(gpu: &GpuContext, layout: &wgpu::BindGroupLayout) -> Result<wg
     Ok(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("wedges_wedge_pipeline"),
         layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("wedges_wedge_vertex"), compilation_options: Default::default(), buffers: &[] },
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("wedges_wedge_vertex"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
         primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Front), unclipped_depth: true, ..Default::default() },
         // A surface in front of the back face may be inside; one behind it is not.
         depth_stencil: Some(wgpu::DepthStencilState {
@@ -759,7 +798,8 @@ impl ShadowTechnique for PenumbraWedges {
                 }),
             );
             pass.set_pipeline(&self.depth_copy_pipeline);
-            pass.set_bind_group(0, &self.depth_copy_group, &[]);
+            pass.set_bind_group(0, light_frame, &[]);
+            pass.set_bind_group(1, &self.depth_copy_group, &[]);
             pass.draw(0..3, 0..1);
             self.passes_issued += 1;
         }
@@ -779,9 +819,8 @@ impl ShadowTechnique for PenumbraWedges {
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
         let mut out = vec![("passes".to_owned(), f64::from(self.passes_issued))];
         let Some(mesh) = &self.mesh else { return out };
-        let word = |bytes: &[u8], index: usize| {
-            bytes.get(index * 4..index * 4 + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        };
+        let word =
+            |bytes: &[u8], index: usize| bytes.get(index * 4..index * 4 + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
         if let Ok(counters) = ssm_core::readback::read_buffer(gpu, &mesh.counters, COUNTER_WORDS * 4, "wedges counters") {
             let half_edges = word(&counters, 3);
             out.push(("silhouette_edges".to_owned(), f64::from(half_edges)));
@@ -973,7 +1012,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             imports: LOCAL_SHADERS,
             rust: WedgesSettingsUniform::LAYOUT,
         },
-        UniformCheck { wgsl_struct: "WedgesMesh", wgsl_source: SILHOUETTES_SHADER, imports: LOCAL_SHADERS, rust: WedgesMeshUniform::LAYOUT },
+        UniformCheck {
+            wgsl_struct: "WedgesMesh",
+            wgsl_source: SILHOUETTES_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: WedgesMeshUniform::LAYOUT,
+        },
     ],
 };
 
