@@ -29,9 +29,13 @@ const FACE_TWO_SIDED: u32 = 1u;
 // Face state bits, computed per frame from the light's centre.
 const STATE_PARTICIPATES: u32 = 1u;
 const STATE_REVERSED: u32 = 2u;
-// Wedge record flags (in `flags` of WedgeRecord).
+// Wedge record flags (in `flags` of WedgeRecord): no wedge; a fallback bounded by
+// its screen rectangle; a fallback bounded by the pyramid from its apex (the end
+// nearer the light, a' unless WEDGE_APEX_B) to the far rectangle.
 const WEDGE_EMPTY: u32 = 1u;
 const WEDGE_FALLBACK: u32 = 2u;
+const WEDGE_PYRAMID: u32 = 4u;
+const WEDGE_APEX_B: u32 = 8u;
 
 // The technique's parameters (WedgesSettingsUniform).
 struct WedgesSettings {
@@ -83,25 +87,22 @@ struct EdgeRecord {
 // One silhouette half-edge and its penumbra wedge (Sec. 4.2; Lengyel 2005).
 // `a -> b` is the edge oriented so that its shadow volume (the prism of its
 // face, turned towards the light) lies on the negative side of the plane
-// through the light's centre, a and b. The wedge is split by that plane into
-// an inner half (towards the umbra) and an outer half; each is the convex
-// polyhedron a', b' (the edge clipped to the geometric near plane), and its
-// far points on the plane past the frame's far depth. A fallback wedge keeps
-// in split0, split1, outer0, outer1 the corners of its far rectangle.
+// through the light's centre, a and b (the split plane). The wedge is the
+// convex polyhedron of a', b' (the edge clipped to the geometric near plane)
+// and four far points, on the plane past the frame's far depth, where the
+// inner and outer tangent planes meet the side planes. A fallback wedge keeps
+// instead the four corners of its far rectangle.
 struct WedgeRecord {
     // xyz: a; w: parameter along a -> b where the wedge's spine starts.
     a: vec4<f32>,
     // xyz: b; w: parameter where it ends.
     b: vec4<f32>,
-    // Far points: inner tangent plane, at a's side plane and at b's side plane.
+    // Far points of the inner tangent plane, at a's side plane and at b's (fallback: two corners).
     inner0: vec4<f32>,
     inner1: vec4<f32>,
-    // Far points on the split plane (the shadow-volume side's plane).
-    split0: vec4<f32>,
-    split1: vec4<f32>,
-    // Far points of the outer tangent plane.
+    // Far points of the outer tangent plane (fallback: the other two corners).
     outer0: vec4<f32>,
-    // xyz: the last far point; w: flags (bitcast u32: WEDGE_EMPTY, WEDGE_FALLBACK).
+    // xyz: the last far point; w: flags (bitcast u32: WEDGE_EMPTY, WEDGE_FALLBACK, WEDGE_PYRAMID, WEDGE_APEX_B).
     outer1: vec4<f32>,
 };
 

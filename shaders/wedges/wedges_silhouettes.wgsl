@@ -399,12 +399,15 @@ fn flag_record(record: ptr<function, WedgeRecord>, flags: u32) {
 }
 
 // The fallback bound of a wedge whose planes degenerate: the convex hull of
-// the clipped edge a1 b1 and the rectangle (along the light's axes, on the far
-// plane) that bounds the far sections of the cones of rays from the light's
-// corners through a1 and through b1. Every ray from the light through the
-// edge lies in that hull, so its screen-space bounding box (drawn by the
-// vertex stage) covers every pixel the wedge can touch; the fragments then
-// decide exactly, without the bounding-plane test.
+// the clipped edge a1 b1 and the rectangle R (along the light's axes, on the
+// far plane) that bounds the far sections of the cones of rays from the
+// light's corners through a1 and through b1. Every ray from the light through
+// the edge lies in that hull. When the end farther from the light lies inside
+// the pyramid from the nearer end (the apex) to R, as it does whenever the
+// edge's line crosses the light (the edge continues a ray from the light), the
+// hull is that pyramid: drawn with its four side planes as the bounding
+// planes. Otherwise the vertex stage draws the hull's screen-space bounding
+// box, and the fragments decide exactly.
 fn fallback_wedge(record: ptr<function, WedgeRecord>, a1: vec3<f32>, b1: vec3<f32>, corners: array<vec3<f32>, 4>, far_depth: f32) {
     let c = frame.centre.xyz;
     let n = frame.normal.xyz;
@@ -421,12 +424,33 @@ fn fallback_wedge(record: ptr<function, WedgeRecord>, a1: vec3<f32>, b1: vec3<f3
         low = min(low, min(vec2<f32>(dot(through_a, u), dot(through_a, v)), vec2<f32>(dot(through_b, u), dot(through_b, v))));
         high = max(high, max(vec2<f32>(dot(through_a, u), dot(through_a, v)), vec2<f32>(dot(through_b, u), dot(through_b, v))));
     }
+    // A little slack, so that the other end on the pyramid's surface counts as inside.
+    let slack = scene_length(frame, 1e-5);
+    low -= vec2<f32>(slack);
+    high += vec2<f32>(slack);
     let base = c + n * far_depth;
-    (*record).split0 = vec4<f32>(base + low.x * u + low.y * v, 0.0);
-    (*record).split1 = vec4<f32>(base + high.x * u + low.y * v, 0.0);
-    (*record).outer0 = vec4<f32>(base + high.x * u + high.y * v, 0.0);
-    (*record).outer1 = vec4<f32>(base + low.x * u + high.y * v, 0.0);
-    flag_record(record, WEDGE_FALLBACK);
+    let rectangle = array<vec3<f32>, 4>(
+        base + low.x * u + low.y * v, base + high.x * u + low.y * v, base + high.x * u + high.y * v, base + low.x * u + high.y * v,
+    );
+    (*record).inner0 = vec4<f32>(rectangle[0], 0.0);
+    (*record).inner1 = vec4<f32>(rectangle[1], 0.0);
+    (*record).outer0 = vec4<f32>(rectangle[2], 0.0);
+    (*record).outer1 = vec4<f32>(rectangle[3], 0.0);
+    let apex_is_b = depth_b < depth_a;
+    let apex = select(a1, b1, apex_is_b);
+    let other = select(b1, a1, apex_is_b);
+    let inside = (rectangle[0] + rectangle[1] + rectangle[2] + rectangle[3]) * 0.25;
+    var in_pyramid = true;
+    for (var k = 0u; k < 4u; k += 1u) {
+        var normal = cross(rectangle[k] - apex, rectangle[(k + 1u) % 4u] - apex);
+        if (dot(normal, inside - apex) < 0.0) {
+            normal = -normal;
+        }
+        if (dot(normal, other - apex) < -1e-6 * length(normal) * length(other - apex)) {
+            in_pyramid = false;
+        }
+    }
+    flag_record(record, WEDGE_FALLBACK | select(0u, WEDGE_PYRAMID, in_pyramid) | select(0u, WEDGE_APEX_B, apex_is_b));
     atomicAdd(&counters.fallback_wedges, 1u);
 }
 
@@ -565,8 +589,6 @@ fn build_wedge(a: vec3<f32>, b: vec3<f32>) -> WedgeRecord {
     }
     record.inner0 = vec4<f32>(m0.point, 0.0);
     record.inner1 = vec4<f32>(m1.point, 0.0);
-    record.split0 = vec4<f32>(m2.point, 0.0);
-    record.split1 = vec4<f32>(m3.point, 0.0);
     record.outer0 = vec4<f32>(m4.point, 0.0);
     record.outer1 = vec4<f32>(m5.point, 0.0);
     flag_record(&record, 0u);

@@ -42,8 +42,10 @@
 @group(3) @binding(0) var gbuffer_position: texture_2d<f32>;
 @group(3) @binding(1) var gbuffer_normal: texture_2d<f32>;
 
-// Fragment kind: a fallback wedge (no bounding planes).
+// Fragment kinds: a fallback wedge drawn as a screen rectangle (no bounding planes); a
+// fallback pyramid (four bounding planes, all tested).
 const KIND_FALLBACK: u32 = 2u;
+const KIND_PYRAMID: u32 = 4u;
 
 struct WedgeVarying {
     @builtin(position) clip: vec4<f32>,
@@ -88,6 +90,12 @@ const WEDGE_TRIANGLES = array<vec3<u32>, 8>(
 
 const NO_PLANE = vec4<f32>(0.0, 0.0, 0.0, -1e30);
 
+// Corners (into apex, R0, R1, R2, R3) of the six triangles of a fallback pyramid.
+const PYRAMID_TRIANGLES = array<vec3<u32>, 6>(
+    vec3<u32>(0u, 1u, 2u), vec3<u32>(0u, 2u, 3u), vec3<u32>(0u, 3u, 4u), vec3<u32>(0u, 4u, 1u),
+    vec3<u32>(1u, 2u, 3u), vec3<u32>(1u, 3u, 4u),
+);
+
 @vertex
 fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
     let index = vertex / WEDGE_VERTICES;
@@ -109,12 +117,34 @@ fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
     }
     let a = record.a.xyz;
     let b = record.b.xyz;
+    if ((flags & WEDGE_PYRAMID) != 0u) {
+        // The pyramid from the apex to the far rectangle: its four side planes bound it.
+        out.kind = KIND_PYRAMID;
+        let apex = select(mix(a, b, record.a.w), mix(a, b, record.b.w), (flags & WEDGE_APEX_B) != 0u);
+        let pyramid = array<vec3<f32>, 5>(apex, record.inner0.xyz, record.inner1.xyz, record.outer0.xyz, record.outer1.xyz);
+        let centroid = (apex + pyramid[1] + pyramid[2] + pyramid[3] + pyramid[4]) * 0.2;
+        if (triangle < 6u) {
+            var corners = PYRAMID_TRIANGLES[triangle];
+            let p0 = pyramid[corners.x];
+            let p1 = pyramid[corners.y];
+            let p2 = pyramid[corners.z];
+            if (dot(cross(p1 - p0, p2 - p0), (p0 + p1 + p2) / 3.0 - centroid) < 0.0) {
+                corners = corners.xzy;
+            }
+            out.clip = camera.view_proj * vec4<f32>(pyramid[corners[corner]], 1.0);
+        }
+        out.inner = oriented_plane(apex, pyramid[1], pyramid[2], centroid);
+        out.outer = oriented_plane(apex, pyramid[2], pyramid[3], centroid);
+        out.side0 = oriented_plane(apex, pyramid[3], pyramid[4], centroid);
+        out.side1 = oriented_plane(apex, pyramid[4], pyramid[1], centroid);
+        return out;
+    }
     if ((flags & WEDGE_FALLBACK) != 0u) {
         out.kind = KIND_FALLBACK;
         // The screen-space bounding box of the fallback hull: the clipped edge and the far rectangle.
         if (triangle < 2u) {
             let hull = array<vec3<f32>, 6>(
-                mix(a, b, record.a.w), mix(a, b, record.b.w), record.split0.xyz, record.split1.xyz, record.outer0.xyz, record.outer1.xyz,
+                mix(a, b, record.a.w), mix(a, b, record.b.w), record.inner0.xyz, record.inner1.xyz, record.outer0.xyz, record.outer1.xyz,
             );
             var low = vec2<f32>(1.0);
             var high = vec2<f32>(-1.0);
@@ -300,8 +330,10 @@ fn wedges_wedge_fragment(in: WedgeVarying) -> WedgeTargets {
     }
     // Lengyel's quick rejection: outside any of the half-wedge's three bounding planes.
     let tolerance = scene_length(frame, settings.plane_tolerance);
+    let pyramid = in.kind == KIND_PYRAMID;
     let bound = select(in.outer, in.inner, inner);
-    if (outside(bound, p, tolerance) || outside(in.side0, p, tolerance) || outside(in.side1, p, tolerance)) {
+    if (outside(bound, p, tolerance) || outside(in.side0, p, tolerance) || outside(in.side1, p, tolerance)
+        || (pyramid && outside(select(in.inner, in.outer, inner), p, tolerance))) {
         discard;
     }
     let n = frame.normal.xyz;
@@ -327,7 +359,11 @@ fn wedges_wedge_fragment(in: WedgeVarying) -> WedgeTargets {
     // The same affine clip on the depth: depth_a + t (depth_b - depth_a) >= near, along the segment
     // as clipped so far (W = depth_p - depth, so depth = depth_p - W).
     segment = clip_segment(segment, depth_p - segment.h0.z - near, depth_p - segment.h1.z - near);
-    if (!segment.ok) {
+    // Outside the wedge proper: the projected edge misses the light (both ends beyond one border).
+    let h0 = segment.h0;
+    let h1 = segment.h1;
+    if (!segment.ok || (h0.x > h0.z && h1.x > h1.z) || (h0.x < -h0.z && h1.x < -h1.z) || (h0.y > h0.z && h1.y > h1.z)
+        || (h0.y < -h0.z && h1.y < -h1.z)) {
         discard;
     }
     let sign = select(1.0, -1.0, inner);

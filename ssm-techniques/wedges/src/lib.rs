@@ -27,6 +27,7 @@
 //! No CPU work per frame depends on the triangle count.
 
 mod mesh;
+pub mod scenes;
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
@@ -76,7 +77,7 @@ pub const SILHOUETTE_TARGETS: usize = 8;
 /// Bytes per pixel of the silhouette buffer's targets.
 const SILHOUETTE_BYTES: u32 = 7 * 16 + 4;
 /// Bytes of one silhouette half-edge with its wedge (`WedgeRecord`).
-pub const WEDGE_RECORD_BYTES: u64 = 128;
+pub const WEDGE_RECORD_BYTES: u64 = 96;
 /// Threads per compute workgroup (`WORKGROUP`).
 const WORKGROUP: u32 = 256;
 /// u32s of the counters (`Counters`): eight scalars and six arrays of [`MAX_SILHOUETTE_BUFFERS`].
@@ -864,6 +865,7 @@ fn silhouette_loops(gpu: &GpuContext, half_edges: &wgpu::Buffer, count: u32) -> 
         x
     }
     for record in bytes.chunks_exact(WEDGE_RECORD_BYTES as usize) {
+        // a and b: the first two vec4s.
         let floats: &[f32] = bytemuck::cast_slice(&record[..32]);
         let a = id_of([floats[0], floats[1], floats[2]], &mut parent);
         let b = id_of([floats[4], floats[5], floats[6]], &mut parent);
@@ -986,6 +988,7 @@ const PRESETS: &[Preset] = &[
             "ssm-techniques/wedges/scenes/spheres-27.toml",
             "ssm-techniques/wedges/scenes/spheres-64.toml",
             "ssm-techniques/wedges/scenes/spheres-125.toml",
+            "ssm-techniques/wedges/scenes/spheres-216.toml",
             "ssm-techniques/wedges/scenes/spheres-343.toml",
         ],
         varies: &["wedges.blending=none,forest"],

@@ -73,6 +73,12 @@ pub struct CastingMesh {
     pub report: MeshReport,
 }
 
+/// An undirected edge: its welded vertices, smaller first.
+type EdgeKey = (u32, u32);
+
+/// One face's traversal of an edge: from, to, face.
+type Incidence = (u32, u32, u32);
+
 /// Union–find over faces, for the connected components.
 struct Components {
     parent: Vec<u32>,
@@ -108,8 +114,8 @@ impl CastingMesh {
         let face_count = adjacency.triangles.len();
         let mut report = MeshReport { faces: face_count, ..MeshReport::default() };
         // Every directed edge (from, to, face), grouped by undirected key in first-seen order.
-        let mut order: Vec<(u32, u32)> = Vec::new();
-        let mut incidences: HashMap<(u32, u32), Vec<(u32, u32, u32)>> = HashMap::new();
+        let mut order: Vec<EdgeKey> = Vec::new();
+        let mut incidences: HashMap<EdgeKey, Vec<Incidence>> = HashMap::new();
         for (face, triangle) in adjacency.triangles.iter().enumerate() {
             if triangle[0] == triangle[1] || triangle[1] == triangle[2] || triangle[2] == triangle[0] {
                 report.collapsed_faces += 1;
