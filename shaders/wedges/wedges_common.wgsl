@@ -55,7 +55,7 @@ struct WedgesSettings {
     _pad2: f32,
 };
 
-// The casting mesh's sizes (WedgesMeshUniform).
+// The casting mesh's sizes and the scene's bounds (WedgesMeshUniform).
 struct WedgesMesh {
     face_count: u32,
     record_count: u32,
@@ -65,6 +65,9 @@ struct WedgesMesh {
     height: u32,
     _pad0: u32,
     _pad1: u32,
+    // The scene's bounding box, enlarged by a margin (w unused): wedges are cut at its faces.
+    bounds_min: vec4<f32>,
+    bounds_max: vec4<f32>,
 };
 
 // One triangle of the welded casting mesh (Requirements::adjacency).

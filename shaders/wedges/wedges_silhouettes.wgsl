@@ -454,6 +454,52 @@ fn fallback_wedge(record: ptr<function, WedgeRecord>, a1: vec3<f32>, b1: vec3<f3
     atomicAdd(&counters.fallback_wedges, 1u);
 }
 
+// The plane that closes a wedge far from the light. Every receiver lies in the
+// scene's bounding box, so any of its face planes cuts the wedge without
+// losing a receiver: the face that the wedge's central ray leaves the box by,
+// when all four of the wedge's lateral edges run towards it (the far section
+// is then a quadrilateral), else the plane past the frame's far depth. With a
+// tilted light over a wide ground, this stops the wedges at the ground instead
+// of far below it, where every ground pixel above them would run a fragment.
+fn truncation(a1: vec3<f32>, b1: vec3<f32>, planes: array<Plane, 4>, far_depth: f32) -> Plane {
+    let c = frame.centre.xyz;
+    let n = frame.normal.xyz;
+    // The lateral edges: tangent plane x side plane, pointed away from the light.
+    var lateral = array<vec3<f32>, 4>(
+        cross(planes[0].normal, planes[2].normal), cross(planes[0].normal, planes[3].normal),
+        cross(planes[1].normal, planes[2].normal), cross(planes[1].normal, planes[3].normal),
+    );
+    for (var k = 0u; k < 4u; k += 1u) {
+        if (dot(lateral[k], n) < 0.0) {
+            lateral[k] = -lateral[k];
+        }
+    }
+    let middle = (a1 + b1) * 0.5;
+    let direction = middle - c;
+    var best = Plane(n, dot(n, c) + far_depth);
+    var best_t = 3.4e38;
+    for (var axis = 0u; axis < 3u; axis += 1u) {
+        for (var side = 0u; side < 2u; side += 1u) {
+            var normal = vec3<f32>(0.0);
+            normal[axis] = select(-1.0, 1.0, side == 1u);
+            let offset = select(-mesh.bounds_min[axis], mesh.bounds_max[axis], side == 1u);
+            var towards = dot(normal, direction) > 0.0;
+            for (var k = 0u; k < 4u; k += 1u) {
+                towards = towards && dot(normal, lateral[k]) > 1e-6 * length(lateral[k]);
+            }
+            if (towards) {
+                // Where the central ray from the light's centre leaves the box by this face.
+                let t = (offset - dot(normal, c)) / dot(normal, direction);
+                if (t > 1.0 && t < best_t) {
+                    best_t = t;
+                    best = Plane(normal, offset);
+                }
+            }
+        }
+    }
+    return best;
+}
+
 // The penumbra wedge of silhouette edge a -> b (Akenine-Möller and Assarsson
 // 2002, Sec. 4; Lengyel 2005's bounding planes): the edge is clipped to the
 // geometric near plane (depth `near` in front of the light); its front and
@@ -566,7 +612,7 @@ fn build_wedge(a: vec3<f32>, b: vec3<f32>) -> WedgeRecord {
             ok = false;
         }
     }
-    let far = Plane(n, dot(n, c) + far_depth);
+    let far = truncation(a1, b1, array<Plane, 4>(inner_plane, outer_plane, side0, side1), far_depth);
     let m0 = meet(inner_plane, side0, far);
     let m1 = meet(inner_plane, side1, far);
     let m2 = meet(split, side0, far);

@@ -158,11 +158,18 @@ pub struct WedgesMeshUniform {
     height: u32,
     _pad0: u32,
     _pad1: u32,
+    bounds_min: [f32; 4],
+    bounds_max: [f32; 4],
 }
 
+/// Margin of the scene's box that cuts the wedges, as a fraction of its diagonal: receivers on
+/// its faces stay strictly inside.
+const BOUNDS_MARGIN: f32 = 1e-3;
+
 impl WedgesMeshUniform {
-    fn new(mesh: &CastingMesh, width: u32, height: u32) -> Self {
+    fn new(mesh: &CastingMesh, (width, height): (u32, u32), bounds: &ssm_scene::Aabb) -> Self {
         let face_count = mesh.faces.len() as u32;
+        let margin = glam::Vec3::splat(bounds.size().length() * BOUNDS_MARGIN);
         Self {
             face_count,
             record_count: mesh.records.len() as u32,
@@ -172,6 +179,8 @@ impl WedgesMeshUniform {
             height,
             _pad0: 0,
             _pad1: 0,
+            bounds_min: (bounds.min - margin).extend(0.0).to_array(),
+            bounds_max: (bounds.max + margin).extend(0.0).to_array(),
         }
     }
 }
@@ -333,7 +342,7 @@ impl PenumbraWedges {
         let mesh = if casting.faces.is_empty() {
             None
         } else {
-            let uniform = WedgesMeshUniform::new(&casting, width, height);
+            let uniform = WedgesMeshUniform::new(&casting, (width, height), &setup.scene.bounds);
             Some(MeshPasses::new(setup, &casting, uniform, (&settings_buffer, &indirect))?)
         };
         Ok(Self {
