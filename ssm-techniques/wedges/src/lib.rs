@@ -971,7 +971,9 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
     })
 }
 
-/// Forest et al.'s and Atty et al.'s studies, as sweeps.
+/// Forest et al.'s and Atty et al.'s studies, as sweeps. The sphere scenes are this crate's
+/// manifests (`scenes/`), named by absolute path so that the presets run from any directory
+/// (the CLI, the preset benches).
 const PRESETS: &[Preset] = &[
     Preset {
         name: "wedges-fig1",
@@ -992,16 +994,30 @@ const PRESETS: &[Preset] = &[
         name: "wedges-fig12",
         summary: "Forest et al., Fig. 12: frame time of none and forest; one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles)",
         scenes: &[
-            "ssm-techniques/wedges/scenes/spheres-1.toml",
-            "ssm-techniques/wedges/scenes/spheres-8.toml",
-            "ssm-techniques/wedges/scenes/spheres-27.toml",
-            "ssm-techniques/wedges/scenes/spheres-64.toml",
-            "ssm-techniques/wedges/scenes/spheres-125.toml",
-            "ssm-techniques/wedges/scenes/spheres-216.toml",
-            "ssm-techniques/wedges/scenes/spheres-343.toml",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-1.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-8.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-27.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-64.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-125.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-216.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-343.toml"),
         ],
         varies: &["wedges.blending=none,forest"],
         y_axis: "time",
+        ..Preset::DEFAULT
+    },
+    Preset {
+        name: "wedges-atty-fig25",
+        summary: "Atty et al., Fig. 25: soft shadow volumes (wedges, forest) against soft shadow maps (atty two-sided, 210² occluder map) as polygons grow; one scene per sphere count, time against error (the fig12 example sweeps them all)",
+        scenes: &[
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-8.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-27.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-64.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-125.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-216.toml"),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-343.toml"),
+        ],
+        varies: &["wedges.blending=forest", "atty.two_sided=true", "atty.occluder_map_size=210"],
         ..Preset::DEFAULT
     },
 ];
