@@ -1,0 +1,144 @@
+// Penumbra wedges (Akenine-Möller and Assarsson 2002, Assarsson and
+// Akenine-Möller 2003) with Forest, Barthe and Paulin's blending of
+// overlapping penumbrae (Graphics Hardware 2006): what every wedges shader
+// shares. The buffers' layouts are those of ssm-techniques/wedges/src/lib.rs.
+
+// #import common/light_frame.wgsl
+
+// No face: the second face of an edge record used by one face only.
+const NO_FACE: u32 = 0xffffffffu;
+// Threads per workgroup of every compute pass.
+const WORKGROUP: u32 = 256u;
+// Most silhouette buffers (Forest et al., Sec. 3: one per silhouette; here
+// silhouettes are grouped round-robin into at most this many).
+const MAX_SILHOUETTE_BUFFERS: u32 = 64u;
+// Vertices drawn per silhouette half-edge: a shadow-volume side quad (two
+// triangles), and a penumbra wedge (eight triangles); per cap face, the near
+// and far caps.
+const SIDE_VERTICES: u32 = 6u;
+const CAP_VERTICES: u32 = 6u;
+const WEDGE_VERTICES: u32 = 24u;
+// u32 offset of the first group's draw arguments in the indirect buffer (after two dispatches).
+const DRAW_ARGUMENTS: u32 = 8u;
+// u32s of indirect arguments per group: draws of the sides, caps and wedges, and the blend's dispatch.
+const GROUP_ARGUMENTS: u32 = 16u;
+
+// Face flag: the face's connected component is not a closed, consistently
+// wound manifold, so its faces are two-sided (each faces the light).
+const FACE_TWO_SIDED: u32 = 1u;
+// Face state bits, computed per frame from the light's centre.
+const STATE_PARTICIPATES: u32 = 1u;
+const STATE_REVERSED: u32 = 2u;
+// Wedge record flags (in `flags` of WedgeRecord): no wedge; a fallback bounded by
+// its screen rectangle; a fallback bounded by the pyramid from its apex (the end
+// nearer the light, a' unless WEDGE_APEX_B) to the far rectangle.
+const WEDGE_EMPTY: u32 = 1u;
+const WEDGE_FALLBACK: u32 = 2u;
+const WEDGE_PYRAMID: u32 = 4u;
+const WEDGE_APEX_B: u32 = 8u;
+
+// The technique's parameters (WedgesSettingsUniform).
+struct WedgesSettings {
+    // 0: none, the silhouettes' occlusions summed (Akenine-Möller and Assarsson); 1: Forest et al.'s blending.
+    blending: u32,
+    // Silhouette buffers K: silhouette regions are blended in K groups.
+    silhouette_buffers: u32,
+    _pad0: u32,
+    _pad1: u32,
+    // Depth in front of the light's plane below which silhouette edges are clipped (the
+    // geometric near plane), and the local near plane's offset, as fractions of the scene's diagonal.
+    near_fraction: f32,
+    // Slack of Lengyel's bounding-plane rejection, a fraction of the scene's diagonal.
+    plane_tolerance: f32,
+    // Camera depth the G-buffer's is moved by, to the surface's side facing the light, when it is copied for the volumes (NDC units).
+    depth_bias: f32,
+    _pad2: f32,
+};
+
+// The casting mesh's sizes and the scene's bounds (WedgesMeshUniform).
+struct WedgesMesh {
+    face_count: u32,
+    record_count: u32,
+    half_edge_capacity: u32,
+    rank_blocks: u32,
+    width: u32,
+    height: u32,
+    _pad0: u32,
+    _pad1: u32,
+    // The scene's bounding box, enlarged by a margin (w unused): wedges are cut at its faces.
+    bounds_min: vec4<f32>,
+    bounds_max: vec4<f32>,
+};
+
+// One triangle of the welded casting mesh (Requirements::adjacency).
+struct Face {
+    v0: u32,
+    v1: u32,
+    v2: u32,
+    flags: u32,
+};
+
+// One edge incidence: `v0 -> v1` is the edge as `face_a` winds it; `face_b`,
+// when present, winds it `v1 -> v0` (a manifold, consistently wound edge).
+struct EdgeRecord {
+    v0: u32,
+    v1: u32,
+    face_a: u32,
+    face_b: u32,
+};
+
+// One silhouette half-edge and its penumbra wedge (Sec. 4.2; Lengyel 2005).
+// `a -> b` is the edge oriented so that its shadow volume (the prism of its
+// face, turned towards the light) lies on the negative side of the plane
+// through the light's centre, a and b (the split plane). The wedge is the
+// convex polyhedron of a', b' (the edge clipped to the geometric near plane)
+// and four far points, on the plane past the frame's far depth, where the
+// inner and outer tangent planes meet the side planes. A fallback wedge keeps
+// instead the four corners of its far rectangle.
+struct WedgeRecord {
+    // xyz: a; w: parameter along a -> b where the wedge's spine starts.
+    a: vec4<f32>,
+    // xyz: b; w: parameter where it ends.
+    b: vec4<f32>,
+    // Far points of the inner tangent plane, at a's side plane and at b's (fallback: two corners).
+    inner0: vec4<f32>,
+    inner1: vec4<f32>,
+    // Far points of the outer tangent plane (fallback: the other two corners).
+    outer0: vec4<f32>,
+    // xyz: the last far point; w: flags (bitcast u32: WEDGE_EMPTY, WEDGE_FALLBACK, WEDGE_PYRAMID, WEDGE_APEX_B).
+    outer1: vec4<f32>,
+};
+
+// The frame's counters (a storage buffer cleared by the reset pass).
+struct Counters {
+    // Set by a hook pass that linked two labels.
+    changed: atomic<u32>,
+    // Label-propagation rounds that linked anything.
+    rounds: atomic<u32>,
+    // Silhouette regions (connected sets of faces turned to the light).
+    regions: u32,
+    // Silhouette half-edges emitted, cap faces emitted.
+    half_edges: u32,
+    caps: u32,
+    // Wedges drawn as a full-screen fallback (degenerate geometry).
+    fallback_wedges: atomic<u32>,
+    // Groups with anything in them.
+    groups_used: u32,
+    _pad0: u32,
+    edge_count: array<atomic<u32>, 64>,
+    edge_cursor: array<atomic<u32>, 64>,
+    cap_count: array<atomic<u32>, 64>,
+    cap_cursor: array<atomic<u32>, 64>,
+    edge_offset: array<u32, 64>,
+    cap_offset: array<u32, 64>,
+};
+
+// The light's centre.
+fn light_centre(frame: LightFrame) -> vec3<f32> {
+    return frame.centre.xyz;
+}
+
+// A point at infinity in the direction from the light's centre through `p`, in clip space.
+fn clip_at_infinity(view_proj: mat4x4<f32>, frame: LightFrame, p: vec3<f32>) -> vec4<f32> {
+    return view_proj * vec4<f32>(p - frame.centre.xyz, 0.0);
+}

@@ -1,0 +1,196 @@
+//! Forest et al., Fig. 12 (and Atty et al., Fig. 25): frame time against the
+//! number of triangles, for `wedges` with `blending=none` and `forest`, and
+//! Atty et al.'s soft shadow maps (two-sided, 210² occluder map, as in their
+//! Fig. 25), on cubes of 1 to 343 spheres of 760 triangles.
+//!
+//! ```sh
+//! cargo run --release -p ssm-wedges --example fig12 -- --out out/fig12 [--size 320x240] [--frames 5] \
+//!     [--sides 1,2,3,4,5,6,7] [--error] [--write-scenes]
+//! ```
+//!
+//! The three are timed in turns, frame by frame after a warm-up round, so that
+//! a drift of the machine's speed affects them alike. Writes `results.csv`
+//! (triangles, technique, median GPU ms, silhouette edges, wedge fragments,
+//! the mean time of each pass, and with `--error` the penumbra MAE and mean
+//! signed penumbra error against a 16×16-ray ground truth), `time.png`/`.svg`
+//! (time against triangles) and `ratio.png`/`.svg` (forest ÷ none). With
+//! `--write-scenes` it (re)writes the `wedges-fig12` preset's manifests in
+//! `ssm-techniques/wedges/scenes/` and exits.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use ssm_bench::report::measure;
+use ssm_bench::sweep::{PlotAxes, PlotPoint, plot};
+use ssm_core::metrics::{ShadowClass, classify, compare};
+use ssm_core::{GpuContext, Renderer, Requirements};
+use ssm_wedges::scenes::{FIG12_SIDES, PAPER_RINGS, PAPER_SEGMENTS, fig12_manifest, paper_sphere_obj, sphere_cube};
+
+/// One measured series: its label, the technique, and its settings.
+type Run = (&'static str, &'static str, &'static [(&'static str, &'static str)]);
+
+struct Options {
+    out: PathBuf,
+    size: (u32, u32),
+    frames: u32,
+    sides: Vec<u32>,
+    error: bool,
+    write_scenes: bool,
+}
+
+fn options() -> Result<Options> {
+    let mut options = Options {
+        out: PathBuf::from("out/fig12"),
+        size: (320, 240),
+        frames: 5,
+        sides: FIG12_SIDES.to_vec(),
+        error: false,
+        write_scenes: false,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = || args.next().with_context(|| format!("{arg} needs a value"));
+        match arg.as_str() {
+            "--out" => options.out = PathBuf::from(value()?),
+            "--size" => {
+                let text = value()?;
+                let (w, h) = text.split_once('x').with_context(|| format!("--size {text}: expected WxH"))?;
+                options.size = (w.parse()?, h.parse()?);
+            }
+            "--frames" => options.frames = value()?.parse()?,
+            "--sides" => options.sides = value()?.split(',').map(str::parse).collect::<Result<_, _>>()?,
+            "--error" => options.error = true,
+            "--write-scenes" => options.write_scenes = true,
+            other => bail!("unknown argument {other}"),
+        }
+    }
+    Ok(options)
+}
+
+/// Mean signed error over the reference's penumbra (negative: too dark), and the penumbra MAE.
+fn errors(truth: &[f32], image: &[f32], covered: &[bool], (width, height): (u32, u32)) -> (f64, f64) {
+    let classes = classify(truth, covered);
+    let signed: Vec<f64> = classes
+        .iter()
+        .zip(image)
+        .zip(truth)
+        .filter(|((class, _), _)| **class == ShadowClass::Penumbra)
+        .map(|((_, v), r)| f64::from(v - r))
+        .collect();
+    let mae = compare(truth, image, covered, width as usize, height as usize).mae_penumbra;
+    (signed.iter().sum::<f64>() / signed.len().max(1) as f64, mae)
+}
+
+fn main() -> Result<()> {
+    let options = options()?;
+    if options.write_scenes {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        std::fs::create_dir_all(&dir)?;
+        std::fs::write(dir.join("sphere-760.obj"), paper_sphere_obj())?;
+        for side in FIG12_SIDES {
+            std::fs::write(dir.join(format!("spheres-{}.toml", side * side * side)), fig12_manifest(side))?;
+        }
+        println!("wrote {}", dir.display());
+        return Ok(());
+    }
+    let registry = ssm_bench::registry()?;
+    let gpu = GpuContext::new()?;
+    std::fs::create_dir_all(&options.out)?;
+    let runs: [Run; 3] = [
+        ("wedges none", "wedges", &[("blending", "none")]),
+        ("wedges forest", "wedges", &[("blending", "forest")]),
+        ("atty two-sided 210²", "atty", &[("two_sided", "true"), ("occluder_map_size", "210")]),
+    ];
+    let mut csv = String::from(
+        "spheres,triangles,technique,width,height,gpu_ms_median,silhouette_edges,wedge_fragments,mae_penumbra,mean_signed_penumbra,pass_ms_means,adapter\n",
+    );
+    let mut time_points = Vec::new();
+    let mut ratio_points = Vec::new();
+    for &side in &options.sides {
+        let scene = sphere_cube(side, PAPER_SEGMENTS, PAPER_RINGS);
+        let triangles = scene.triangle_count() - 2;
+        let spheres = side * side * side;
+        let mut needs = Requirements { gbuffer: true, ..Requirements::NONE };
+        let mut params = Vec::new();
+        for (_, name, settings) in &runs {
+            let info = registry.get(name)?;
+            let values = info.params_from(settings.iter().copied())?;
+            needs = needs.union((info.requirements)(&values)?);
+            params.push((info, values));
+        }
+        let mut renderer = Renderer::new(&gpu, &scene, options.size.0, options.size.1, &needs)?;
+        let truth = if options.error {
+            let values = ssm_core::reference::INFO.params_from([("samples", "16")])?;
+            Some(measure(&mut renderer, &ssm_core::reference::INFO, &values, 1)?.visibility.swap_remove(0))
+        } else {
+            None
+        };
+
+        let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
+        // none and forest alternate frame by frame, so that a drift of the machine's speed
+        // affects both alike (their ratio is the figure's point); atty is timed after them.
+        let mut instances = params.iter().map(|(info, values)| renderer.create_technique(info, values)).collect::<Result<Vec<_>, _>>()?;
+        let mut frame_times: Vec<Vec<f64>> = vec![Vec::new(); runs.len()];
+        let mut pass_times: Vec<Vec<(String, f64)>> = vec![Vec::new(); runs.len()];
+        for round in 0..=options.frames {
+            for (k, ((info, _), technique)) in params.iter().zip(&mut instances).enumerate() {
+                let timings = renderer.render(technique.as_mut(), info.name)?;
+                // The first round is the warm-up: pipelines compile on first use.
+                if round > 0 {
+                    frame_times[k].push(timings.gpu_ms.unwrap_or(f64::NAN));
+                    pass_times[k].extend(timings.passes.iter().map(|p| (p.name.clone(), p.ms)));
+                }
+            }
+        }
+        let mut times = Vec::new();
+        for (k, ((label, _, _), (info, _))) in runs.iter().zip(&params).enumerate() {
+            let technique = &mut instances[k];
+            renderer.render(technique.as_mut(), info.name)?;
+            let visibility = renderer.read_visibility(0, info.name)?;
+            let diagnostics = technique.diagnostics(&gpu);
+            let ms = ssm_bench::median(&frame_times[k]).unwrap_or(f64::NAN);
+            let diagnostic = |name: &str| diagnostics.iter().find(|(n, _)| n == name).map_or(String::new(), |(_, v)| v.to_string());
+            let (signed, mae) = truth.as_ref().map_or((f64::NAN, f64::NAN), |t| errors(t, &visibility, &covered, options.size));
+            let mut passes: Vec<(String, f64)> = Vec::new();
+            for (name, ms) in &pass_times[k] {
+                match passes.iter_mut().find(|(n, _)| n == name) {
+                    Some((_, total)) => *total += ms,
+                    None => passes.push((name.clone(), *ms)),
+                }
+            }
+            let frames = frame_times[k].len().max(1) as f64;
+            let passes = passes.iter().map(|(n, t)| format!("{n}={:.1}", t / frames)).collect::<Vec<_>>().join(";");
+            let _ = writeln!(
+                csv,
+                "{spheres},{triangles},{label},{},{},{ms:.3},{},{},{mae:.5},{signed:.5},{passes},\"{}\"",
+                options.size.0,
+                options.size.1,
+                diagnostic("silhouette_edges"),
+                diagnostic("wedge_fragments"),
+                gpu.describe()
+            );
+            println!(
+                "{spheres:4} spheres, {triangles:7} triangles, {label:22}: {ms:9.1} ms  MAE {mae:.4}  signed {signed:+.4}  ({passes})"
+            );
+            time_points.push(PlotPoint { series: (*label).to_owned(), x: triangles as f64, y: ms, label: String::new() });
+            times.push(ms);
+        }
+        if let [none, forest, ..] = times[..] {
+            println!("{spheres:4} spheres: forest / none = {:.3}", forest / none);
+            ratio_points.push(PlotPoint {
+                series: "forest / none".into(),
+                x: triangles as f64,
+                y: forest / none,
+                label: format!("{:.2}", forest / none),
+            });
+        }
+        std::fs::write(options.out.join("results.csv"), &csv)?;
+    }
+    let axes = |y: &str| PlotAxes { x_label: "triangles".into(), y_label: y.into(), log_x: true, pareto: false };
+    let title = format!("Forest et al. Fig. 12 / Atty et al. Fig. 25, {}x{}, {}", options.size.0, options.size.1, gpu.info.name);
+    plot(&time_points, &axes("GPU ms per frame"), &title, &options.out.join("time.png"), &options.out.join("time.svg"))?;
+    plot(&ratio_points, &axes("forest time / none time"), &title, &options.out.join("ratio.png"), &options.out.join("ratio.svg"))?;
+    println!("wrote {}", options.out.display());
+    Ok(())
+}
