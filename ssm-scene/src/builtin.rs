@@ -137,8 +137,21 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         name: "sphere-cube",
         summary: "a 5x5x5 cube of small spheres above a plane: overlapping penumbrae (Forest et al., Fig. 1)",
         params: &[
-            BuiltinParam { name: "spheres", doc: "spheres along each side of the cube", default: 5.0, min: 1.0, max: 40.0 },
-            BuiltinParam { name: "segments", doc: "segments around each sphere (half as many rings)", default: 16.0, min: 4.0, max: 256.0 },
+            BuiltinParam {
+                name: "spheres",
+                doc: "spheres along each side of the cube, 0.3 apart (the cube grows)",
+                default: 5.0,
+                min: 1.0,
+                max: 40.0,
+            },
+            BuiltinParam { name: "segments", doc: "segments around each sphere", default: 16.0, min: 3.0, max: 256.0 },
+            BuiltinParam {
+                name: "rings",
+                doc: "rings from pole to pole of each sphere (2·segments·(rings − 1) triangles; 20 and 20 give Forest et al.'s 760)",
+                default: 8.0,
+                min: 2.0,
+                max: 256.0,
+            },
         ],
         build: sphere_cube,
     },
@@ -244,17 +257,14 @@ fn contact() -> Scene {
 
 fn sphere_cube(args: &BuiltinArgs) -> Scene {
     let mut b = SceneBuilder::new("sphere-cube", downward_light(Vec3::new(0.0, 4.5, 0.0), 1.0)).ground(8.0);
-    let (count, segments) = (args.get("spheres") as u32, args.get("segments") as u32);
-    // The cube keeps its 1.2-unit side whatever the count: spheres shrink as they multiply.
-    let spacing = 1.2 / count.saturating_sub(1).max(1) as f32;
-    // 0.11 at the default 5 (0.3 apart), and the same share of the spacing otherwise.
-    let radius = if count == 1 { 0.11 } else { 0.44 / (count - 1) as f32 };
-    let ball = b.mesh(sphere("small-sphere", radius, segments, (segments / 2).max(2)));
+    let (count, segments, rings) = (args.get("spheres") as u32, args.get("segments") as u32, args.get("rings") as u32);
+    let ball = b.mesh(sphere("small-sphere", 0.11, segments, rings));
+    // Spheres 0.3 apart whatever their number: the cube grows with it (Forest et al., Fig. 12).
     let middle = (count as f32 - 1.0) * 0.5;
     for i in 0..count {
         for j in 0..count {
             for k in 0..count {
-                let offset = (Vec3::new(i as f32, j as f32, k as f32) - Vec3::splat(middle)) * spacing;
+                let offset = (Vec3::new(i as f32, j as f32, k as f32) - Vec3::splat(middle)) * 0.3;
                 b.place(format!("sphere-{i}-{j}-{k}"), ball, Mat4::from_translation(Vec3::new(0.0, 1.6, 0.0) + offset), Role::Occluder);
             }
         }
@@ -398,10 +408,12 @@ mod tests {
         let default = builtin("forest").unwrap().build();
         let default_triangles: usize = default.instances.iter().map(|i| default.meshes[i.mesh].indices.len() / 3).sum();
         assert!((default_triangles as f64 - 20_000.0).abs() < 200.0, "{default_triangles}");
-        let cube = parse_builtin("sphere-cube:spheres=3").unwrap().unwrap().1;
+        let cube = parse_builtin("sphere-cube:spheres=3,segments=20,rings=20").unwrap().unwrap().1;
         assert_eq!(cube.instances.len(), 27 + 1);
+        assert_eq!(cube.meshes.iter().find(|m| m.name == "small-sphere").unwrap().indices.len() / 3, 760);
         for (spec, needle) in [
             ("forest:leaves=3", "unknown parameter `leaves`; its parameters: triangles, trees"),
+            ("sphere-cube:spheres=3,size=2", "its parameters: spheres, segments, rings"),
             ("forest:trees=many", "`many` is not a number"),
             ("forest:trees=0", "trees = 0 is outside 1..=4096"),
             ("forest:trees=nan", "outside"),

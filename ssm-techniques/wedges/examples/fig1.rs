@@ -8,7 +8,7 @@
 //! ```
 //!
 //! `--scene` takes a built-in name or a manifest (the paper's spheres:
-//! `ssm-techniques/wedges/scenes/spheres-125.toml`).
+//! `sphere-cube:spheres=5,segments=20,rings=20`).
 
 use anyhow::{Context, Result, bail};
 use ssm_bench::report::measure;

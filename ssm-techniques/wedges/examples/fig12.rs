@@ -5,7 +5,7 @@
 //!
 //! ```sh
 //! cargo run --release -p ssm-wedges --example fig12 -- --out out/fig12 [--size 320x240] [--frames 5] \
-//!     [--sides 1,2,3,4,5,6,7] [--error] [--write-scenes]
+//!     [--sides 1,2,3,4,5,6,7] [--error]
 //! ```
 //!
 //! The three are timed in turns, frame by frame after a warm-up round, so that
@@ -13,9 +13,8 @@
 //! (triangles, technique, median GPU ms, silhouette edges, wedge fragments,
 //! the mean time of each pass, and with `--error` the penumbra MAE and mean
 //! signed penumbra error against a 16×16-ray ground truth), `time.png`/`.svg`
-//! (time against triangles) and `ratio.png`/`.svg` (forest ÷ none). With
-//! `--write-scenes` it (re)writes the `wedges-fig12` preset's manifests in
-//! `ssm-techniques/wedges/scenes/` and exits.
+//! (time against triangles) and `ratio.png`/`.svg` (forest ÷ none). The
+//! scenes are the built-in `sphere-cube:spheres=N,segments=20,rings=20`.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -25,7 +24,7 @@ use ssm_bench::report::measure;
 use ssm_bench::sweep::{PlotAxes, PlotPoint, plot};
 use ssm_core::metrics::{ShadowClass, classify, compare};
 use ssm_core::{GpuContext, Renderer, Requirements};
-use ssm_wedges::scenes::{FIG12_SIDES, PAPER_RINGS, PAPER_SEGMENTS, fig12_manifest, paper_sphere_obj, sphere_cube};
+use ssm_wedges::scenes::{FIG12_SIDES, PAPER_RINGS, PAPER_SEGMENTS, sphere_cube};
 
 /// One measured series: its label, the technique, and its settings.
 type Run = (&'static str, &'static str, &'static [(&'static str, &'static str)]);
@@ -36,18 +35,10 @@ struct Options {
     frames: u32,
     sides: Vec<u32>,
     error: bool,
-    write_scenes: bool,
 }
 
 fn options() -> Result<Options> {
-    let mut options = Options {
-        out: PathBuf::from("out/fig12"),
-        size: (320, 240),
-        frames: 5,
-        sides: FIG12_SIDES.to_vec(),
-        error: false,
-        write_scenes: false,
-    };
+    let mut options = Options { out: PathBuf::from("out/fig12"), size: (320, 240), frames: 5, sides: FIG12_SIDES.to_vec(), error: false };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         let mut value = || args.next().with_context(|| format!("{arg} needs a value"));
@@ -61,7 +52,6 @@ fn options() -> Result<Options> {
             "--frames" => options.frames = value()?.parse()?,
             "--sides" => options.sides = value()?.split(',').map(str::parse).collect::<Result<_, _>>()?,
             "--error" => options.error = true,
-            "--write-scenes" => options.write_scenes = true,
             other => bail!("unknown argument {other}"),
         }
     }
@@ -84,16 +74,6 @@ fn errors(truth: &[f32], image: &[f32], covered: &[bool], (width, height): (u32,
 
 fn main() -> Result<()> {
     let options = options()?;
-    if options.write_scenes {
-        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
-        std::fs::create_dir_all(&dir)?;
-        std::fs::write(dir.join("sphere-760.obj"), paper_sphere_obj())?;
-        for side in FIG12_SIDES {
-            std::fs::write(dir.join(format!("spheres-{}.toml", side * side * side)), fig12_manifest(side))?;
-        }
-        println!("wrote {}", dir.display());
-        return Ok(());
-    }
     let registry = ssm_bench::registry()?;
     let gpu = GpuContext::new()?;
     std::fs::create_dir_all(&options.out)?;

@@ -971,9 +971,29 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
     })
 }
 
-/// Forest et al.'s and Atty et al.'s studies, as sweeps. The sphere scenes are this crate's
-/// manifests (`scenes/`), named by absolute path so that the presets run from any directory
-/// (the CLI, the preset benches).
+/// Fig. 12's scenes: cubes of 1 to 7 spheres a side (1 to 343 spheres) of the paper's 760
+/// triangles, the built-in `sphere-cube` with parameters ([`scenes::sphere_cube_name`]).
+pub const FIG12_SCENES: &[&str] = &[
+    "sphere-cube:spheres=1,segments=20,rings=20",
+    "sphere-cube:spheres=2,segments=20,rings=20",
+    "sphere-cube:spheres=3,segments=20,rings=20",
+    "sphere-cube:spheres=4,segments=20,rings=20",
+    "sphere-cube:spheres=5,segments=20,rings=20",
+    "sphere-cube:spheres=6,segments=20,rings=20",
+    "sphere-cube:spheres=7,segments=20,rings=20",
+];
+
+/// Atty et al.'s Fig. 25: the same cubes from 8 spheres.
+pub const FIG25_SCENES: &[&str] = &[
+    "sphere-cube:spheres=2,segments=20,rings=20",
+    "sphere-cube:spheres=3,segments=20,rings=20",
+    "sphere-cube:spheres=4,segments=20,rings=20",
+    "sphere-cube:spheres=5,segments=20,rings=20",
+    "sphere-cube:spheres=6,segments=20,rings=20",
+    "sphere-cube:spheres=7,segments=20,rings=20",
+];
+
+/// Forest et al.'s evaluations, as sweeps.
 const PRESETS: &[Preset] = &[
     Preset {
         name: "wedges-fig1",
@@ -993,15 +1013,7 @@ const PRESETS: &[Preset] = &[
     Preset {
         name: "wedges-fig12",
         summary: "Forest et al., Fig. 12: frame time of none and forest; one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles)",
-        scenes: &[
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-1.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-8.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-27.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-64.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-125.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-216.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-343.toml"),
-        ],
+        scenes: FIG12_SCENES,
         varies: &["wedges.blending=none,forest"],
         y_axis: "time",
         ..Preset::DEFAULT
@@ -1009,14 +1021,7 @@ const PRESETS: &[Preset] = &[
     Preset {
         name: "wedges-atty-fig25",
         summary: "Atty et al., Fig. 25: soft shadow volumes (wedges, forest) against soft shadow maps (atty two-sided, 210² occluder map) as polygons grow; one scene per sphere count, time against error (the fig12 example sweeps them all)",
-        scenes: &[
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-8.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-27.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-64.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-125.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-216.toml"),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres-343.toml"),
-        ],
+        scenes: FIG25_SCENES,
         varies: &["wedges.blending=forest", "atty.two_sided=true", "atty.occluder_map_size=210"],
         ..Preset::DEFAULT
     },
