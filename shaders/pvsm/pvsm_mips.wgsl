@@ -13,11 +13,16 @@ fn pvsm_low_res_mip(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id.xy >= size)) {
         return;
     }
-    let limit = vec2<i32>(textureDimensions(finer)) - 1;
-    let base = vec2<i32>(id.xy) * 2;
-    let a = textureLoad(finer, min(base, limit), 0).x;
-    let b = textureLoad(finer, min(base + vec2<i32>(1, 0), limit), 0).x;
-    let c = textureLoad(finer, min(base + vec2<i32>(0, 1), limit), 0).x;
-    let d = textureLoad(finer, min(base + vec2<i32>(1, 1), limit), 0).x;
-    textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(min(min(a, b), min(c, d))));
+    // Texels 2i and 2i + 1 of the finer level; the last texel of a coarser level also takes the
+    // finer level's odd last texel (a side that is not a power of two), so none is dropped.
+    let finer_size = vec2<i32>(textureDimensions(finer));
+    let low = vec2<i32>(id.xy) * 2;
+    let high = select(min(low + 1, finer_size - 1), finer_size - 1, id.xy == size - 1u);
+    var nearest = textureLoad(finer, low, 0).x;
+    for (var y = low.y; y <= high.y; y++) {
+        for (var x = low.x; x <= high.x; x++) {
+            nearest = min(nearest, textureLoad(finer, vec2<i32>(x, y), 0).x);
+        }
+    }
+    textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest));
 }

@@ -175,8 +175,12 @@ impl GpuScene {
         let receivers = scene.bounds_where(Role::receives);
         let casting_points: Vec<glam::Vec3> =
             vertices.iter().filter(|v| v.role & ROLE_CASTS != 0).map(|v| glam::Vec3::from_array(v.position)).collect();
-        let light_frames: Vec<LightFrame> =
-            scene.lights.iter().map(|light| LightFrame::fit_with_occluders(light, &bounds, &receivers, &casting_points)).collect();
+        let triangle_corners: Vec<glam::Vec3> = vertices.iter().map(|v| glam::Vec3::from_array(v.position)).collect();
+        let light_frames: Vec<LightFrame> = scene
+            .lights
+            .iter()
+            .map(|light| LightFrame::fit_to_geometry(light, &bounds, &receivers, &casting_points, &triangle_corners))
+            .collect();
         let light_buffers: Vec<wgpu::Buffer> = light_frames
             .iter()
             .enumerate()

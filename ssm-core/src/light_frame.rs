@@ -59,6 +59,19 @@ impl LightFrame {
     /// widen it. Triangles are judged by their corners.
     #[must_use]
     pub fn fit_with_occluders(light: &RectLight, bounds: &Aabb, receivers: &Aabb, casting_points: &[Vec3]) -> Self {
+        Self::fit_to_geometry(light, bounds, receivers, casting_points, &[])
+    }
+
+    /// As [`LightFrame::fit_with_occluders`], and where the light's plane clips
+    /// the box (a light inside the scene's bounds, or tilted across them), fitted
+    /// to `triangle_corners` (three per triangle, world space) instead of the
+    /// box: the box's corners beside the light are empty space, and a frame
+    /// stretched over them (up to [`MAX_HALF_ANGLE_TANGENT`], with its near
+    /// plane at the light) would spend most of a map's texels, and every
+    /// depth-range and search-region bound, on nothing. A triangle that itself
+    /// crosses the light's plane keeps the box's fit.
+    #[must_use]
+    pub fn fit_to_geometry(light: &RectLight, bounds: &Aabb, receivers: &Aabb, casting_points: &[Vec3], triangle_corners: &[Vec3]) -> Self {
         let normal = light.normal();
         let view = glam::camera::rh::view::look_to_mat4(light.centre, normal, -light.v_axis);
         let extent = bounds.size().length().max(1e-6);
@@ -92,6 +105,12 @@ impl LightFrame {
             far = min_depth * 2.0;
         }
         let mut tan_half = light_shaped_tangents(light, widest_tangents(&points)).min(Vec2::splat(MAX_HALF_ANGLE_TANGENT));
+        if tan_half.max_element() >= MAX_HALF_ANGLE_TANGENT {
+            if let Some((tangents, geometry_near, geometry_far)) = geometry_extent(triangle_corners, local, min_depth) {
+                tan_half = light_shaped_tangents(light, tangents).min(Vec2::splat(MAX_HALF_ANGLE_TANGENT));
+                (near, far) = (geometry_near, geometry_far);
+            }
+        }
         if tan_half.max_element() >= MAX_HALF_ANGLE_TANGENT && !receivers.is_empty() {
             // The box was clipped: widen the frame for the occluders it clipped that block light.
             let receiver_corners = receivers.corners().map(local);
@@ -176,6 +195,28 @@ impl LightFrame {
 }
 
 /// Largest |x|/z and |y|/z over light-space points (at least 1e-3).
+/// The widest tangents and the depth range of the triangles in front of the
+/// light (light-space corners from `local`); `None` when none is, or when one
+/// crosses the plane at `min_depth` (its part next to the light is as wide as
+/// the box's).
+fn geometry_extent(triangle_corners: &[Vec3], local: impl Fn(Vec3) -> Vec3, min_depth: f32) -> Option<(Vec2, f32, f32)> {
+    let mut in_front = Vec::with_capacity(triangle_corners.len());
+    for triangle in triangle_corners.chunks_exact(3) {
+        let corners = [local(triangle[0]), local(triangle[1]), local(triangle[2])];
+        let ahead = corners.iter().filter(|c| c.z >= min_depth).count();
+        match ahead {
+            0 => {}
+            3 => in_front.extend_from_slice(&corners),
+            _ => return None,
+        }
+    }
+    if in_front.is_empty() {
+        return None;
+    }
+    let (near, far) = in_front.iter().fold((f32::INFINITY, min_depth), |(near, far), p| (near.min(p.z), far.max(p.z)));
+    Some((widest_tangents(&in_front), near, far))
+}
+
 fn widest_tangents(points: &[Vec3]) -> Vec2 {
     points.iter().fold(Vec2::splat(1e-3), |tan, p| tan.max(Vec2::new(p.x.abs(), p.y.abs()) / p.z))
 }
@@ -308,6 +349,38 @@ mod tests {
             LightFrame::fit_with_occluders(&light, &scene.bounds(), &receivers, &[Vec3::Y * 2.0]),
             LightFrame::fit(&light, &scene.bounds())
         );
+    }
+
+    /// The dragon's set-up: a light tilted across the scene's box (its plane cuts the box's top
+    /// corners) is fitted to the triangles, not to the box's empty corners: a narrower frame that
+    /// still holds every triangle, with its near plane at the nearest one instead of at the light.
+    /// A triangle crossing the light's plane brings back the box's fit.
+    #[test]
+    fn a_light_tilted_across_the_box_is_fitted_to_the_triangles() {
+        let light = RectLight::try_facing(Vec3::new(1.2, 3.2, 0.8), Vec3::new(-0.35, -1.0, -0.25), Vec3::X, Vec2::splat(0.8), 1.0).unwrap();
+        let ground = [(-4.0, -4.0), (4.0, -4.0), (4.0, 4.0), (-4.0, -4.0), (4.0, 4.0), (-4.0, 4.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
+        // A tall, thin occluder whose top lifts the box to y = 2.5.
+        let pole = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.1, 0.0, 0.0), Vec3::new(0.0, 2.5, 0.0)];
+        let triangles: Vec<Vec3> = ground.iter().chain(pole.iter()).copied().collect();
+        let mut bounds = Aabb::EMPTY;
+        triangles.iter().for_each(|p| bounds.extend(*p));
+        let receivers = Aabb { min: Vec3::new(-4.0, 0.0, -4.0), max: Vec3::new(4.0, 0.0, 4.0) };
+        let boxed = LightFrame::fit_with_occluders(&light, &bounds, &receivers, &pole);
+        assert_eq!(boxed.tan_half.max_element(), MAX_HALF_ANGLE_TANGENT, "the box is clipped: {}", boxed.tan_half);
+        let fitted = LightFrame::fit_to_geometry(&light, &bounds, &receivers, &pole, &triangles);
+        assert!(fitted.tan_half.max_element() < 0.5 * MAX_HALF_ANGLE_TANGENT, "{}", fitted.tan_half);
+        assert!(fitted.near > 0.5, "near plane at the nearest triangle, not the light: {}", fitted.near);
+        for corner in &triangles {
+            let uvd = fitted.uv_depth(*corner);
+            assert!((0.0..=1.0).contains(&uvd.x) && (0.0..=1.0).contains(&uvd.y), "{corner} -> {uvd}");
+            assert!(uvd.z >= fitted.near && uvd.z <= fitted.far, "{corner}: {} not in [{}, {}]", uvd.z, fitted.near, fitted.far);
+        }
+        let mut crossing = triangles.clone();
+        crossing.extend_from_slice(&[Vec3::new(1.2, 3.0, 0.8), Vec3::new(1.3, 3.0, 0.8), Vec3::new(1.2, 3.5, 0.8)]);
+        let mut crossing_bounds = bounds;
+        crossing.iter().for_each(|p| crossing_bounds.extend(*p));
+        let crossed = LightFrame::fit_to_geometry(&light, &crossing_bounds, &receivers, &pole, &crossing);
+        assert_eq!(crossed.tan_half.max_element(), MAX_HALF_ANGLE_TANGENT);
     }
 
     /// A tile's clip space maps its part of the map onto the whole viewport.

@@ -247,3 +247,41 @@ fn analytic_anti_aliasing_comes_near_heavy_supersampling() {
     println!("grid, mean |x - 32×32|: analytic {analytic:.4}, none {plain:.4}, 8×8 {eight:.4}");
     assert!(analytic < 0.5 * plain, "{analytic} vs {plain}");
 }
+
+/// A small square beside the light, a hair below its plane, blocks nothing but brings the light
+/// frame's near plane next to the light. The blocker search region is bounded by the nearest depth
+/// in the conservative map (the occluder's), not by that near plane: with the near plane, the region
+/// was the whole map, read at its 1×1 level. Here that made every pixel a candidate (1.7% skipped as
+/// lit instead of 79%); on a receiver tilted from the light, the depth tolerance of that one coarse
+/// texel hid the occluder from every pixel instead (the dragon rendered with no shadow).
+/// parallel-square's error stays what it is without the square.
+#[test]
+fn a_near_plane_next_to_the_light_does_not_hide_the_occluders() {
+    use glam::Mat4;
+    use ssm_scene::{Instance, Role, primitives};
+    let mut scene = builtin("parallel-square").unwrap().build();
+    let light = scene.lights[0];
+    scene.meshes.push(primitives::plane("beside the light", Vec2::splat(0.5)));
+    scene.instances.push(Instance {
+        name: "beside the light".into(),
+        mesh: scene.meshes.len() - 1,
+        transform: Mat4::from_translation(light.centre + Vec3::new(20.0, -0.002, 0.0)),
+        role: Role::Occluder,
+    });
+    let frame = LightFrame::fit_to_geometry(&light, &scene.bounds(), &scene.bounds_where(Role::receives), &[], &corners(&scene));
+    assert!(frame.near < 0.01, "the square brings the near plane next to the light: {}", frame.near);
+    let (rendered, diagnostics, _) = run(&scene, &[], (320, 240));
+    let exact = rendered.parallel_square_exact();
+    let metrics = compare(&exact, &rendered.visibility, &rendered.coverage(), 320, 240);
+    println!(
+        "with a square beside the light: penumbra MAE {:.4}, lit skipped {:.3}",
+        metrics.mae_penumbra,
+        value(&diagnostics, "pvsm_lit_skipped")
+    );
+    assert!(metrics.mae_penumbra <= 0.03, "{}", metrics.mae_penumbra);
+    assert!(value(&diagnostics, "pvsm_lit_skipped") > 0.5, "the fully-lit test still skips the lit ground");
+}
+
+fn corners(scene: &Scene) -> Vec<Vec3> {
+    scene.world_triangles().flat_map(|triangle| triangle.corners).collect()
+}
