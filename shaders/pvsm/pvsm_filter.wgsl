@@ -35,11 +35,13 @@ const MAX_TEXELS_PER_AXIS: f32 = 96.0;
 fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec2<f32> {
     let extent = tile.uv_max - tile.uv_min;
     let scale = tile.size / extent;
-    // The filter in the tile's texel units.
+    // The filter in the tile's texel units, never narrower than one texel: a filter of zero size
+    // (no penumbra, and antialiasing off so that no pixel footprint widens it) is the hard shadow
+    // test of the texel under the point, not an empty integral.
     let c = (centre - tile.uv_min) * scale;
-    let ux = abs(u.x) * scale.x;
+    let ux = max(abs(u.x) * scale.x, 0.5);
     let uy = select(u.y, -u.y, u.x < 0.0) * scale.y;
-    let vy = v_height * scale.y;
+    let vy = max(v_height * scale.y, 0.5);
     let x_low = max(c.x - ux, 0.0);
     let x_high = min(c.x + ux, tile.size.x);
     let reach_y = abs(uy) + vy;

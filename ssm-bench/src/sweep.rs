@@ -408,21 +408,82 @@ where
     area.fill(&WHITE).map_err(chart_error)?;
     let mut builder = ChartBuilder::on(area);
     builder.caption(title, ("sans-serif", 24)).margin(20).x_label_area_size(50).y_label_area_size(70);
-    let y_range = (y_min / 1.5..y_max * 1.5).log_scale();
+    let (y_low, y_high) = (y_min / 1.5, y_max * 1.5);
+    let y_range = (y_low..y_high).log_scale();
+    let y_fraction = |y: f64| (y / y_low).ln() / (y_high / y_low).ln();
     if axes.log_x {
-        let chart = builder.build_cartesian_2d((x_min / 1.5..x_max * 1.5).log_scale(), y_range).map_err(chart_error)?;
-        draw_series(chart, &usable, axes)
+        let (x_low, x_high) = (x_min / 1.5, x_max * 1.5);
+        let legend = emptiest_corner(&usable, |x| (x / x_low).ln() / (x_high / x_low).ln(), y_fraction);
+        let chart = builder.build_cartesian_2d((x_low..x_high).log_scale(), y_range).map_err(chart_error)?;
+        draw_series(chart, &usable, axes, legend)
     } else {
         let pad = ((x_max - x_min) * 0.08).max(1e-6);
-        let chart = builder.build_cartesian_2d(x_min - pad..x_max + pad, y_range).map_err(chart_error)?;
-        draw_series(chart, &usable, axes)
+        let (x_low, x_high) = (x_min - pad, x_max + pad);
+        let legend = emptiest_corner(&usable, |x| (x - x_low) / (x_high - x_low), y_fraction);
+        let chart = builder.build_cartesian_2d(x_low..x_high, y_range).map_err(chart_error)?;
+        draw_series(chart, &usable, axes, legend)
     }
+}
+
+/// A log axis's tick label: only at 1, 2, 3 and 5 times a power of ten, since plotters puts a tick at
+/// every integer multiple and, over less than a decade, their labels overprint.
+fn log_tick(value: f64) -> String {
+    if !(value > 0.0 && value.is_finite()) {
+        return String::new();
+    }
+    let mantissa = value / 10f64.powf(value.log10().floor());
+    if [1.0, 2.0, 3.0, 5.0, 10.0].iter().any(|m| (mantissa - m).abs() < 1e-6 * m) { compact(value) } else { String::new() }
+}
+
+/// A number with at most three significant decimals and no trailing zeros.
+fn compact(value: f64) -> String {
+    let text = if value.abs() >= 100.0 { format!("{value:.0}") } else { format!("{value:.3}") };
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
+}
+
+/// A label's rectangle in pixels: left, top, right, bottom.
+type LabelBox = (i32, i32, i32, i32);
+
+/// Where to draw the label of the point at pixel `at`, relative to it: above and to the right,
+/// or else below, higher or lower, whichever first overlaps no label in `placed` (which it joins).
+fn label_offset(at: (i32, i32), label: &str, placed: &mut Vec<LabelBox>) -> (i32, i32) {
+    // 13-pixel sans-serif: about 7 pixels a character.
+    let (width, height) = (7 * i32::try_from(label.chars().count()).unwrap_or(i32::MAX / 8), 13);
+    let candidates = [(8, -16), (8, 6), (8, -30), (8, 20)];
+    let rectangle = |(dx, dy): (i32, i32)| (at.0 + dx, at.1 + dy, at.0 + dx + width, at.1 + dy + height);
+    let overlaps = |a: LabelBox, b: &LabelBox| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+    let chosen = candidates.into_iter().find(|offset| !placed.iter().any(|b| overlaps(rectangle(*offset), b))).unwrap_or(candidates[0]);
+    placed.push(rectangle(chosen));
+    chosen
+}
+
+/// The corner of the plot whose region (a third of the width, two fifths of the height) holds the
+/// fewest points, for the legend, so that it hides no measurement. `x_fraction` and `y_fraction`
+/// place a value in [0, 1] along the axes as drawn.
+fn emptiest_corner(points: &[&PlotPoint], x_fraction: impl Fn(f64) -> f64, y_fraction: impl Fn(f64) -> f64) -> SeriesLabelPosition {
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerLeft, false, false),
+        (SeriesLabelPosition::LowerRight, true, false),
+    ];
+    let crowding = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|p| {
+                let (x, y) = (x_fraction(p.x), y_fraction(p.y));
+                (if right { x > 0.66 } else { x < 0.34 }) && (if upper { y > 0.6 } else { y < 0.4 })
+            })
+            .count()
+    };
+    corners.into_iter().min_by_key(|(_, right, upper)| crowding(*right, *upper)).map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 fn draw_series<'a, DB, X>(
     mut chart: ChartContext<'a, DB, Cartesian2d<X, plotters::coord::combinators::LogCoord<f64>>>,
     points: &[&PlotPoint],
     axes: &PlotAxes,
+    legend: SeriesLabelPosition,
 ) -> Result<()>
 where
     DB: DrawingBackend + 'a,
@@ -434,8 +495,8 @@ where
         .x_desc(axes.x_label.as_str())
         .y_desc(axes.y_label.as_str())
         .label_style(("sans-serif", 15))
-        .x_label_formatter(&|v| format!("{v:.3}"))
-        .y_label_formatter(&|v| format!("{v:.3}"))
+        .x_label_formatter(&|v| if axes.log_x { log_tick(*v) } else { compact(*v) })
+        .y_label_formatter(&|v| log_tick(*v))
         .draw()
         .map_err(chart_error)?;
     let mut series_names: Vec<&str> = Vec::new();
@@ -444,6 +505,8 @@ where
             series_names.push(&p.series);
         }
     }
+    // Pixel rectangles of the labels drawn so far, so that close points' labels do not overprint.
+    let mut placed_labels: Vec<LabelBox> = Vec::new();
     for (index, name) in series_names.iter().enumerate() {
         let colour = Palette99::pick(index).mix(0.9);
         let mut series: Vec<&PlotPoint> = points.iter().copied().filter(|p| p.series == *name).collect();
@@ -456,12 +519,12 @@ where
             .label(name.to_string())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(3)));
         chart.draw_series(series.iter().map(|p| Circle::new((p.x, p.y), 5, colour.filled()))).map_err(chart_error)?;
+        let offsets: Vec<(i32, i32)> =
+            series.iter().map(|p| label_offset(chart.backend_coord(&(p.x, p.y)), &p.label, &mut placed_labels)).collect();
         chart
-            .draw_series(
-                series.iter().map(|p| {
-                    EmptyElement::at((p.x, p.y)) + Text::new(p.label.clone(), (8, -16), ("sans-serif", 13).into_font().color(&BLACK))
-                }),
-            )
+            .draw_series(series.iter().zip(offsets).map(|(p, offset)| {
+                EmptyElement::at((p.x, p.y)) + Text::new(p.label.clone(), offset, ("sans-serif", 13).into_font().color(&BLACK))
+            }))
             .map_err(chart_error)?;
     }
     if axes.pareto {
@@ -476,6 +539,7 @@ where
     }
     chart
         .configure_series_labels()
+        .position(legend)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 15))
@@ -487,6 +551,17 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_ticks_label_one_two_three_and_five_and_labels_do_not_overprint() {
+        assert_eq!([10.0, 20.0, 30.0, 50.0, 70.0, 100.0, 0.05, 0.06].map(log_tick), ["10", "20", "30", "50", "", "100", "0.05", ""]);
+        assert_eq!(compact(0.1), "0.1");
+        let mut placed = Vec::new();
+        let first = label_offset((100, 100), "1024", &mut placed);
+        let second = label_offset((104, 100), "2048", &mut placed);
+        assert_ne!(first, second, "a point 4 pixels away gets its label elsewhere");
+        assert_eq!(label_offset((400, 100), "4096", &mut placed), first);
+    }
 
     #[test]
     fn vary_specifications_parse_and_expand() {

@@ -47,25 +47,28 @@ fn parallel_square_is_within_two_hundredths_of_the_exact_visibility() {
 
 /// A light of size zero: every filter is the pixel's footprint, and the result is the hard shadow
 /// at the predicted resolution: the same as `hard`'s on all but the pixels along the shadow's edge
-/// (anti-aliased there).
+/// (anti-aliased there). Without anti-aliasing the filter has no size at all, and is read as the
+/// texel under the point (it was an empty integral, read as lit: every umbra pixel wrong).
 #[test]
 fn a_point_light_gives_the_hard_shadow() {
     let mut scene = builtin("floating-sphere").unwrap().build();
     scene.lights[0].half_size = Vec2::ZERO;
-    let (pvsm, _, _) = run(&scene, &[], SIZE);
     let hard = render(&gpu(), &scene, &ssm_hard::INFO, &[("shadow_map_size", "4096")], SIZE.0, SIZE.1).unwrap();
-    let receivers = pvsm.coverage();
-    let total = receivers.iter().filter(|c| **c).count() as f32;
-    let wrong =
-        pvsm.visibility.iter().zip(&hard.visibility).zip(&receivers).filter(|((p, h), c)| **c && (*p - *h).abs() > 0.5).count() as f32;
-    let soft = pvsm.visibility.iter().zip(&receivers).filter(|(v, c)| **c && **v > 0.02 && **v < 0.98).count() as f32;
-    println!(
-        "point light: {:.2}% of pixels on the other side of 0.5 than hard, {:.2}% between 0 and 1",
-        wrong / total * 100.0,
-        soft / total * 100.0
-    );
-    assert!(wrong / total < 0.01, "{wrong} of {total}");
-    assert!(soft / total < 0.02, "a point light has only anti-aliased edges: {soft} of {total}");
+    for antialiasing in ["true", "false"] {
+        let (pvsm, _, _) = run(&scene, &[("antialiasing", antialiasing)], SIZE);
+        let receivers = pvsm.coverage();
+        let total = receivers.iter().filter(|c| **c).count() as f32;
+        let wrong =
+            pvsm.visibility.iter().zip(&hard.visibility).zip(&receivers).filter(|((p, h), c)| **c && (*p - *h).abs() > 0.5).count() as f32;
+        let soft = pvsm.visibility.iter().zip(&receivers).filter(|(v, c)| **c && **v > 0.02 && **v < 0.98).count() as f32;
+        println!(
+            "point light, antialiasing {antialiasing}: {:.2}% of pixels on the other side of 0.5 than hard, {:.2}% between 0 and 1",
+            wrong / total * 100.0,
+            soft / total * 100.0
+        );
+        assert!(wrong / total < 0.01, "antialiasing {antialiasing}: {wrong} of {total}");
+        assert!(soft / total < 0.02, "a point light has only anti-aliased edges: {soft} of {total}");
+    }
 }
 
 /// Fig. 10's claim: softer shadows need lower resolutions, so fewer texels and tiles are rendered.
