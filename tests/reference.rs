@@ -67,8 +67,10 @@ fn ray_caster_matches_the_analytic_parallel_square_within_the_sampling_error() {
 fn cached_results_are_identical_and_keyed_by_their_inputs() {
     let scene = builtin("parallel-square").unwrap().build();
     let truth = GroundTruth::new(&scene);
-    let points: Vec<Option<SurfacePoint>> =
-        (0..64).map(|i| Some(SurfacePoint { position: Vec3::new(i as f32 * 0.04, 0.0, 0.3), normal: Vec3::Y })).chain([None]).collect();
+    let points: Vec<Option<SurfacePoint>> = (0..64)
+        .map(|i| Some(SurfacePoint { position: Vec3::new(i as f32 * 0.04, 0.0, 0.3), normal: Vec3::Y, footprint: None }))
+        .chain([None])
+        .collect();
     let dir = std::env::temp_dir().join(format!("ssm-reference-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let light = &scene.lights[0];
@@ -91,11 +93,48 @@ fn a_point_behind_the_light_or_a_point_light_gives_exact_answers() {
     let truth = GroundTruth::new(&scene);
     let mut light = scene.lights[0];
     let mut rng = ssm_core::reference::SplitMix64::for_pixel(1, 0);
-    let behind = SurfacePoint { position: Vec3::new(0.0, 5.0, 0.0), normal: Vec3::Y };
+    let behind = SurfacePoint { position: Vec3::new(0.0, 5.0, 0.0), normal: Vec3::Y, footprint: None };
     assert_eq!(truth.visibility(&light, &behind, 8, &mut rng), 0.0);
     light.half_size = Vec2::ZERO;
-    let under = SurfacePoint { position: Vec3::new(0.9, 0.0, 0.0), normal: Vec3::Y };
-    let beside = SurfacePoint { position: Vec3::new(1.1, 0.0, 0.0), normal: Vec3::Y };
+    let under = SurfacePoint { position: Vec3::new(0.9, 0.0, 0.0), normal: Vec3::Y, footprint: None };
+    let beside = SurfacePoint { position: Vec3::new(1.1, 0.0, 0.0), normal: Vec3::Y, footprint: None };
     assert_eq!(truth.visibility(&light, &under, 8, &mut rng), 0.0);
     assert_eq!(truth.visibility(&light, &beside, 8, &mut rng), 1.0);
+}
+
+/// `footprint = pixel`: each sample starts from its own point of the pixel's footprint on the
+/// tangent plane, so the result is the exact visibility averaged over the footprint (here a
+/// 1.2 × 1.2 square of the ground across the penumbra's inner edge, where visibility is not
+/// linear and the average differs from the centre's value), within the sampling error.
+#[test]
+fn a_pixel_footprint_averages_the_visibility_over_the_pixel() {
+    use ssm_core::reference::PixelFootprint;
+    let scene = builtin("parallel-square").unwrap().build();
+    let truth = GroundTruth::new(&scene);
+    let light = scene.lights[0];
+    let exact = |p: Vec3| parallel_rectangle_visibility(&light, Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5), p);
+    let (centre, half) = (Vec3::new(0.4, 0.0, 0.1), 0.6);
+    let eye = centre + Vec3::new(0.0, 10.0, 0.0);
+    let footprint = PixelFootprint {
+        eye,
+        corner: Vec3::new(-half, -10.0, -half),
+        across: Vec3::new(2.0 * half, 0.0, 0.0),
+        down: Vec3::new(0.0, 0.0, 2.0 * half),
+    };
+    let dense = 200;
+    let mut average = 0.0;
+    for j in 0..dense {
+        for i in 0..dense {
+            let (s, t) = ((i as f32 + 0.5) / dense as f32, (j as f32 + 0.5) / dense as f32);
+            average += exact(footprint.on_plane(s, t, centre, Vec3::Y).unwrap());
+        }
+    }
+    average /= (dense * dense) as f32;
+    let point = SurfacePoint { position: centre, normal: Vec3::Y, footprint: Some(footprint) };
+    let traced: f32 =
+        (0..512).map(|seed| truth.visibility(&light, &point, 32, &mut ssm_core::reference::SplitMix64::for_pixel(seed, 0))).sum::<f32>()
+            / 512.0;
+    println!("footprint average: exact {average:.4}, traced {traced:.4}, centre {:.4}", exact(centre));
+    assert!((exact(centre) - average).abs() > 0.05, "the footprint must matter here");
+    assert!((traced - average).abs() < 0.004, "traced {traced} against the exact average {average}");
 }

@@ -40,6 +40,39 @@ pub struct SurfacePoint {
     pub position: Vec3,
     /// Unit normal (either side; rays leave on the side facing each light sample).
     pub normal: Vec3,
+    /// The camera rays bounding the pixel, when its visibility is averaged over the pixel's
+    /// footprint on the surface's tangent plane instead of taken at the point.
+    pub footprint: Option<PixelFootprint>,
+}
+
+/// The camera rays through one pixel: every ray through it leaves `eye` along
+/// `corner + s·across + t·down` for (s, t) in [0, 1]² (directions are affine in
+/// pixel coordinates for a pinhole camera).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelFootprint {
+    /// The camera's centre.
+    pub eye: Vec3,
+    /// The direction through the pixel's top-left corner.
+    pub corner: Vec3,
+    /// The change of direction from the left edge to the right one.
+    pub across: Vec3,
+    /// The change of direction from the top edge to the bottom one.
+    pub down: Vec3,
+}
+
+impl PixelFootprint {
+    /// Where the ray through (s, t) of the pixel meets the plane through `point` with `normal`;
+    /// `None` when it runs along the plane or meets it behind the eye.
+    #[must_use]
+    pub fn on_plane(&self, s: f32, t: f32, point: Vec3, normal: Vec3) -> Option<Vec3> {
+        let direction = self.corner + self.across * s + self.down * t;
+        let denominator = direction.dot(normal);
+        if denominator.abs() < 1e-12 {
+            return None;
+        }
+        let distance = (point - self.eye).dot(normal) / denominator;
+        (distance > 0.0 && distance.is_finite()).then(|| self.eye + direction * distance)
+    }
 }
 
 /// The result of tracing one image.
@@ -97,21 +130,50 @@ impl GroundTruth {
 
     /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
     /// samples jittered by `rng`. Points behind the light's plane see none of it.
+    /// With a footprint, each sample also starts from its own point of the
+    /// pixel's footprint on the tangent plane (stratified too, the pixel's
+    /// strata paired with the light's in a random order): the visibility
+    /// averaged over the pixel, what a screen-space prefilter aims at.
     #[must_use]
     pub fn visibility(&self, light: &RectLight, point: &SurfacePoint, samples_per_axis: u32, rng: &mut SplitMix64) -> f32 {
-        if (point.position - light.centre).dot(light.normal()) <= 0.0 {
+        if point.footprint.is_none() && (point.position - light.centre).dot(light.normal()) <= 0.0 {
             return 0.0;
         }
         let n = samples_per_axis.max(1);
+        // With a footprint, the pixel's strata in a random order: a fixed pairing with the
+        // light's strata (such as (i, j) with (j, i)) correlates them and biases the average.
+        let pixel_strata: Vec<u32> = match point.footprint {
+            Some(_) => {
+                let mut order: Vec<u32> = (0..n * n).collect();
+                for k in (1..order.len()).rev() {
+                    order.swap(k, (rng.next_u64() % (k as u64 + 1)) as usize);
+                }
+                order
+            }
+            None => Vec::new(),
+        };
         let mut visible = 0u32;
         for j in 0..n {
             for i in 0..n {
                 let jitter = Vec2::new(rng.next_f32(), rng.next_f32());
                 let stratum = (Vec2::new(i as f32, j as f32) + jitter) / n as f32 * 2.0 - Vec2::ONE;
                 let sample = light.point(stratum.x, stratum.y);
+                let position = match &point.footprint {
+                    Some(footprint) => {
+                        let cell = pixel_strata[(j * n + i) as usize];
+                        let sub_pixel =
+                            (Vec2::new((cell % n) as f32, (cell / n) as f32) + Vec2::new(rng.next_f32(), rng.next_f32())) / n as f32;
+                        let position = footprint.on_plane(sub_pixel.x, sub_pixel.y, point.position, point.normal).unwrap_or(point.position);
+                        if (position - light.centre).dot(light.normal()) <= 0.0 {
+                            continue;
+                        }
+                        position
+                    }
+                    None => point.position,
+                };
                 // Leave the surface on the side facing this sample, so that it does not shadow itself.
-                let side = if point.normal.dot(sample - point.position) >= 0.0 { 1.0 } else { -1.0 };
-                let origin = point.position + point.normal * (side * self.surface_offset);
+                let side = if point.normal.dot(sample - position) >= 0.0 { 1.0 } else { -1.0 };
+                let origin = position + point.normal * (side * self.surface_offset);
                 if self.unoccluded(origin, sample) {
                     visible += 1;
                 }
@@ -177,7 +239,16 @@ impl GroundTruth {
         hasher.write(&(points.len() as u64).to_le_bytes());
         for point in points {
             match point {
-                Some(p) => hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]),
+                Some(p) => {
+                    hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]);
+                    // Points without a footprint hash as before, so that their cache stays valid.
+                    if let Some(f) = &p.footprint {
+                        hasher.write(&[0xfe]);
+                        for v in [f.eye, f.corner, f.across, f.down] {
+                            hasher.write_f32s(&v.to_array());
+                        }
+                    }
+                }
                 None => hasher.write(&[0xff]),
             }
         }
@@ -333,6 +404,20 @@ mod tests {
     }
 }
 
+/// The camera rays through the pixel whose top-left corner is at (`x`, `y`), in pixels.
+fn pixel_rays(camera: &crate::CameraUniform, x: f32, y: f32) -> PixelFootprint {
+    let inverse = glam::Mat4::from_cols_array_2d(&camera.inverse_view_proj);
+    let eye = Vec3::new(camera.position[0], camera.position[1], camera.position[2]);
+    // Points of the far plane are affine in NDC, so the directions are affine in pixels.
+    let direction = |x: f32, y: f32| {
+        let ndc = glam::Vec4::new(x * camera.viewport[2] * 2.0 - 1.0, 1.0 - y * camera.viewport[3] * 2.0, 1.0, 1.0);
+        let far = inverse * ndc;
+        far.truncate() / far.w - eye
+    };
+    let corner = direction(x, y);
+    PixelFootprint { eye, corner, across: direction(x + 1.0, y) - corner, down: direction(x, y + 1.0) - corner }
+}
+
 /// The registered name of the ground truth.
 pub const NAME: &str = "reference";
 
@@ -349,6 +434,11 @@ pub const PARAMS: &[crate::ParamSpec] = &[
         kind: crate::ParamKind::Bool { default: true },
         doc: "read and write the on-disk cache (SSM_CACHE_DIR, else ~/.cache/ssm)",
     },
+    crate::ParamSpec {
+        name: "footprint",
+        kind: crate::ParamKind::Choice { default: "centre", options: &["centre", "pixel"] },
+        doc: "where each pixel is sampled: at the G-buffer's point (centre), or over the pixel's footprint on the point's tangent plane (pixel: the prefiltered visibility that anti-aliasing aims at)",
+    },
 ];
 
 /// The ground truth as a technique: traces on the CPU, uploads, copies into the target.
@@ -359,6 +449,8 @@ struct ReferenceTechnique {
     cache_dir: Option<PathBuf>,
     /// The G-buffer's points, read once: the scene and camera are static.
     points: Option<Vec<Option<SurfacePoint>>>,
+    /// Whether each point carries its pixel's footprint (`footprint = pixel`).
+    pixel_footprint: bool,
     /// One texture and bind group per light: an upload is recorded on the queue
     /// before the frame's commands run, so lights sharing one texture would all
     /// read the last light's upload.
@@ -376,14 +468,19 @@ impl ReferenceTechnique {
             let normals = crate::readback::read_texture(frame.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
             let positions: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&positions);
             let normals: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&normals);
+            let camera = &frame.scene.camera;
+            let width = frame.scene.width.max(1) as usize;
+            let pixel_footprint = self.pixel_footprint;
             self.points = Some(
                 positions
                     .iter()
                     .zip(&normals)
-                    .map(|(p, n)| {
+                    .enumerate()
+                    .map(|(index, (p, n))| {
                         (p[3] > 0.5).then(|| SurfacePoint {
                             position: Vec3::new(p[0], p[1], p[2]),
                             normal: Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y),
+                            footprint: pixel_footprint.then(|| pixel_rays(camera, (index % width) as f32, (index / width) as f32)),
                         })
                     })
                     .collect(),
@@ -486,6 +583,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         seed: u64::try_from(params.int("seed")?).unwrap_or(1),
         cache_dir: params.bool("cache")?.then(default_cache_dir),
         points: None,
+        pixel_footprint: params.choice("footprint")? == "pixel",
         traced,
         upload,
         traced_per_light: Vec::new(),
