@@ -180,6 +180,39 @@ impl LightDepthMap {
         region: Option<(u32, u32)>,
         label: &str,
     ) {
+        self.encode_region_with(frame, light_frame, bias, region, label, None);
+    }
+
+    /// As [`LightDepthMap::encode_region`], drawing the triangles that `indices` lists (indices
+    /// into the scene's vertex buffer, a subset of [`LightDepthMap::index_range`] compacted on the
+    /// GPU) with the `draw_indexed_indirect` arguments in `arguments` (offset 0).
+    pub fn encode_region_indirect(
+        &self,
+        frame: &mut Frame<'_>,
+        light_frame: &wgpu::BindGroup,
+        bias: &wgpu::BindGroup,
+        region: Option<(u32, u32)>,
+        label: &str,
+        (indices, arguments): (&wgpu::Buffer, &wgpu::Buffer),
+    ) {
+        self.encode_region_with(frame, light_frame, bias, region, label, Some((indices, arguments)));
+    }
+
+    /// The range of the scene's index buffer this map draws (its [`Geometry`]).
+    #[must_use]
+    pub fn index_range(&self) -> std::ops::Range<u32> {
+        self.indices.clone()
+    }
+
+    fn encode_region_with(
+        &self,
+        frame: &mut Frame<'_>,
+        light_frame: &wgpu::BindGroup,
+        bias: &wgpu::BindGroup,
+        region: Option<(u32, u32)>,
+        label: &str,
+        indirect: Option<(&wgpu::Buffer, &wgpu::Buffer)>,
+    ) {
         let scene = frame.scene;
         let mut pass = frame.render_pass(
             label,
@@ -201,7 +234,14 @@ impl LightDepthMap {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);
         pass.set_bind_group(1, bias, &[]);
-        scene.draw(&mut pass, self.indices.clone());
+        match indirect {
+            Some((indices, arguments)) => {
+                pass.set_vertex_buffer(0, scene.vertex_buffer.slice(..));
+                pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed_indirect(arguments, 0);
+            }
+            None => scene.draw(&mut pass, self.indices.clone()),
+        }
     }
 }
 

@@ -52,6 +52,8 @@ const PYRAMID_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_pyramid.wg
 const MIPS_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_mips.wgsl");
 /// Step 8 and the merge.
 const FILTER_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_filter.wgsl");
+/// Step 7's culling to the tile.
+const CULL_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_cull.wgsl");
 
 /// How the low-resolution map is rasterised conservatively (step 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
@@ -125,6 +127,9 @@ pub struct PvsmSettings {
     /// k: the filter evaluated at k×k points of each pixel and averaged (Fig. 11's supersampling; set antialiasing=false).
     #[param(default = 1, min = 1, max = 32)]
     pub supersampling: u32,
+    /// Step 7's culling to the tile: a compute pass keeps the triangles that can touch the tile and the tile map draws only those (false: every triangle, left to the clipper; for comparison).
+    #[param(default = true)]
+    pub tile_culling: bool,
     /// What the texels are compared with (as pcss's).
     #[param(flatten)]
     pub receiver: ReceiverModel,
@@ -190,6 +195,16 @@ pub struct PyramidSettingsUniform {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+}
+
+/// `CullSettings` of `shaders/pvsm/pvsm_cull.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct CullSettingsUniform {
+    first_index: u32,
+    triangle_count: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 /// `TileSettings` of `shaders/pvsm/pvsm_filter.wgsl`.
@@ -302,6 +317,7 @@ struct Pipelines {
     pyramid: wgpu::ComputePipeline,
     filter: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
+    cull: wgpu::ComputePipeline,
 }
 
 /// The buffers of the screen-space and grid passes.
@@ -313,6 +329,9 @@ struct Buffers {
     pyramid: wgpu::Buffer,
     pyramid_readback: wgpu::Buffer,
     pyramid_cells: u64,
+    /// Step 7: the indices of the triangles kept for the current tile, and its indirect draw.
+    culled_indices: wgpu::Buffer,
+    tile_draw: wgpu::Buffer,
 }
 
 /// What the last frame measured, for `diagnostics`.
@@ -331,6 +350,9 @@ pub struct PredictedVirtualShadowMaps {
     gbuffer_group: wgpu::BindGroup,
     kernel_group: wgpu::BindGroup,
     pyramid_group: wgpu::BindGroup,
+    cull_group: wgpu::BindGroup,
+    /// Triangles step 7's culling tests per tile.
+    cull_triangles: u32,
     /// Per light: its tile slots, then its resolve group (binding its visibility target).
     slots: Vec<Vec<TileSlot>>,
     resolve_groups: Vec<wgpu::BindGroup>,
@@ -364,7 +386,7 @@ impl PredictedVirtualShadowMaps {
         let limit = device.limits().max_texture_dimension_2d;
         let atlas_side = if settings.prediction == Prediction::Fixed { settings.fixed_size } else { settings.max_tile_size }.min(limit);
         let (width, height) = (setup.scene.width, setup.scene.height);
-        let buffers = Self::buffers(device, &settings, width, height);
+        let buffers = Self::buffers(device, &settings, width, height, setup.scene.triangle_count);
         let hardware = match settings.conservative {
             Conservative::Hardware => true,
             Conservative::Software | Conservative::Off => false,
@@ -374,6 +396,21 @@ impl PredictedVirtualShadowMaps {
         let low_res = LowResMap::new(device, settings.low_res_size, &layouts.mip);
         let groups = StepGroups::new(setup, &settings, &layouts, &buffers, &low_res, hardware);
         let tile_maps = Self::tile_maps(setup, atlas_side)?;
+        let range = tile_maps.first().map_or(0..0, LightDepthMap::index_range);
+        let cull_triangles = (range.end - range.start) / 3;
+        let cull_settings = CullSettingsUniform { first_index: range.start, triangle_count: cull_triangles, _pad0: 0, _pad1: 0 };
+        let cull_group = bind_group(
+            device,
+            "pvsm_tile_cull_bind_group",
+            &layouts.cull,
+            &[
+                uniform_buffer(device, "pvsm_tile_cull_uniform", &cull_settings).as_entire_binding(),
+                setup.scene.vertex_buffer.as_entire_binding(),
+                setup.scene.index_buffer.as_entire_binding(),
+                buffers.culled_indices.as_entire_binding(),
+                buffers.tile_draw.as_entire_binding(),
+            ],
+        );
         let slots = (0..setup.scene.light_count())
             .map(|light| Self::tile_slots(gpu, &layouts.tile, &tile_maps, light, settings.max_tiles))
             .collect();
@@ -388,6 +425,8 @@ impl PredictedVirtualShadowMaps {
             gbuffer_group: gbuffer.bind_group.clone(),
             kernel_group: groups.kernel,
             pyramid_group: groups.pyramid,
+            cull_group,
+            cull_triangles,
             slots,
             resolve_groups,
             common_group: groups.common,
@@ -442,7 +481,7 @@ impl PredictedVirtualShadowMaps {
             .collect()
     }
 
-    fn buffers(device: &wgpu::Device, settings: &PvsmSettings, width: u32, height: u32) -> Buffers {
+    fn buffers(device: &wgpu::Device, settings: &PvsmSettings, width: u32, height: u32, triangles: u32) -> Buffers {
         let pixels = u64::from(width) * u64::from(height);
         // Every level of the pyramid: a geometric series of the grid's cells.
         let mut pyramid_cells = 0u64;
@@ -463,6 +502,21 @@ impl PredictedVirtualShadowMaps {
             pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * 8),
             pyramid_readback: readback_buffer(device, "pvsm_smtg_pyramid_readback", pyramid_cells * 8),
             pyramid_cells,
+            culled_indices: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pvsm_tile_culled_indices"),
+                size: (u64::from(triangles) * 12).max(12),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+                mapped_at_creation: false,
+            }),
+            tile_draw: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pvsm_tile_draw_arguments"),
+                size: 20,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
         }
     }
 
@@ -518,6 +572,18 @@ impl PredictedVirtualShadowMaps {
     }
 
     /// Steps 5 and 6: the pyramid, its readback, the kd-tree.
+    /// Step 7's culling: the triangles that can touch the tile whose frame is `tile_frame`, compacted
+    /// into `culled_indices` with their count in `tile_draw`'s indirect arguments.
+    fn cull_to_tile(&self, frame: &mut Frame<'_>, tile_frame: &wgpu::BindGroup) {
+        frame.clear_buffer("pvsm_clear_tile_draw", &self.buffers.tile_draw, 0, None);
+        let groups = self.cull_triangles.div_ceil(256).max(1);
+        let mut pass = frame.compute_pass("pvsm_tile_cull");
+        pass.set_pipeline(&self.pipelines.cull);
+        pass.set_bind_group(0, tile_frame, &[]);
+        pass.set_bind_group(1, &self.cull_group, &[]);
+        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+    }
+
     fn tiling(&self, frame: &mut Frame<'_>) -> Result<Tiling> {
         if self.settings.prediction == Prediction::Fixed {
             let side = self.atlas_side;
@@ -656,6 +722,7 @@ struct Layouts {
     common: wgpu::BindGroupLayout,
     tile: wgpu::BindGroupLayout,
     resolve: wgpu::BindGroupLayout,
+    cull: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -698,6 +765,11 @@ impl Layouts {
                 &[uniform_entry(0), uniform_entry(1), storage_entry(2, true), storage_entry(3, false)],
             ),
             tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1)]),
+            cull: bind_group_layout(
+                device,
+                "pvsm_tile_cull_layout",
+                &[uniform_entry(0), storage_entry(1, true), storage_entry(2, true), storage_entry(3, false), storage_entry(4, false)],
+            ),
             resolve: bind_group_layout(
                 device,
                 "pvsm_resolve_layout",
@@ -751,6 +823,7 @@ impl Pipelines {
         let pyramid_module = module("pvsm_pyramid_shader", PYRAMID_SHADER)?;
         let filter_module = module("pvsm_filter_shader", FILTER_SHADER)?;
         let mip_module = module("pvsm_mips_shader", MIPS_SHADER)?;
+        let cull_module = module("pvsm_cull_shader", CULL_SHADER)?;
         Ok(Self {
             low_res,
             mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip]),
@@ -775,6 +848,13 @@ impl Pipelines {
                 &filter_module,
                 "pvsm_resolve",
                 &[screen[0], screen[1], &layouts.common, &layouts.resolve],
+            ),
+            cull: compute_pipeline(
+                device,
+                "pvsm_tile_cull_pipeline",
+                &cull_module,
+                "pvsm_tile_cull",
+                &[gpu.uniform_layout(), &layouts.cull],
             ),
         })
     }
@@ -835,7 +915,14 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             let (Some(map), Some(filter_group)) = (self.tile_maps.get(class), slot.filter_groups.get(class)) else {
                 return Err(Error::Technique { technique: NAME.into(), message: "no tile map".into() });
             };
-            map.encode_region(frame, &slot.frame_group, &slot.bias_group, Some((tile.size.x, tile.size.y)), "pvsm_tile_map");
+            let region = Some((tile.size.x, tile.size.y));
+            if self.settings.tile_culling {
+                self.cull_to_tile(frame, &slot.frame_group);
+                let draw = (&self.buffers.culled_indices, &self.buffers.tile_draw);
+                map.encode_region_indirect(frame, &slot.frame_group, &slot.bias_group, region, "pvsm_tile_map", draw);
+            } else {
+                map.encode_region(frame, &slot.frame_group, &slot.bias_group, region, "pvsm_tile_map");
+            }
             self.dispatch(frame, "pvsm_tile_filter", &self.pipelines.filter, &[&self.common_group, filter_group], light);
         }
         self.dispatch(frame, "pvsm_resolve", &self.pipelines.resolve, &[&self.common_group, &resolve_group], light);
@@ -867,6 +954,17 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
                 if total > 0.0 {
                     out.push(("pvsm_lit_skipped".to_owned(), f64::from(lit) / total));
                 }
+            }
+        }
+        // Step 7's culling: the share of the triangles the last tile drew.
+        if self.settings.tile_culling
+            && !tiles.is_empty()
+            && self.cull_triangles > 0
+            && let Ok(bytes) = ssm_core::readback::read_buffer(gpu, &self.buffers.tile_draw, 20, "PVSM tile draw")
+        {
+            let arguments: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+            if let Some(indices) = arguments.first() {
+                out.push(("pvsm_last_tile_triangle_share".to_owned(), f64::from(*indices) / 3.0 / f64::from(self.cull_triangles)));
             }
         }
         out
@@ -967,6 +1065,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         UniformCheck { wgsl_struct: "RasterSettings", wgsl_source: CONSERVATIVE_SHADER, imports: &[], rust: RasterSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "PyramidSettings", wgsl_source: PYRAMID_SHADER, imports: &[], rust: PyramidSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_SHADER, imports: LOCAL_SHADERS, rust: TileSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "CullSettings", wgsl_source: CULL_SHADER, imports: &[], rust: CullSettingsUniform::LAYOUT },
     ],
 };
 

@@ -288,3 +288,23 @@ fn a_near_plane_next_to_the_light_does_not_hide_the_occluders() {
 fn corners(scene: &Scene) -> Vec<Vec3> {
     scene.world_triangles().flat_map(|triangle| triangle.corners).collect()
 }
+
+/// Step 7's culling to the tile changes the work, not the image: with several tiles, each tile's
+/// map draws only the triangles that can touch it (the last tile a fraction of the scene's), and
+/// the visibility is the same as when every tile draws every triangle.
+#[test]
+fn culling_to_the_tile_draws_fewer_triangles_and_changes_no_pixel() {
+    let scene = builtin("sphere-cube").unwrap().build();
+    let (culled, diagnostics, _) = run(&scene, &[("grid_size", "16"), ("max_tile_size", "512")], SIZE);
+    let (unculled, _, _) = run(&scene, &[("grid_size", "16"), ("max_tile_size", "512"), ("tile_culling", "false")], SIZE);
+    let share = value(&diagnostics, "pvsm_last_tile_triangle_share");
+    let largest = culled.visibility.iter().zip(&unculled.visibility).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    println!(
+        "{} tiles, the last drew {:.1}% of the triangles; largest difference {largest}",
+        value(&diagnostics, "pvsm_tiles"),
+        share * 100.0
+    );
+    assert!(value(&diagnostics, "pvsm_tiles") >= 2.0);
+    assert!(share > 0.0 && share < 0.9, "{share}");
+    assert!(largest <= 1e-6, "{largest}");
+}
