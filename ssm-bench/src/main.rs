@@ -28,7 +28,7 @@ enum Command {
     Render(RenderArgs),
     /// Render every technique (or those named) and the ground truth; write results.csv, report.md and index.html.
     Compare(CompareArgs),
-    /// Vary techniques' parameters over a grid; write sweep.csv and the time-against-error plot (PNG, SVG).
+    /// Vary techniques' parameters over a grid; write sweep.csv, sweep.md and the time-against-error plot (PNG, SVG).
     Sweep(SweepArgs),
 }
 
@@ -38,7 +38,8 @@ struct SweepArgs {
     #[arg(long, required_unless_present_any = ["list_presets", "preset"])]
     scene: Option<String>,
     /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step);
-    /// `scene.light_scale` and `scene.occluder_lift` vary the scene; repeatable.
+    /// `scene.light_scale`, `scene.occluder_lift` and `scene.lights` vary the scene; a bare `<technique>` runs it at its
+    /// defaults; repeatable.
     #[arg(long = "vary", value_name = "TECHNIQUE.PARAM=V1,V2,...")]
     varies: Vec<String>,
     /// A named set of --vary axes (see `ssm sweep --list-presets`).
@@ -68,7 +69,7 @@ struct SweepArgs {
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
     pixels: Option<report::PixelSet>,
-    /// Output directory: sweep.csv, sweep.png, sweep.svg.
+    /// Output directory: sweep.csv, sweep.md (a Markdown table), sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
 }
@@ -484,6 +485,26 @@ fn write_sweep(
 ) -> Result<()> {
     let (out, x_axis, error) = (&sweep.out, &sweep.x_axis, sweep.error);
     std::fs::write(out.join("sweep.csv"), report::csv(rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
+    let table: Vec<sweep::MarkdownRow> = rows
+        .iter()
+        .zip(varied)
+        .map(|(row, values)| {
+            let own = format!("{}.", row.technique);
+            let point: Vec<(String, String)> =
+                values.iter().filter_map(|(k, v)| k.strip_prefix(&own).map(|k| (k.to_owned(), v.clone()))).collect();
+            sweep::MarkdownRow {
+                scene: row.scene.clone(),
+                technique: row.technique.clone(),
+                point: point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
+                ms: sweep::time_of(row),
+                mae_penumbra: row.metrics.mae_penumbra,
+                psnr: row.metrics.psnr,
+            }
+        })
+        .collect();
+    let name = args.preset.as_deref().unwrap_or("custom");
+    let markdown = sweep::markdown(name, &gpu.info.name, (args.width, args.height), args.frames, &table);
+    std::fs::write(out.join("sweep.md"), markdown).with_context(|| format!("writing {}", out.join("sweep.md").display()))?;
     // One series per technique and combination of the varied values that are not on the x axis.
     let plot_points: Vec<sweep::PlotPoint> = rows
         .iter()
@@ -529,7 +550,13 @@ fn write_sweep(
     if axes.pareto {
         say!("(* on the Pareto front)");
     }
-    say!("wrote {}, {} and {}", out.join("sweep.csv").display(), out.join("sweep.png").display(), out.join("sweep.svg").display());
+    say!(
+        "wrote {}, {}, {} and {}",
+        out.join("sweep.csv").display(),
+        out.join("sweep.md").display(),
+        out.join("sweep.png").display(),
+        out.join("sweep.svg").display()
+    );
     Ok(())
 }
 

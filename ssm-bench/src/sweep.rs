@@ -23,11 +23,16 @@ pub struct Vary {
 }
 
 impl Vary {
-    /// Parses `technique.p1[:p2...]=a1[:a2...],b1[:b2...],...`.
+    /// Parses `technique.p1[:p2...]=a1[:a2...],b1[:b2...],...`, or a bare `technique`: one
+    /// point at its defaults (a technique compared as it is while the scene varies).
     ///
     /// # Errors
     /// A malformed specification, with what was expected.
     pub fn parse(text: &str) -> Result<Self> {
+        let bare = text.trim();
+        if !bare.is_empty() && !bare.contains(['.', '=', ':', ',']) {
+            return Ok(Self { technique: bare.to_owned(), params: Vec::new(), values: vec![Vec::new()] });
+        }
         let expected = || format!("--vary `{text}`: expected <technique>.<param>[:<param>...]=<value>[:<value>...],...");
         let (key, values) = text.split_once('=').with_context(expected)?;
         let (technique, params) = key.split_once('.').with_context(expected)?;
@@ -113,12 +118,33 @@ pub fn trade_preset(registry: &Registry) -> PresetSpec {
     }
 }
 
-/// Every preset: `trade`, then each technique's, by technique name.
+/// The scene the `lights` preset runs on without `--scene`.
+pub const LIGHTS_SCENE: &str = "sphere-cube";
+
+/// `lights`: every real-time technique at its defaults with 1, 2 and 3 lights (Buades et al.,
+/// Fig. 11): the frame's time should grow linearly, since only per-light work repeats.
+#[must_use]
+pub fn lights_preset(registry: &Registry) -> PresetSpec {
+    let mut varies = vec!["scene.lights=1,2,3".to_owned()];
+    varies.extend(registry.iter().filter(|i| i.kind == TechniqueKind::Realtime).map(|i| i.name.to_owned()));
+    PresetSpec {
+        name: "lights".into(),
+        summary: "every technique at its defaults with 1, 2 and 3 copies of the scene's light (the timing of Buades et al., Fig. 11): time per frame against the light count, linear when only per-light work repeats".into(),
+        owner: None,
+        scenes: vec![LIGHTS_SCENE.into()],
+        varies,
+        x_axis: "scene.lights".into(),
+        y_axis: ErrorAxis::Time,
+        pixels: PixelSet::All,
+    }
+}
+
+/// Every preset: `trade`, `lights`, then each technique's, by technique name.
 ///
 /// # Errors
 /// A technique's preset with axes the tool does not know, or two presets of one name.
 pub fn presets(registry: &Registry) -> Result<Vec<PresetSpec>> {
-    let mut all = vec![trade_preset(registry)];
+    let mut all = vec![trade_preset(registry), lights_preset(registry)];
     for info in registry.iter() {
         for preset in info.presets {
             let spec = PresetSpec::from_technique(info.name, preset)?;
@@ -207,13 +233,20 @@ pub struct SceneOverrides {
     pub light_scale: f32,
     /// Occluder-only instances move this far towards the first light, along its normal, world units (`scene.occluder_lift`).
     pub occluder_lift: f32,
+    /// The number of lights (`scene.lights`): the scene's first ones, then copies of its first
+    /// light when it has fewer. Copies cost what the first costs, so a frame's time against the
+    /// light count shows what a technique repeats per light and what it shares.
+    pub lights: Option<usize>,
 }
 
 impl Default for SceneOverrides {
     fn default() -> Self {
-        Self { light_scale: 1.0, occluder_lift: 0.0 }
+        Self { light_scale: 1.0, occluder_lift: 0.0, lights: None }
     }
 }
+
+/// Most lights `scene.lights` asks for.
+pub const MAX_SWEPT_LIGHTS: usize = 8;
 
 impl SceneOverrides {
     /// The overrides of one grid point.
@@ -229,7 +262,11 @@ impl SceneOverrides {
                 "light_scale" if number >= 0.0 => overrides.light_scale = number,
                 "light_scale" => bail!("scene.light_scale={value}: must be non-negative"),
                 "occluder_lift" => overrides.occluder_lift = number,
-                other => bail!("unknown scene parameter `scene.{other}`; scene parameters: light_scale, occluder_lift"),
+                "lights" if number.fract() == 0.0 && (1.0..=MAX_SWEPT_LIGHTS as f32).contains(&number) => {
+                    overrides.lights = Some(number as usize);
+                }
+                "lights" => bail!("scene.lights={value}: must be a whole number from 1 to {MAX_SWEPT_LIGHTS}"),
+                other => bail!("unknown scene parameter `scene.{other}`; scene parameters: light_scale, occluder_lift, lights"),
             }
         }
         Ok(overrides)
@@ -241,6 +278,9 @@ impl SceneOverrides {
     /// The modified scene is invalid (an occluder lifted to a non-finite place, say).
     pub fn apply(&self, scene: &ssm_scene::Scene) -> Result<ssm_scene::Scene> {
         let mut scene = scene.clone();
+        if let (Some(count), Some(first)) = (self.lights, scene.lights.first().copied()) {
+            scene.lights.resize(count, first);
+        }
         for light in &mut scene.lights {
             light.half_size *= self.light_scale;
         }
@@ -319,6 +359,41 @@ impl ErrorAxis {
 #[must_use]
 pub fn time_of(row: &Row) -> f64 {
     row.gpu_ms_median.unwrap_or(row.cpu_ms)
+}
+
+/// One line of `sweep.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarkdownRow {
+    /// The scene, with its varied values (`sphere-cube[lights=2]`).
+    pub scene: String,
+    /// The technique.
+    pub technique: String,
+    /// Its varied values (`point_label`), empty at its defaults.
+    pub point: String,
+    /// Median time per frame, ms.
+    pub ms: f64,
+    /// Penumbra MAE against the ground truth.
+    pub mae_penumbra: f64,
+    /// PSNR against the ground truth, dB.
+    pub psnr: f64,
+}
+
+/// `sweep.md`: the sweep's rows as one Markdown table whose first column names the sweep (a
+/// preset's name), under a line naming the adapter, the image size and the frames timed. The
+/// table's lines from the fifth on are rows only, so that tables of several sweeps on one machine
+/// concatenate into one (`scripts/gpu-bench.sh`).
+#[must_use]
+pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
+    let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
+    text.push_str("| sweep | scene | technique | point | ms | penumbra MAE | PSNR dB |\n|---|---|---|---|---:|---:|---:|\n");
+    for row in rows {
+        let point = if row.point.is_empty() { "defaults" } else { &row.point };
+        text.push_str(&format!(
+            "| {sweep} | {} | {} | {point} | {:.2} | {:.4} | {:.1} |\n",
+            row.scene, row.technique, row.ms, row.mae_penumbra, row.psnr
+        ));
+    }
+    text
 }
 
 /// Indices of the rows on the Pareto front of (time, error): no other row is
@@ -577,6 +652,25 @@ mod tests {
         assert!(Vary::parse("mine.a:b=1:2,3").is_err());
         assert!(Vary::parse("mine=1").is_err());
         assert!(Vary::parse("mine.a=").is_err());
+        // A bare technique: one point at its defaults.
+        let bare = Vary::parse("mine").unwrap();
+        assert_eq!(grid(&[&bare, &size]).len(), 2);
+        assert_eq!(grid(&[&bare])[0], Vec::<(String, String)>::new());
+    }
+
+    #[test]
+    fn scene_lights_keeps_the_first_lights_or_copies_the_first() {
+        let scene = ssm_scene::builtin("sphere-cube").unwrap().build();
+        let with = |n: &str| SceneOverrides::from_point(&[("lights".into(), n.into())]).unwrap().apply(&scene).unwrap();
+        assert_eq!(with("1").lights, scene.lights[..1].to_vec());
+        assert_eq!(with("3").lights, vec![scene.lights[0]; 3]);
+        let mut two = scene.clone();
+        two.lights.push(ssm_scene::RectLight { half_size: glam::Vec2::ZERO, ..scene.lights[0] });
+        let kept = SceneOverrides::from_point(&[("lights".into(), "3".into())]).unwrap().apply(&two).unwrap();
+        assert_eq!(kept.lights, vec![two.lights[0], two.lights[1], two.lights[0]], "the scene's own lights first");
+        for bad in ["0", "1.5", "9", "-1"] {
+            assert!(SceneOverrides::from_point(&[("lights".into(), bad.into())]).is_err(), "scene.lights={bad}");
+        }
     }
 
     #[test]
@@ -590,6 +684,23 @@ mod tests {
         assert_eq!(changed.bounds_where(|r| r == ssm_scene::Role::Receiver), scene.bounds_where(|r| r == ssm_scene::Role::Receiver));
         assert!(SceneOverrides::from_point(&[("size".into(), "1".into())]).is_err());
         assert!(SceneOverrides::from_point(&[("light_scale".into(), "-1".into())]).is_err());
+    }
+
+    #[test]
+    fn markdown_tables_of_several_sweeps_concatenate() {
+        let row = |technique: &str| MarkdownRow {
+            scene: "sphere-cube[lights=2]".into(),
+            technique: technique.into(),
+            point: String::new(),
+            ms: 12.345,
+            mae_penumbra: 0.01234,
+            psnr: 31.25,
+        };
+        let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
+        let lines: Vec<&str> = first.lines().collect();
+        assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
+        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0123 | 31.2 |");
+        assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }
 
     #[test]

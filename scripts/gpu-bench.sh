@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The speed presets on whatever adapter wgpu picks, at 1920×1080 unless told otherwise, gathered
+# into one Markdown table that names the adapter (issue 13: run it on a machine with a GPU and put
+# the table in the README beside the lavapipe one).
+#
+#   scripts/gpu-bench.sh [OUT]          # default OUT: gpu-bench; writes OUT/gpu-bench.md
+#
+# Environment: SSM_BENCH_WIDTH, SSM_BENCH_HEIGHT (1920, 1080), SSM_BENCH_FRAMES (5),
+# SSM_BENCH_PRESETS (space-separated preset names; default below), SSM_BENCH_SET (extra
+# `--set` assignments, space-separated, e.g. "reference.samples=64" to shorten the ground truth).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+out="${1:-gpu-bench}"
+width="${SSM_BENCH_WIDTH:-1920}"
+height="${SSM_BENCH_HEIGHT:-1080}"
+frames="${SSM_BENCH_FRAMES:-5}"
+# Buades et al.'s Table 4, Atty et al.'s map sizes (one- and two-sided), 1–3 lights for every
+# technique, Shen et al.'s Figs. 10 and 11, Forest et al.'s Fig. 12.
+presets="${SSM_BENCH_PRESETS:-sssm-table4 atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+
+settings=()
+for assignment in ${SSM_BENCH_SET:-}; do
+    settings+=(--set "$assignment")
+done
+
+cargo build --release --locked --bin ssm
+ssm() { cargo run --release --locked --quiet --bin ssm -- "$@"; }
+mkdir -p "$out"
+table="$out/gpu-bench.md"
+first=1
+for preset in $presets; do
+    echo "== $preset" >&2
+    ssm sweep --preset "$preset" --width "$width" --height "$height" --frames "$frames" \
+        "${settings[@]}" --out "$out/$preset"
+    # sweep.md: a title naming the adapter, a blank line, the header and its rule, then rows.
+    if [ "$first" = 1 ]; then
+        { echo "# ssm speed presets"; echo; cat "$out/$preset/sweep.md"; } > "$table"
+        first=0
+    else
+        tail -n +5 "$out/$preset/sweep.md" >> "$table"
+    fi
+done
+echo "wrote $table" >&2
