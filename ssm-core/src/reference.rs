@@ -7,6 +7,15 @@
 //! Deterministic: each pixel's jitter comes from a fixed seed and the pixel's
 //! index, so the result does not depend on thread scheduling, and it is cached
 //! on disk under a hash of everything that changes it.
+//!
+//! A pixel's rays share their origin, so they are not traced one by one where
+//! that can be avoided, with the same answer ray for ray: the triangles in the
+//! pyramid from the point to the light are gathered from the BVH once (none:
+//! lit; one that covers the pyramid: dark; a few: each ray tested against
+//! them; too many: the light cut into quarters, each with its own pyramid),
+//! and rays that still traverse the BVH first try the triangles that blocked
+//! the pixel's last rays. `GroundTruth::visibility_per_ray` is the plain
+//! definition, which a test compares it with.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -21,7 +30,89 @@ use ssm_scene::{RectLight, Scene};
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 1;
+pub const REFERENCE_VERSION: u32 = 2;
+
+/// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
+/// more, the part is cut further or its rays traverse the BVH one by one.
+const GATHER_LIMIT: usize = 12;
+
+/// With at most this many triangles in a part's pyramid, its rays are tested against them one by
+/// one rather than the part being cut into quarters.
+const DIRECT_CANDIDATES: usize = 12;
+
+/// The pyramid from a ray origin to a rectangle of the light: every segment from the apex to a
+/// point of the rectangle lies inside it.
+struct Pyramid {
+    apex: Vec3,
+    /// The rectangle's corners, in order around it.
+    base: [Vec3; 4],
+    /// Outward normals and offsets of the four sides and the base.
+    planes: [(Vec3, f32); 5],
+}
+
+impl Pyramid {
+    /// `None` when it is degenerate (a side of no area: the apex in the light's plane).
+    fn new(apex: Vec3, base: [Vec3; 4], light: &RectLight) -> Option<Self> {
+        let inside = (apex + (base[0] + base[2]) * 0.5) * 0.5;
+        let mut planes = [(Vec3::ZERO, 0.0f32); 5];
+        for (k, plane) in planes.iter_mut().take(4).enumerate() {
+            let normal = (base[k] - apex).cross(base[(k + 1) % 4] - apex).try_normalize()?;
+            let normal = if normal.dot(inside - apex) > 0.0 { -normal } else { normal };
+            *plane = (normal, normal.dot(apex));
+        }
+        let normal = light.normal();
+        let normal = if normal.dot(base[0] - apex) < 0.0 { -normal } else { normal };
+        planes[4] = (normal, normal.dot(base[0]));
+        Some(Self { apex, base, planes })
+    }
+
+    /// True when the box lies wholly beyond one plane by more than `margin`.
+    fn box_outside(&self, min: Vec3, max: Vec3, margin: f32) -> bool {
+        self.planes.iter().any(|(normal, offset)| {
+            let nearest = Vec3::select(normal.cmpge(Vec3::ZERO), min, max);
+            normal.dot(nearest) > offset + margin
+        })
+    }
+}
+
+/// One pixel's rays, all from one origin: the light, the strata and their jitter.
+struct PixelRays<'a> {
+    light: &'a RectLight,
+    origin: Vec3,
+    n: u32,
+    /// Jitter of stratum (i, j) at j·n + i.
+    jitter: Vec<Vec2>,
+    recent: RecentBlockers,
+}
+
+impl PixelRays<'_> {
+    /// The light sample of stratum (i, j), as visibility_per_ray places it.
+    fn sample(&self, i: u32, j: u32) -> Vec3 {
+        let jitter = self.jitter[(j * self.n + i) as usize];
+        let stratum = (Vec2::new(i as f32, j as f32) + jitter) / self.n as f32 * 2.0 - Vec2::ONE;
+        self.light.point(stratum.x, stratum.y)
+    }
+}
+
+/// The last few triangles that blocked a pixel's rays, newest first.
+#[derive(Default)]
+struct RecentBlockers {
+    slots: [u32; 4],
+    count: usize,
+}
+
+impl RecentBlockers {
+    fn triangles(&self) -> &[u32] {
+        &self.slots[..self.count]
+    }
+
+    fn push(&mut self, triangle: u32) {
+        let len = self.slots.len();
+        self.slots.copy_within(0..len - 1, 1);
+        self.slots[0] = triangle;
+        self.count = (self.count + 1).min(len);
+    }
+}
 
 /// The scene's triangles in a BVH, ready for shadow rays.
 pub struct GroundTruth {
@@ -128,6 +219,112 @@ impl GroundTruth {
         self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
     }
 
+    /// The triangles that can cross a segment inside `pyramid` (their BVH leaf boxes meet it,
+    /// no plane of it has all three corners beyond, and their own plane does not pass beside
+    /// it), into `found`; `false` as soon as there are more than `limit`.
+    fn pyramid_candidates(&self, pyramid: &Pyramid, limit: usize, found: &mut Vec<u32>) -> bool {
+        found.clear();
+        if self.bvh.nodes.is_empty() {
+            return true;
+        }
+        let margin = self.pyramid_margin();
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(index) = stack.pop() {
+            let node = &self.bvh.nodes[index as usize];
+            for child in 0..8 {
+                if node.is_child_empty(child) {
+                    continue;
+                }
+                let aabb = node.child_aabb(child);
+                if pyramid.box_outside(Vec3::from(aabb.min), Vec3::from(aabb.max), margin) {
+                    continue;
+                }
+                if node.is_leaf(child) {
+                    let (start, count) = node.child_primitives(child);
+                    for slot in start..start + count {
+                        let index = self.bvh.primitive_indices[slot as usize];
+                        if self.may_cross(index, pyramid) {
+                            found.push(index);
+                        }
+                    }
+                    if found.len() > limit {
+                        return false;
+                    }
+                } else {
+                    stack.push(node.child_node_index(child));
+                }
+            }
+        }
+        true
+    }
+
+    /// How far outside a pyramid's planes a box or triangle may lie and still be kept: rays
+    /// grazing a triangle's edge must keep it.
+    fn pyramid_margin(&self) -> f32 {
+        self.surface_offset * 10.0
+    }
+
+    /// Whether triangle `index` can cross a segment from the pyramid's apex to its base: no
+    /// plane of the pyramid has all three of its corners beyond, and its own plane does not
+    /// have the apex and the base's corners all on one side, clear of it by half the surface
+    /// offset (no segment then crosses it: this drops the surface a point lies on, which its
+    /// rays leave by the surface offset, and faces turned away from the light).
+    fn may_cross(&self, index: u32, pyramid: &Pyramid) -> bool {
+        let triangle = &self.triangles[index as usize];
+        let corners = [Vec3::from(triangle.v0), Vec3::from(triangle.v1), Vec3::from(triangle.v2)];
+        let margin = self.pyramid_margin();
+        if pyramid.planes.iter().any(|(normal, offset)| corners.iter().all(|c| normal.dot(*c) > offset + margin)) {
+            return false;
+        }
+        let Some(normal) = (corners[1] - corners[0]).cross(corners[2] - corners[0]).try_normalize() else {
+            return true;
+        };
+        let clearance = 0.5 * self.surface_offset;
+        let side = |p: Vec3| normal.dot(p - corners[0]);
+        let first = side(pyramid.apex);
+        if first.abs() <= clearance {
+            return true;
+        }
+        !pyramid.base.iter().all(|corner| {
+            let distance = side(*corner);
+            distance.abs() > clearance && (distance > 0.0) == (first > 0.0)
+        })
+    }
+
+    /// The triangle the BVH finds first on the segment from `origin` to `target` (the segment and
+    /// test of [`GroundTruth::unoccluded`]), if any.
+    fn first_blocker(&self, origin: Vec3, target: Vec3) -> Option<u32> {
+        let offset = target - origin;
+        let distance = offset.length();
+        if distance <= 0.0 {
+            return None;
+        }
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
+        let mut found = None;
+        self.bvh.ray_traverse_miss(ray, |ray, id| {
+            let index = self.bvh.primitive_indices[id];
+            let t = self.triangles[index as usize].intersect(ray);
+            if t < ray.tmax {
+                found = Some(index);
+            }
+            t
+        });
+        found
+    }
+
+    /// True when the ray from `origin` to `target` crosses one of `candidates` (the same
+    /// segment and intersection test as [`GroundTruth::unoccluded`]).
+    fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
+        let offset = target - origin;
+        let distance = offset.length();
+        if distance <= 0.0 {
+            return false;
+        }
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
+        candidates.iter().any(|index| self.triangles[*index as usize].intersect(&ray) < ray.tmax)
+    }
+
     /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
     /// samples jittered by `rng`. Points behind the light's plane see none of it.
     /// With a footprint, each sample also starts from its own point of the
@@ -140,6 +337,126 @@ impl GroundTruth {
             return 0.0;
         }
         let n = samples_per_axis.max(1);
+        if point.footprint.is_none()
+            && let Some(shortcut) = self.pyramid_visibility(light, point, n, rng)
+        {
+            return shortcut;
+        }
+        self.visibility_of_rays(light, point, n, rng, true)
+    }
+
+    /// The shortcut of [`GroundTruth::visibility`] for a point (no footprint) whose N² rays
+    /// all leave one origin (the light wholly on one side of its tangent plane): the light is
+    /// cut into quarters, each with the pyramid from the origin to it ([`GroundTruth::count_visible`]).
+    /// A point light casts one ray for all N². `None` leaves the pixel to the per-ray traversal.
+    fn pyramid_visibility(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64) -> Option<f32> {
+        let corners = [light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)];
+        // One origin for every sample: the side rule is affine in the sample, so the corners decide.
+        let first_side = point.normal.dot(corners[0] - point.position) >= 0.0;
+        if corners.iter().any(|c| (point.normal.dot(*c - point.position) >= 0.0) != first_side) {
+            return None;
+        }
+        let side = if first_side { 1.0 } else { -1.0 };
+        let origin = point.position + point.normal * (side * self.surface_offset);
+        if light.is_point() {
+            return Some(if self.unoccluded(origin, light.centre) { 1.0 } else { 0.0 });
+        }
+        // The jitter of every stratum, drawn in the order visibility_per_ray draws it.
+        let jitter: Vec<Vec2> = (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
+        let mut rays = PixelRays { light, origin, n, jitter, recent: RecentBlockers::default() };
+        let visible = self.count_visible(&mut rays, [0, n, 0, n], None, 0);
+        Some(visible as f32 / (n * n) as f32)
+    }
+
+    /// How many of the rays to the strata [i0, i1) × [j0, j1) reach the light, from the
+    /// triangles in the pyramid from the origin to that part of the light (`parent`: those of
+    /// the enclosing part, or `None` to gather them from the BVH). None in it: every ray reaches
+    /// the light. One triangle that the four corner rays all cross: it covers the pyramid (a
+    /// convex triangle, a convex cone), none does. A few: each ray is tested against them.
+    /// Otherwise the part is cut into quarters. Exact: a triangle a ray crosses is always among
+    /// the candidates, and each ray is decided by the same test as the BVH's.
+    fn count_visible(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32) -> u32 {
+        let [i0, i1, j0, j1] = region;
+        let strata = (i1 - i0) * (j1 - j0);
+        if strata == 0 {
+            return 0;
+        }
+        let scale = 2.0 / rays.n as f32;
+        let (s0, s1, t0, t1) = (i0 as f32 * scale - 1.0, i1 as f32 * scale - 1.0, j0 as f32 * scale - 1.0, j1 as f32 * scale - 1.0);
+        let corners = [rays.light.point(s0, t0), rays.light.point(s1, t0), rays.light.point(s1, t1), rays.light.point(s0, t1)];
+        let gathered = Pyramid::new(rays.origin, corners, rays.light).and_then(|pyramid| {
+            let mut found = Vec::new();
+            let complete = match parent {
+                Some(parent) => {
+                    found.extend(parent.iter().copied().filter(|index| self.may_cross(*index, &pyramid)));
+                    true
+                }
+                // Gathering from the BVH costs a traversal: only for the whole light and its quarters.
+                None if depth <= 1 => self.pyramid_candidates(&pyramid, GATHER_LIMIT, &mut found),
+                None => false,
+            };
+            complete.then_some(found)
+        });
+        match gathered {
+            Some(candidates) if candidates.is_empty() => strata,
+            Some(candidates) if candidates.iter().any(|index| corners.iter().all(|c| self.blocked_by(rays.origin, *c, &[*index]))) => 0,
+            Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
+                let mut visible = 0;
+                for j in j0..j1 {
+                    for i in i0..i1 {
+                        if !self.blocked_by(rays.origin, rays.sample(i, j), &candidates) {
+                            visible += 1;
+                        }
+                    }
+                }
+                visible
+            }
+            Some(candidates) => self.count_quarters(rays, region, Some(&candidates), depth),
+            None if strata > 1 && depth == 0 => self.count_quarters(rays, region, None, depth),
+            None => {
+                // Too many triangles even here: each ray through the BVH.
+                let mut visible = 0;
+                for j in j0..j1 {
+                    for i in i0..i1 {
+                        let sample = rays.sample(i, j);
+                        let blocked = self.blocked_by(rays.origin, sample, rays.recent.triangles())
+                            || self.first_blocker(rays.origin, sample).map(|blocker| rays.recent.push(blocker)).is_some();
+                        if !blocked {
+                            visible += 1;
+                        }
+                    }
+                }
+                visible
+            }
+        }
+    }
+
+    /// [`GroundTruth::count_visible`] of the four quarters of `region`.
+    fn count_quarters(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32) -> u32 {
+        let [i0, i1, j0, j1] = region;
+        let (im, jm) = ((i0 + i1).div_ceil(2), (j0 + j1).div_ceil(2));
+        [[i0, im, j0, jm], [im, i1, j0, jm], [i0, im, jm, j1], [im, i1, jm, j1]]
+            .into_iter()
+            .map(|quarter| self.count_visible(rays, quarter, parent, depth + 1))
+            .sum()
+    }
+
+    /// [`GroundTruth::visibility`] one ray at a time through the BVH: the definition the
+    /// shortcuts must match (tests compare them).
+    #[must_use]
+    pub fn visibility_per_ray(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64) -> f32 {
+        if point.footprint.is_none() && (point.position - light.centre).dot(light.normal()) <= 0.0 {
+            return 0.0;
+        }
+        self.visibility_of_rays(light, point, n, rng, false)
+    }
+
+    /// The N² rays of a pixel, each through the BVH; with `remember`, each ray first tries the
+    /// last few triangles that blocked the pixel's rays (neighbouring rays mostly hit the same
+    /// ones), which changes no answer: a ray one of them blocks is blocked.
+    fn visibility_of_rays(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64, remember: bool) -> f32 {
+        let n = n.max(1);
+        let mut recent = RecentBlockers::default();
         // With a footprint, the pixel's strata in a random order: a fixed pairing with the
         // light's strata (such as (i, j) with (j, i)) correlates them and biases the average.
         let pixel_strata: Vec<u32> = match point.footprint {
@@ -174,7 +491,19 @@ impl GroundTruth {
                 // Leave the surface on the side facing this sample, so that it does not shadow itself.
                 let side = if point.normal.dot(sample - position) >= 0.0 { 1.0 } else { -1.0 };
                 let origin = position + point.normal * (side * self.surface_offset);
-                if self.unoccluded(origin, sample) {
+                let open = if remember {
+                    !self.blocked_by(origin, sample, recent.triangles())
+                        && match self.first_blocker(origin, sample) {
+                            Some(blocker) => {
+                                recent.push(blocker);
+                                false
+                            }
+                            None => true,
+                        }
+                } else {
+                    self.unoccluded(origin, sample)
+                };
+                if open {
                     visible += 1;
                 }
             }
