@@ -19,6 +19,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
 
 struct PcssSettings {
     // Samples per axis of the blocker search (n).
@@ -29,10 +30,20 @@ struct PcssSettings {
     receiver_plane: u32,
     // Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
+    // 1: count the texture reads of each computed pixel into read_counts (profiling; atomics cost time).
+    count_reads: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
+// Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
+@group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texture reads of this invocation: the G-buffer's two and every shadow-map tap.
+var<private> reads: u32;
 
 // The depth a tap at `uv` is compared with (common/shadow_map.wgsl).
 fn compared_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
@@ -46,6 +57,18 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     if (trivial >= 0.0) {
         return trivial;
     }
+    reads = 2u;
+    let visibility = soft_visibility(point);
+    if (settings.count_reads != 0u) {
+        let word = read_count_word(0u, point.texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+    return visibility;
+}
+
+// Steps 1 to 3 for a pixel that needs them.
+fn soft_visibility(point: ScreenPoint) -> f32 {
     let normal = point.normal;
     let lookup = normal_offset_position(frame, shadow_map, point.position, normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
@@ -60,6 +83,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         for (var i = 0u; i < n; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
             let depth = shadow_map_depth(shadow_map, uv);
+            reads += 1u;
             if (depth < compared_depth(lookup, normal, uv, receiver_depth)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
@@ -79,6 +103,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         for (var i = 0u; i < m; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
             lit += select(0.0, 1.0, compared_depth(lookup, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
+            reads += 1u;
         }
     }
     return lit / f32(m * m);

@@ -5,7 +5,7 @@
 
 // #import sssm/sssm_common.wgsl
 
-@group(2) @binding(3) var horizontal_blocker: texture_2d<f32>;
+@group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
 
 // (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker rows
 // reused); w = -1 where nothing was computed (background, behind the light).
@@ -13,10 +13,17 @@
 fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
-    let d = own.x;
-    if (d < 0.0) {
+    if (own.x < 0.0) {
         return vec4<f32>(own.w, 0.0, 0.0, -1.0);
     }
+    reads = 3u;
+    let result = blocker_and_blur(in, point, own);
+    record_reads(1u, point.texel);
+    return result;
+}
+
+fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> vec4<f32> {
+    let d = own.x;
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let search = light_half_extent_uv(frame, frame.projection.z, d);
@@ -36,6 +43,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
         var reuse = false;
         if (screen.z > 0.0 && on_screen(screen.xy)) {
             let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
+            reads += 1u;
             if (other.x >= 0.0 && abs(d - other.x) < scene_length(frame, settings.alpha)) {
                 sum += other.y;
                 count += other.z;
@@ -47,6 +55,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
             for (var i = 0u; i < n; i++) {
                 let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
                 let depth = shadow_map_depth(shadow_map, tap);
+                reads += 1u;
                 if (depth < compared_depth(lookup, point.normal, tap, d)) {
                     sum += depth;
                     count += 1.0;
@@ -85,6 +94,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
         var weight = tap_weight(j, m);
         if (on_screen(tap)) {
             value = textureLoad(horizontal_blocker, vec2<i32>(tap), 0).w;
+            reads += 1u;
             weight *= bilateral_weight(rays, point.position, point.normal, tap);
         } else {
             // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.

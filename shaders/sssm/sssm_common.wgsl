@@ -3,6 +3,7 @@
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
 // #import common/camera.wgsl
+// #import common/read_counts.wgsl
 
 struct SssmSettings {
     // Samples per axis of the blocker search (n) and of the blur (m).
@@ -22,7 +23,8 @@ struct SssmSettings {
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    _pad0: f32,
+    // 1: count each computed pixel's texture reads into read_counts (profiling; atomics cost time).
+    count_reads: u32,
     _pad1: f32,
     _pad2: f32,
 };
@@ -30,6 +32,21 @@ struct SssmSettings {
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
+// Per pass (0 horizontal blocker, 1 blocker and horizontal blur, 2 vertical blur): (pixels,
+// reads) per bucket (common/read_counts.wgsl).
+@group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texture reads of this invocation so far (G-buffer, shadow map, the passes' own targets).
+var<private> reads: u32;
+
+// Adds this pixel and its reads to pass `pass_index`'s counts, when counting.
+fn record_reads(pass_index: u32, texel: vec2<i32>) {
+    if (settings.count_reads != 0u) {
+        let word = read_count_word(pass_index, texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+}
 
 // The world point at shadow-map coordinates `uv` and linear light depth `depth` (inverse of light_uv_depth).
 fn light_point(uv: vec2<f32>, depth: f32) -> vec3<f32> {
@@ -90,6 +107,7 @@ fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
         return 0.0;
     }
     let uvd = light_uv_depth(frame, world + offset);
+    reads += 1u;
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
 }
 
@@ -175,10 +193,12 @@ fn bilateral_weight(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel
     }
     let texel = vec2<i32>(pixel);
     let other = textureLoad(gbuffer_position, texel, 0);
+    reads += 1u;
     let expected = tangent_plane_point(rays, point, normal, pixel);
     if (other.w < 0.5 || expected.w == 0.0) {
         return 0.0;
     }
+    reads += 1u;
     let eye = camera.position.xyz;
     let gap = (distance(other.xyz, eye) - distance(expected.xyz, eye)) / scene_length(frame, settings.bilateral_depth);
     let turn = max(dot(normal, textureLoad(gbuffer_normal, texel, 0).xyz), 0.0);

@@ -13,9 +13,17 @@ fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
     if (trivial >= 0.0) {
         return vec4<f32>(-1.0, 0.0, 0.0, trivial);
     }
+    reads = 2u;
+    let result = partial_blocker(point);
+    record_reads(0u, point.texel);
+    return result;
+}
+
+fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let hard = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+    reads += 1u;
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
     let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
     let n = max(settings.blocker_kernel, 1u);
@@ -24,6 +32,7 @@ fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
     for (var i = 0u; i < n; i++) {
         let tap = uvd.xy + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
         let depth = shadow_map_depth(shadow_map, tap);
+        reads += 1u;
         if (depth < compared_depth(lookup, point.normal, tap, uvd.z)) {
             sum += depth;
             count += 1.0;

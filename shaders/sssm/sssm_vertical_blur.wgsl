@@ -6,9 +6,9 @@
 
 // #import sssm/sssm_common.wgsl
 
-@group(2) @binding(3) var horizontal_blocker: texture_2d<f32>;
-@group(2) @binding(4) var horizontal_blur: texture_2d<f32>;
-@group(2) @binding(5) var reuse_share: texture_storage_2d<r32float, write>;
+@group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
+@group(2) @binding(5) var horizontal_blur: texture_2d<f32>;
+@group(2) @binding(6) var reuse_share: texture_storage_2d<r32float, write>;
 
 @fragment
 fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
@@ -20,6 +20,13 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
         textureStore(reuse_share, point.texel, vec4<f32>(-1.0));
         return own.x;
     }
+    reads = 3u;
+    let result = vertical(in, point, own);
+    record_reads(2u, point.texel);
+    return result;
+}
+
+fn vertical(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> f32 {
     let n = f32(max(settings.blocker_kernel, 1u));
     let radii = own.yz;
     if (max(radii.x, radii.y) < 0.5) {
@@ -31,6 +38,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
     let eye = camera.position.xyz;
     let rays = camera_rays();
     let own_hard = textureLoad(horizontal_blocker, point.texel, 0).w;
+    reads += 1u;
     let offset = lookup_offset(point.position, point.normal);
     var blurred = 0.0;
     var total = 0.0;
@@ -43,9 +51,11 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
         if (on_screen(row)) {
             let texel = vec2<i32>(row);
             let other = textureLoad(gbuffer_position, texel, 0);
+            reads += 1u;
             let expected = tangent_plane_point(rays, point.position, point.normal, row);
             if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < scene_length(frame, settings.beta)) {
                 value = textureLoad(horizontal_blur, texel, 0).x;
+                reads += 1u;
                 weight *= bilateral_weight(rays, point.position, point.normal, row);
                 reuse = true;
                 reused += 1.0;

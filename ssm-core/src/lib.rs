@@ -28,6 +28,7 @@ mod light_frame;
 pub mod metrics;
 mod params;
 pub mod passes;
+pub mod read_counts;
 pub mod readback;
 pub mod reference;
 mod registry;

@@ -22,6 +22,7 @@ pub const COMMON_SHADERS: &[(&str, &str)] = &[
     common_shader!("light_frame.wgsl"),
     common_shader!("shadow_map.wgsl"),
     common_shader!("screen_pass.wgsl"),
+    common_shader!("read_counts.wgsl"),
 ];
 
 /// The prefix of an import line.

@@ -11,11 +11,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings,
-    ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
-    register_technique, screen_space_requirements,
+    Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE,
+    ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
+    VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -36,6 +37,9 @@ pub struct PcssSettings {
     /// Samples per axis of the PCF filter (m; m² taps per pixel).
     #[param(default = 15, min = 1, max = 128)]
     pub pcf_kernel: u32,
+    /// Count each pass's texture reads per pixel (diagnostics `pcss_blocker_search_and_filter_reads_per_pixel`); the atomics cost time, so off when timing.
+    #[param(default = false)]
+    pub count_reads: bool,
     /// What the taps are compared with.
     #[param(flatten)]
     pub receiver: ReceiverModel,
@@ -52,6 +56,10 @@ pub struct PcssSettingsUniform {
     pcf_kernel: u32,
     receiver_plane: u32,
     normal_offset: f32,
+    count_reads: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 impl From<&PcssSettings> for PcssSettingsUniform {
@@ -61,6 +69,10 @@ impl From<&PcssSettings> for PcssSettingsUniform {
             pcf_kernel: settings.pcf_kernel,
             receiver_plane: u32::from(settings.receiver.receiver_plane),
             normal_offset: settings.bias.normal_offset,
+            count_reads: u32::from(settings.count_reads),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 }
@@ -70,6 +82,8 @@ pub struct Pcss {
     depth_map: LightDepthMap,
     search_and_filter: ScreenPass,
     map_bind_group: wgpu::BindGroup,
+    read_counts: ReadCounts,
+    count_reads: bool,
 }
 
 impl Pcss {
@@ -82,12 +96,17 @@ impl Pcss {
         let device = &setup.gpu.device;
         let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
-        let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1)]);
+        let read_counts = ReadCounts::new(device, "pcss_read_counts", &["pcss_blocker_search_and_filter"]);
+        let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
             "pcss_map_bind_group",
             &map_layout,
-            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), settings_buffer.as_entire_binding()],
+            &[
+                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                settings_buffer.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
+            ],
         );
         let module = create_shader(setup.gpu, "pcss_filter_shader", SHADER)?;
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
@@ -99,15 +118,23 @@ impl Pcss {
             Some(&map_layout),
             VISIBILITY_FORMAT.into(),
         )?;
-        Ok(Self { depth_map, search_and_filter, map_bind_group })
+        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, count_reads: settings.count_reads })
     }
 }
 
 impl ShadowTechnique for Pcss {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
+        if self.count_reads {
+            self.read_counts.clear(frame, light);
+        }
         self.depth_map.encode(frame, light);
         self.search_and_filter.encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
+    }
+
+    /// With `count_reads`: texture reads per computed pixel, and the pixels.
+    fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
+        if self.count_reads { self.read_counts.diagnostics(gpu) } else { Vec::new() }
     }
 }
 

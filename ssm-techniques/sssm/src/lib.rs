@@ -12,6 +12,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{bind_group, bind_group_layout, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry};
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
@@ -71,6 +72,9 @@ pub struct SssmSettings {
     /// Blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur).
     #[param(default = 0.005, min = 0.0, max = 1.0)]
     pub bilateral_depth: f32,
+    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`); the atomics cost time, so off when timing.
+    #[param(default = false)]
+    pub count_reads: bool,
     /// Depth bias and normal offset.
     #[param(flatten)]
     pub bias: ShadowMapBias,
@@ -89,7 +93,7 @@ pub struct SssmSettingsUniform {
     sigma: f32,
     normal_offset: f32,
     bilateral_depth: f32,
-    _pad0: f32,
+    count_reads: u32,
     _pad1: f32,
     _pad2: f32,
 }
@@ -106,7 +110,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             sigma: settings.sigma,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
-            _pad0: 0.0,
+            count_reads: u32::from(settings.count_reads),
             _pad1: 0.0,
             _pad2: 0.0,
         }
@@ -124,7 +128,12 @@ pub struct SeparableSoftShadowMaps {
     horizontal_blocker_view: wgpu::TextureView,
     horizontal_blur_view: wgpu::TextureView,
     reuse: wgpu::Texture,
+    read_counts: ReadCounts,
+    count_reads: bool,
 }
+
+/// The names of the passes whose reads are counted, in the shaders' order.
+const COUNTED_PASSES: &[&str] = &["sssm_horizontal_blocker", "sssm_blocker_and_horizontal_blur", "sssm_vertical_blur"];
 
 /// The intermediate targets between the three passes.
 struct Targets {
@@ -171,7 +180,8 @@ impl SeparableSoftShadowMaps {
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
         let layouts = Self::layouts(device);
-        let groups = Self::bind_groups(setup, &layouts, (&settings_buffer, &depth_map), &targets);
+        let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES);
+        let groups = Self::bind_groups(setup, &layouts, (&settings_buffer, &depth_map, read_counts.buffer()), &targets);
         let module = |label: &str, source: &str| create_shader_with_imports(setup.gpu, label, source, LOCAL_SHADERS);
         let rgba = wgpu::ColorTargetState::from(wgpu::TextureFormat::Rgba32Float);
         let [layout_a, layout_b, layout_c] = &layouts;
@@ -208,18 +218,20 @@ impl SeparableSoftShadowMaps {
             horizontal_blocker_view: targets.horizontal_blocker,
             horizontal_blur_view: targets.horizontal_blur,
             reuse: targets.reuse,
+            read_counts,
+            count_reads: settings.count_reads,
         })
     }
 
     /// The three passes' own layouts: camera, settings and depth map, then what each reads and writes.
     fn layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 3] {
-        let common = [uniform_entry(0), uniform_entry(1), texture_entry(2)];
+        let common = [uniform_entry(0), uniform_entry(1), texture_entry(2), ReadCounts::layout_entry(3)];
         let layout = |label: &str, extra: &[wgpu::BindGroupLayoutEntry]| {
             let entries: Vec<wgpu::BindGroupLayoutEntry> = common.iter().chain(extra).copied().collect();
             bind_group_layout(device, label, &entries)
         };
         let reuse_storage = wgpu::BindGroupLayoutEntry {
-            binding: 5,
+            binding: 6,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: wgpu::BindingType::StorageTexture {
                 access: wgpu::StorageTextureAccess::WriteOnly,
@@ -230,15 +242,15 @@ impl SeparableSoftShadowMaps {
         };
         [
             layout("sssm_horizontal_blocker_layout", &[]),
-            layout("sssm_blocker_blur_layout", &[texture_entry(3)]),
-            layout("sssm_vertical_blur_layout", &[texture_entry(3), texture_entry(4), reuse_storage]),
+            layout("sssm_blocker_blur_layout", &[texture_entry(4)]),
+            layout("sssm_vertical_blur_layout", &[texture_entry(4), texture_entry(5), reuse_storage]),
         ]
     }
 
     fn bind_groups(
         setup: &TechniqueSetup<'_>,
         [layout_a, layout_b, layout_c]: &[wgpu::BindGroupLayout; 3],
-        (settings_buffer, depth_map): (&wgpu::Buffer, &LightDepthMap),
+        (settings_buffer, depth_map, read_counts): (&wgpu::Buffer, &LightDepthMap, &wgpu::Buffer),
         targets: &Targets,
     ) -> [wgpu::BindGroup; 3] {
         let device = &setup.gpu.device;
@@ -247,6 +259,7 @@ impl SeparableSoftShadowMaps {
                 setup.scene.camera_buffer.as_entire_binding(),
                 settings_buffer.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                read_counts.as_entire_binding(),
             ];
             resources.extend_from_slice(extra);
             bind_group(device, label, layout, &resources)
@@ -276,6 +289,9 @@ impl SeparableSoftShadowMaps {
 impl ShadowTechnique for SeparableSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         let [group_a, group_b, group_c] = &self.groups;
+        if self.count_reads {
+            self.read_counts.clear(frame, light);
+        }
         self.depth_map.encode(frame, light);
         self.horizontal_blocker.encode(frame, light, &self.horizontal_blocker_view, Some(group_a), Some(wgpu::Color::TRANSPARENT));
         self.blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(group_b), Some(wgpu::Color::TRANSPARENT));
@@ -290,7 +306,11 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
         if computed.is_empty() {
             return Vec::new();
         }
-        vec![("sssm_reuse_share".to_owned(), computed.iter().sum::<f64>() / computed.len() as f64)]
+        let mut out = vec![("sssm_reuse_share".to_owned(), computed.iter().sum::<f64>() / computed.len() as f64)];
+        if self.count_reads {
+            out.extend(self.read_counts.diagnostics(gpu));
+        }
+        out
     }
 
     fn extra_images(&mut self, gpu: &GpuContext) -> Result<Vec<ExtraImage>> {

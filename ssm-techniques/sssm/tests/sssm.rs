@@ -215,3 +215,48 @@ fn kernels_wider_than_the_screen_and_zero_penumbrae_stay_in_range() {
     assert!(covered.iter().all(|v| *v == 0.0 || *v == 1.0), "a zero penumbra keeps the hard shadow");
     assert!(covered.contains(&0.0) && covered.contains(&1.0));
 }
+
+/// The diagnostics of a technique rendered once with `settings`.
+fn diagnostics_of(info: &'static ssm_core::TechniqueInfo, scene: &Scene, settings: &[(&str, &str)]) -> Vec<(String, f64)> {
+    let gpu = gpu();
+    let params = info.params_from(settings.iter().copied()).unwrap();
+    let needs = (info.requirements)(&params).unwrap();
+    let mut renderer = ssm_core::Renderer::new(&gpu, scene, SIZE.0, SIZE.1, &needs).unwrap();
+    let mut technique = renderer.create_technique(info, &params).unwrap();
+    renderer.render(technique.as_mut(), info.name).unwrap();
+    technique.diagnostics(&renderer.gpu)
+}
+
+fn value(diagnostics: &[(String, f64)], key: &str) -> f64 {
+    diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v).unwrap_or_else(|| panic!("no {key} in {diagnostics:?}"))
+}
+
+/// The read counters count what the shaders read: SSSM's first pass reads the G-buffer's two
+/// textures, the hard shadow's texel and the n texels of its row at every computed pixel; PCSS
+/// reads the G-buffer, n² blocker taps, and m² filter taps where it found a blocker; with
+/// α = β = 0 SSSM recomputes every row, n² + m² taps and more, as PCSS does. Off by default.
+#[test]
+fn read_counters_count_the_taps() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let sssm = diagnostics_of(&ssm_sssm::INFO, &scene, &[("blocker_kernel", "7"), ("blur_kernel", "15"), ("count_reads", "true")]);
+    assert_eq!(value(&sssm, "sssm_horizontal_blocker_reads_per_pixel"), 2.0 + 1.0 + 7.0);
+    let pixels = value(&sssm, "sssm_horizontal_blocker_pixels");
+    assert!(pixels > 0.0);
+    let pcss = diagnostics_of(&ssm_pcss::INFO, &scene, &[("blocker_kernel", "7"), ("pcf_kernel", "15"), ("count_reads", "true")]);
+    let pcss_reads = value(&pcss, "pcss_blocker_search_and_filter_reads_per_pixel");
+    println!("PCSS 7/15: {pcss_reads:.1} reads per pixel over {pixels} pixels");
+    assert!(pcss_reads > 2.0 + 49.0 && pcss_reads < 2.0 + 49.0 + 225.0, "{pcss_reads}");
+    assert_eq!(value(&pcss, "pcss_blocker_search_and_filter_pixels"), pixels, "both compute the same pixels");
+    let exhaustive = diagnostics_of(
+        &ssm_sssm::INFO,
+        &scene,
+        &[("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0"), ("count_reads", "true")],
+    );
+    let total: f64 = ["sssm_horizontal_blocker", "sssm_blocker_and_horizontal_blur", "sssm_vertical_blur"]
+        .iter()
+        .map(|pass| value(&exhaustive, &format!("{pass}_reads_per_pixel")))
+        .sum();
+    println!("SSSM 7/15 with alpha = beta = 0: {total:.1} reads per pixel");
+    assert!(total > pcss_reads * 0.5, "{total} against PCSS's {pcss_reads}");
+    assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| !k.contains("reads")), "counted only on request");
+}

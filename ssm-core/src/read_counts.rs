@@ -1,0 +1,96 @@
+//! Texture reads per pixel, counted on the GPU per pass: where a technique's
+//! time goes, in the unit its cost model is written in (Buades et al. count
+//! taps: PCSS reads n² + m² texels per pixel, a separable pair n + m).
+//!
+//! A technique binds one [`ReadCounts`] buffer, read-write, in the passes it
+//! profiles; each invocation that does the pass's work adds 1 to its pass's
+//! pixel count and the number of textures it read to its read count
+//! (`atomicAdd`, which costs time: techniques count only when their
+//! `count_reads` parameter asks). Each pass's counts are spread over
+//! [`READ_COUNT_BUCKETS`] pairs, chosen by pixel, so that a 32-bit read count
+//! holds a 4K frame's 2,522 reads per pixel and the atomics contend less.
+//! Cleared at the first light of each frame, so the figures cover one
+//! frame's lights.
+//!
+//! In WGSL, with `common/read_counts.wgsl` imported: `let word =
+//! read_count_word(pass_index, texel);` then `atomicAdd(&counts[word], 1u);
+//! atomicAdd(&counts[word + 1u], reads);`.
+
+use crate::{Frame, GpuContext};
+
+/// Buckets (pairs of pixel and read counts) per pass.
+pub const READ_COUNT_BUCKETS: usize = 64;
+
+/// Per-pass (pixels, reads) counters in one storage buffer: pass `k`, bucket `b` at words
+/// `2(k·B + b)` and `2(k·B + b) + 1`, B = [`READ_COUNT_BUCKETS`].
+pub struct ReadCounts {
+    buffer: wgpu::Buffer,
+    passes: &'static [&'static str],
+}
+
+impl ReadCounts {
+    /// Counters for the passes named `passes`, in the order the shaders index them.
+    #[must_use]
+    pub fn new(device: &wgpu::Device, label: &str, passes: &'static [&'static str]) -> Self {
+        let buffer = crate::passes::storage_buffer(device, label, (passes.len().max(1) * READ_COUNT_BUCKETS * 8) as u64);
+        Self { buffer, passes }
+    }
+
+    /// The buffer, to bind as `array<atomic<u32>>`.
+    #[must_use]
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// A layout entry for the buffer at `binding`, writable from fragment and compute shaders.
+    #[must_use]
+    pub const fn layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }
+    }
+
+    /// Zeroes the counters at the first light of a frame.
+    pub fn clear(&self, frame: &mut Frame<'_>, light: usize) {
+        if light == 0 {
+            frame.clear_buffer("read_counts_clear", &self.buffer, 0, None);
+        }
+    }
+
+    /// `<pass>_reads_per_pixel` and `<pass>_pixels` for each pass with pixels, after a frame.
+    #[must_use]
+    pub fn diagnostics(&self, gpu: &GpuContext) -> Vec<(String, f64)> {
+        let Ok(bytes) = crate::readback::read_buffer(gpu, &self.buffer, self.buffer.size(), "read counts") else {
+            return Vec::new();
+        };
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        self.passes
+            .iter()
+            .zip(words.chunks_exact(2 * READ_COUNT_BUCKETS))
+            .filter_map(|(pass, buckets)| {
+                let pixels: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[0])).sum();
+                let reads: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[1])).sum();
+                (pixels > 0)
+                    .then(|| [(format!("{pass}_reads_per_pixel"), reads as f64 / pixels as f64), (format!("{pass}_pixels"), pixels as f64)])
+            })
+            .flatten()
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The WGSL side spreads the counts over as many buckets as the Rust side sums.
+    #[test]
+    fn the_shaders_bucket_count_is_the_same() {
+        let line = format!("const READ_COUNT_BUCKETS: u32 = {}u;", super::READ_COUNT_BUCKETS);
+        assert!(include_str!("../../shaders/common/read_counts.wgsl").contains(&line), "common/read_counts.wgsl lacks `{line}`");
+    }
+}
