@@ -194,7 +194,15 @@ fn bilateral_weight(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel
     let texel = vec2<i32>(pixel);
     let other = textureLoad(gbuffer_position, texel, 0);
     reads += 1u;
-    let expected = tangent_plane_point(rays, point, normal, pixel);
+    return bilateral_weight_of(other, tangent_plane_point(rays, point, normal, pixel), normal, texel);
+}
+
+// bilateral_weight from the G-buffer position `other` seen at `texel` and the point `expected`
+// of this pixel's tangent plane along that pixel's ray, where the caller has them already.
+fn bilateral_weight_of(other: vec4<f32>, expected: vec4<f32>, normal: vec3<f32>, texel: vec2<i32>) -> f32 {
+    if (settings.bilateral_depth <= 0.0) {
+        return 1.0;
+    }
     if (other.w < 0.5 || expected.w == 0.0) {
         return 0.0;
     }

@@ -56,7 +56,8 @@ fn vertical(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> f32 {
             if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < scene_length(frame, settings.beta)) {
                 value = textureLoad(horizontal_blur, texel, 0).x;
                 reads += 1u;
-                weight *= bilateral_weight(rays, point.position, point.normal, row);
+                // The same position and tangent-plane point as the β test's: not read again.
+                weight *= bilateral_weight_of(other, expected, point.normal, texel);
                 reuse = true;
                 reused += 1.0;
             }
