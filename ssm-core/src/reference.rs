@@ -114,6 +114,14 @@ impl RecentBlockers {
     }
 }
 
+/// The ray along the segment from `origin` to `target`, stopping just short of `target` so that
+/// geometry lying in the light's plane does not count; `None` for a segment of no length.
+fn segment_ray(origin: Vec3, target: Vec3) -> Option<Ray> {
+    let offset = target - origin;
+    let distance = offset.length();
+    (distance > 0.0).then(|| Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6)))
+}
+
 /// The scene's triangles in a BVH, ready for shadow rays.
 pub struct GroundTruth {
     triangles: Vec<Triangle>,
@@ -209,14 +217,9 @@ impl GroundTruth {
 
     /// True when the segment from `origin` to `target` crosses no triangle.
     fn unoccluded(&self, origin: Vec3, target: Vec3) -> bool {
-        let offset = target - origin;
-        let distance = offset.length();
-        if distance <= 0.0 {
-            return true;
-        }
-        // Stop just short of the light, so that geometry lying in the light's plane does not count twice.
-        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
-        self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
+        segment_ray(origin, target).is_none_or(|ray| {
+            self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
+        })
     }
 
     /// The triangles that can cross a segment inside `pyramid` (their BVH leaf boxes meet it,
@@ -295,12 +298,7 @@ impl GroundTruth {
     /// The triangle the BVH finds first on the segment from `origin` to `target` (the segment and
     /// test of [`GroundTruth::unoccluded`]), if any.
     fn first_blocker(&self, origin: Vec3, target: Vec3) -> Option<u32> {
-        let offset = target - origin;
-        let distance = offset.length();
-        if distance <= 0.0 {
-            return None;
-        }
-        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
+        let ray = segment_ray(origin, target)?;
         let mut found = None;
         self.bvh.ray_traverse_miss(ray, |ray, id| {
             let index = self.bvh.primitive_indices[id];
@@ -316,13 +314,17 @@ impl GroundTruth {
     /// True when the ray from `origin` to `target` crosses one of `candidates` (the same
     /// segment and intersection test as [`GroundTruth::unoccluded`]).
     fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
-        let offset = target - origin;
-        let distance = offset.length();
-        if distance <= 0.0 {
-            return false;
-        }
-        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6));
-        candidates.iter().any(|index| self.triangles[*index as usize].intersect(&ray) < ray.tmax)
+        segment_ray(origin, target)
+            .is_some_and(|ray| candidates.iter().any(|index| self.triangles[*index as usize].intersect(&ray) < ray.tmax))
+    }
+
+    /// True when the ray from `origin` to `target` is blocked: by one of the triangles in
+    /// `recent` (tried first: a pixel's neighbouring rays mostly hit the same ones), else by the
+    /// triangle the BVH finds, which `recent` then remembers. The same answer as
+    /// `!unoccluded`: a ray a remembered triangle blocks is blocked.
+    fn blocked_remembering(&self, origin: Vec3, target: Vec3, recent: &mut RecentBlockers) -> bool {
+        self.blocked_by(origin, target, recent.triangles())
+            || self.first_blocker(origin, target).map(|blocker| recent.push(blocker)).is_some()
     }
 
     /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
@@ -346,9 +348,10 @@ impl GroundTruth {
     }
 
     /// The shortcut of [`GroundTruth::visibility`] for a point (no footprint) whose N² rays
-    /// all leave one origin (the light wholly on one side of its tangent plane): the light is
-    /// cut into quarters, each with the pyramid from the origin to it ([`GroundTruth::count_visible`]).
-    /// A point light casts one ray for all N². `None` leaves the pixel to the per-ray traversal.
+    /// all leave one origin (the light wholly on one side of its tangent plane): the pyramid from
+    /// the origin to the light, then to its quarters where it holds too many triangles
+    /// ([`GroundTruth::count_visible`]). A point light casts one ray for all N². `None` leaves
+    /// the pixel to the per-ray traversal.
     fn pyramid_visibility(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64) -> Option<f32> {
         let corners = [light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)];
         // One origin for every sample: the side rule is affine in the sample, so the corners decide.
@@ -418,10 +421,7 @@ impl GroundTruth {
                 let mut visible = 0;
                 for j in j0..j1 {
                     for i in i0..i1 {
-                        let sample = rays.sample(i, j);
-                        let blocked = self.blocked_by(rays.origin, sample, rays.recent.triangles())
-                            || self.first_blocker(rays.origin, sample).map(|blocker| rays.recent.push(blocker)).is_some();
-                        if !blocked {
+                        if !self.blocked_remembering(rays.origin, rays.sample(i, j), &mut rays.recent) {
                             visible += 1;
                         }
                     }
@@ -491,18 +491,7 @@ impl GroundTruth {
                 // Leave the surface on the side facing this sample, so that it does not shadow itself.
                 let side = if point.normal.dot(sample - position) >= 0.0 { 1.0 } else { -1.0 };
                 let origin = position + point.normal * (side * self.surface_offset);
-                let open = if remember {
-                    !self.blocked_by(origin, sample, recent.triangles())
-                        && match self.first_blocker(origin, sample) {
-                            Some(blocker) => {
-                                recent.push(blocker);
-                                false
-                            }
-                            None => true,
-                        }
-                } else {
-                    self.unoccluded(origin, sample)
-                };
+                let open = if remember { !self.blocked_remembering(origin, sample, &mut recent) } else { self.unoccluded(origin, sample) };
                 if open {
                     visible += 1;
                 }
