@@ -26,14 +26,17 @@ pub const READ_COUNT_BUCKETS: usize = 64;
 pub struct ReadCounts {
     buffer: wgpu::Buffer,
     passes: &'static [&'static str],
+    /// Whether the technique counts (its `count_reads`): otherwise nothing is cleared or read back.
+    enabled: bool,
 }
 
 impl ReadCounts {
-    /// Counters for the passes named `passes`, in the order the shaders index them.
+    /// Counters for the passes named `passes`, in the order the shaders index them; `enabled`:
+    /// whether the shaders count (the buffer is bound either way).
     #[must_use]
-    pub fn new(device: &wgpu::Device, label: &str, passes: &'static [&'static str]) -> Self {
+    pub fn new(device: &wgpu::Device, label: &str, passes: &'static [&'static str], enabled: bool) -> Self {
         let buffer = crate::passes::storage_buffer(device, label, (passes.len().max(1) * READ_COUNT_BUCKETS * 8) as u64);
-        Self { buffer, passes }
+        Self { buffer, passes, enabled }
     }
 
     /// The buffer, to bind as `array<atomic<u32>>`.
@@ -57,16 +60,20 @@ impl ReadCounts {
         }
     }
 
-    /// Zeroes the counters at the first light of a frame.
+    /// Zeroes the counters at the first light of a frame, when counting.
     pub fn clear(&self, frame: &mut Frame<'_>, light: usize) {
-        if light == 0 {
+        if self.enabled && light == 0 {
             frame.clear_buffer("read_counts_clear", &self.buffer, 0, None);
         }
     }
 
-    /// `<pass>_reads_per_pixel` and `<pass>_pixels` for each pass with pixels, after a frame.
+    /// `<pass>_reads_per_pixel` and `<pass>_pixels` for each pass with pixels, after a frame;
+    /// nothing when not counting.
     #[must_use]
     pub fn diagnostics(&self, gpu: &GpuContext) -> Vec<(String, f64)> {
+        if !self.enabled {
+            return Vec::new();
+        }
         let Ok(bytes) = crate::readback::read_buffer(gpu, &self.buffer, self.buffer.size(), "read counts") else {
             return Vec::new();
         };

@@ -83,7 +83,6 @@ pub struct Pcss {
     search_and_filter: ScreenPass,
     map_bind_group: wgpu::BindGroup,
     read_counts: ReadCounts,
-    count_reads: bool,
 }
 
 impl Pcss {
@@ -96,7 +95,7 @@ impl Pcss {
         let device = &setup.gpu.device;
         let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
-        let read_counts = ReadCounts::new(device, "pcss_read_counts", &["pcss_blocker_search_and_filter"]);
+        let read_counts = ReadCounts::new(device, "pcss_read_counts", &["pcss_blocker_search_and_filter"], settings.count_reads);
         let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
@@ -118,15 +117,13 @@ impl Pcss {
             Some(&map_layout),
             VISIBILITY_FORMAT.into(),
         )?;
-        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, count_reads: settings.count_reads })
+        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts })
     }
 }
 
 impl ShadowTechnique for Pcss {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
-        if self.count_reads {
-            self.read_counts.clear(frame, light);
-        }
+        self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
         self.search_and_filter.encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
@@ -134,7 +131,7 @@ impl ShadowTechnique for Pcss {
 
     /// With `count_reads`: texture reads per computed pixel, and the pixels.
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
-        if self.count_reads { self.read_counts.diagnostics(gpu) } else { Vec::new() }
+        self.read_counts.diagnostics(gpu)
     }
 }
 

@@ -129,7 +129,6 @@ pub struct SeparableSoftShadowMaps {
     horizontal_blur_view: wgpu::TextureView,
     reuse: wgpu::Texture,
     read_counts: ReadCounts,
-    count_reads: bool,
 }
 
 /// The names of the passes whose reads are counted, in the shaders' order.
@@ -180,7 +179,7 @@ impl SeparableSoftShadowMaps {
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
         let layouts = Self::layouts(device);
-        let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES);
+        let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES, settings.count_reads);
         let groups = Self::bind_groups(setup, &layouts, (&settings_buffer, &depth_map, read_counts.buffer()), &targets);
         let module = |label: &str, source: &str| create_shader_with_imports(setup.gpu, label, source, LOCAL_SHADERS);
         let rgba = wgpu::ColorTargetState::from(wgpu::TextureFormat::Rgba32Float);
@@ -219,7 +218,6 @@ impl SeparableSoftShadowMaps {
             horizontal_blur_view: targets.horizontal_blur,
             reuse: targets.reuse,
             read_counts,
-            count_reads: settings.count_reads,
         })
     }
 
@@ -289,9 +287,7 @@ impl SeparableSoftShadowMaps {
 impl ShadowTechnique for SeparableSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         let [group_a, group_b, group_c] = &self.groups;
-        if self.count_reads {
-            self.read_counts.clear(frame, light);
-        }
+        self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
         self.horizontal_blocker.encode(frame, light, &self.horizontal_blocker_view, Some(group_a), Some(wgpu::Color::TRANSPARENT));
         self.blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(group_b), Some(wgpu::Color::TRANSPARENT));
@@ -307,9 +303,7 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
             return Vec::new();
         }
         let mut out = vec![("sssm_reuse_share".to_owned(), computed.iter().sum::<f64>() / computed.len() as f64)];
-        if self.count_reads {
-            out.extend(self.read_counts.diagnostics(gpu));
-        }
+        out.extend(self.read_counts.diagnostics(gpu));
         out
     }
 
