@@ -490,12 +490,11 @@ fn write_sweep(
         .zip(varied)
         .map(|(row, values)| {
             let own = format!("{}.", row.technique);
-            let point: Vec<(String, String)> =
-                values.iter().filter_map(|(k, v)| k.strip_prefix(&own).map(|k| (k.to_owned(), v.clone()))).collect();
+            let point: Vec<String> = values.iter().filter_map(|(k, v)| k.strip_prefix(&own).map(|k| format!("{k}={v}"))).collect();
             sweep::MarkdownRow {
                 scene: row.scene.clone(),
                 technique: row.technique.clone(),
-                point: point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
+                point: point.join(" "),
                 ms: sweep::time_of(row),
                 mae_penumbra: row.metrics.mae_penumbra,
                 psnr: row.metrics.psnr,

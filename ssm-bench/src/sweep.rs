@@ -368,7 +368,7 @@ pub struct MarkdownRow {
     pub scene: String,
     /// The technique.
     pub technique: String,
-    /// Its varied values (`point_label`), empty at its defaults.
+    /// Its own varied values as `param=value`, space-separated; empty at its defaults.
     pub point: String,
     /// Median time per frame, ms.
     pub ms: f64,

@@ -571,7 +571,6 @@ impl PredictedVirtualShadowMaps {
         pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
     }
 
-    /// Steps 5 and 6: the pyramid, its readback, the kd-tree.
     /// Step 7's culling: the triangles that can touch the tile whose frame is `tile_frame`, compacted
     /// into `culled_indices` with their count in `tile_draw`'s indirect arguments.
     fn cull_to_tile(&self, frame: &mut Frame<'_>, tile_frame: &wgpu::BindGroup) {
@@ -584,6 +583,7 @@ impl PredictedVirtualShadowMaps {
         pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
     }
 
+    /// Steps 5 and 6: the pyramid, its readback, the kd-tree.
     fn tiling(&self, frame: &mut Frame<'_>) -> Result<Tiling> {
         if self.settings.prediction == Prediction::Fixed {
             let side = self.atlas_side;
