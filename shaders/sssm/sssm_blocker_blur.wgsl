@@ -1,28 +1,41 @@
 // SSSM step 2 (Table 1): the blocker average over the n×n window, each of its n rows reused
 // from the pixel whose shadow-map position lies on that row when |d - d_t| < α (Sec. 4.1),
 // else read from the depth map; the penumbra size by Eq. 1; then the horizontal screen-space
-// blur of the hard shadow over m taps (Sec. 4.2).
+// blur of the hard shadow over m taps (Sec. 4.2). The entry points (a fragment pass, or a
+// compute pass whose workgroups share the screen row the blur reads) are in
+// sssm_blocker_blur_fragment.wgsl and sssm_blocker_blur_compute.wgsl; each defines
+// `horizontal_source(texel)`, where a blur tap's pixel comes from.
 
 // #import sssm/sssm_common.wgsl
 
 @group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
 
-// (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker rows
-// reused); w = -1 where nothing was computed (background, behind the light).
-@fragment
-fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
-    let point = screen_point(in);
-    let own = textureLoad(horizontal_blocker, point.texel, 0);
-    if (own.x < 0.0) {
-        return vec4<f32>(own.w, 0.0, 0.0, -1.0);
+// A blur tap's pixel read from the textures: step 1's hard visibility, and the G-buffer texels
+// the bilateral weight compares (not read when there is no bilateral weight).
+fn load_horizontal_source(texel: vec2<i32>) -> BlurSource {
+    let value = textureLoad(horizontal_blocker, texel, 0).w;
+    reads += 1u;
+    if (settings.bilateral_depth <= 0.0) {
+        return BlurSource(value, 0.0, vec3<f32>(0.0));
     }
-    reads = 3u;
-    let result = blocker_and_blur(in, point, own);
-    record_reads(1u, point.texel);
-    return result;
+    let position = textureLoad(gbuffer_position, texel, 0);
+    reads += 1u;
+    if (position.w < 0.5) {
+        return blur_source(value, position, vec4<f32>(0.0));
+    }
+    reads += 1u;
+    return blur_source(value, position, textureLoad(gbuffer_normal, texel, 0));
 }
 
-fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> vec4<f32> {
+// The blocker search of a computed pixel, its penumbra and its blur widths: (the hard or lit
+// value, blur half-width along x and along y in pixels, blocker rows reused), and whether the
+// horizontal blur remains to be done (else the vector is the pass's output).
+struct BlockerSearch {
+    result: vec4<f32>,
+    blur: bool,
+};
+
+fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     let d = own.x;
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
@@ -34,8 +47,9 @@ fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) ->
     // The rows' points at depth d lie on a line, and clip space is linear in them: project the two ends once.
     let first_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y - search.y), d), 1.0);
     let last_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y + search.y), d), 1.0);
+    // Rows failing the α test, read after the reused ones.
+    var failed_rows = FailedRows();
     for (var t = 0u; t < n; t++) {
-        let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(t, n) * search.y);
         // The pixel that sees the point of this row at the same light depth d (Fig. 4).
         let clip = mix(first_clip, last_clip, grid_offset(t, n) * 0.5 + 0.5);
         let ndc = clip.xy / clip.w;
@@ -52,20 +66,28 @@ fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) ->
             }
         }
         if (!reuse) {
-            for (var i = 0u; i < n; i++) {
-                let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
-                let depth = shadow_map_depth(shadow_map, tap);
-                reads += 1u;
-                if (depth < compared_depth(lookup, point.normal, tap, d)) {
-                    sum += depth;
-                    count += 1.0;
-                }
+            mark_failed_row(&failed_rows, t);
+        }
+    }
+    loop {
+        let failed = pop_failed_row(&failed_rows);
+        if (failed < 0) {
+            break;
+        }
+        let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(u32(failed), n) * search.y);
+        for (var i = 0u; i < n; i++) {
+            let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
+            let depth = shadow_map_depth(shadow_map, tap);
+            reads += 1u;
+            if (depth < compared_depth(lookup, point.normal, tap, d)) {
+                sum += depth;
+                count += 1.0;
             }
         }
     }
     // No blocker: fully lit (Sec. 4.2).
     if (count == 0.0) {
-        return vec4<f32>(1.0, 0.0, 0.0, reused);
+        return BlockerSearch(vec4<f32>(1.0, 0.0, 0.0, reused), false);
     }
     let blocker = sum / count;
     // Eq. 1: w_penumbra = w_light (z_receiver - z_avg) / z_avg, as the shadow-map half-extent of
@@ -81,21 +103,30 @@ fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) ->
     }
     // A penumbra under half a pixel keeps the hard value.
     if (max(radii.x, radii.y) < 0.5) {
-        return vec4<f32>(own.w, 0.0, 0.0, reused);
+        return BlockerSearch(vec4<f32>(own.w, 0.0, 0.0, reused), false);
     }
+    return BlockerSearch(vec4<f32>(own.w, radii, reused), true);
+}
+
+// The horizontal blur over m taps of the pixel at `centre` (pixel position of its centre) after
+// its blocker search `searched` (blur_search's result with blur = true); each tap's pixel comes
+// from `horizontal_source`.
+fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
+    let radii = searched.yz;
     let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
     var blurred = 0.0;
     var total = 0.0;
-    let centre = in.clip.xy;
     for (var j = 0u; j < m; j++) {
         let tap = centre + vec2<f32>(grid_offset(j, m) * radii.x, 0.0);
         var value: f32;
-        var weight = tap_weight(j, m);
+        var weight = tap_weight(j);
         if (on_screen(tap)) {
-            value = textureLoad(horizontal_blocker, vec2<i32>(tap), 0).w;
-            reads += 1u;
-            weight *= bilateral_weight(rays, point.position, point.normal, tap);
+            let source = horizontal_source(vec2<i32>(tap));
+            value = source.value;
+            if (settings.bilateral_depth > 0.0) {
+                weight *= bilateral_weight_of(source, tangent_plane_point(rays, point.position, point.normal, tap), point.normal);
+            }
         } else {
             // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.
             let plane = tangent_plane_point(rays, point.position, point.normal, tap);
@@ -106,5 +137,5 @@ fn blocker_and_blur(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) ->
     }
     // Every tap on other surfaces (an even m has no centre tap): keep the hard value.
     let horizontal = select(own.w, blurred / total, total > 1e-6);
-    return vec4<f32>(horizontal, radii, reused);
+    return vec4<f32>(horizontal, radii, searched.w);
 }

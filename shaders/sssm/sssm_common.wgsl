@@ -9,8 +9,8 @@ struct SssmSettings {
     // Samples per axis of the blocker search (n) and of the blur (m).
     blocker_kernel: u32,
     blur_kernel: u32,
-    // 1: Gaussian weights; 0: mean (Sec. 4.4).
-    gaussian: u32,
+    // Unused (the blur's weights are in blur_weights).
+    _pad0: u32,
     // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
     receiver_plane: u32,
     // Reuse thresholds as fractions of the scene's diagonal (scene_length): light-depth
@@ -27,6 +27,9 @@ struct SssmSettings {
     count_reads: u32,
     _pad1: f32,
     _pad2: f32,
+    // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian, or 1 for
+    // the mean filter), computed once on the CPU instead of an exponential per tap.
+    blur_weights: array<vec4<f32>, 32>,
 };
 
 @group(2) @binding(0) var<uniform> camera: Camera;
@@ -41,9 +44,15 @@ var<private> reads: u32;
 
 // Adds this pixel and its reads to pass `pass_index`'s counts, when counting.
 fn record_reads(pass_index: u32, texel: vec2<i32>) {
-    if (settings.count_reads != 0u) {
+    record_reads_of(pass_index, texel, 1u);
+}
+
+// Adds `pixels` (0 or 1) and this invocation's reads to pass `pass_index`'s counts, when counting:
+// 0 for an invocation that only loaded its share of a workgroup's shared row.
+fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
+    if (settings.count_reads != 0u && (pixels != 0u || reads != 0u)) {
         let word = read_count_word(pass_index, texel);
-        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
     }
 }
@@ -111,13 +120,34 @@ fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
 }
 
-// Weight of tap `i` of `count` (Sec. 4.4: Gaussian, or 1 for the mean filter).
-fn tap_weight(i: u32, count: u32) -> f32 {
-    if (settings.gaussian == 0u) {
-        return 1.0;
+// Weight of blur tap `i` of the m taps (Sec. 4.4: Gaussian, or 1 for the mean filter).
+fn tap_weight(i: u32) -> f32 {
+    return settings.blur_weights[i / 4u][i % 4u];
+}
+
+// Rows of a kernel that failed their reuse test, recomputed after the reused ones (bit t % 32 of
+// word t / 32 for row t < 128): each pixel then loops over its own failures, so pixels sharing a
+// SIMD vector (a GPU's warp, a CPU rasteriser's lanes) wait for the one with the most, not for
+// every row any of them failed, which with a tenth of the rows failing and 32 lanes would be nearly
+// all of them.
+struct FailedRows {
+    words: array<u32, 4>,
+};
+
+fn mark_failed_row(failed: ptr<function, FailedRows>, row: u32) {
+    (*failed).words[row / 32u] |= 1u << (row % 32u);
+}
+
+// Removes and returns the lowest marked row; -1 when none is left.
+fn pop_failed_row(failed: ptr<function, FailedRows>) -> i32 {
+    for (var word = 0u; word < 4u; word++) {
+        let bits = (*failed).words[word];
+        if (bits != 0u) {
+            (*failed).words[word] = bits & (bits - 1u);
+            return i32(word * 32u + firstTrailingBit(bits));
+        }
     }
-    let x = grid_offset(i, count) / max(settings.sigma, 1e-3);
-    return exp(-0.5 * x * x);
+    return -1;
 }
 
 // Whether a pixel position lies on the screen.
@@ -183,33 +213,49 @@ fn kernel_screen_radii(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, exten
     return min(sqrt(a * a + b * b), 4.0 * camera.viewport.xy);
 }
 
-// Bilateral weight of a blur tap at pixel `texel` for the pixel seen at `point` with normal
-// `normal`: how much the surface seen there looks like this pixel's tangent plane, by the
-// difference of camera distances (the distance of the vertical pass's β test) and of normals.
-// Taps on another object across a silhouette get no weight, so shadow does not leak over edges.
-fn bilateral_weight(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
-    if (settings.bilateral_depth <= 0.0) {
-        return 1.0;
+// What a blur tap needs of the pixel it lands on: the value blurred there, and what the bilateral
+// weight and the vertical pass's β test compare with this pixel's tangent plane.
+struct BlurSource {
+    value: f32,
+    // Distance from the eye to the surface seen there; -1 where nothing covers the pixel.
+    eye_distance: f32,
+    // Its unit normal (zero where nothing covers the pixel or the weight does not need it).
+    normal: vec3<f32>,
+};
+
+// The BlurSource of a pixel from its G-buffer position and normal texels.
+fn blur_source(value: f32, position: vec4<f32>, normal: vec4<f32>) -> BlurSource {
+    if (position.w < 0.5) {
+        return BlurSource(value, -1.0, vec3<f32>(0.0));
     }
-    let texel = vec2<i32>(pixel);
-    let other = textureLoad(gbuffer_position, texel, 0);
-    reads += 1u;
-    return bilateral_weight_of(other, tangent_plane_point(rays, point, normal, pixel), normal, texel);
+    return BlurSource(value, distance(position.xyz, camera.position.xyz), normal.xyz);
 }
 
-// bilateral_weight from the G-buffer position `other` seen at `texel` and the point `expected`
-// of this pixel's tangent plane along that pixel's ray, where the caller has them already.
-fn bilateral_weight_of(other: vec4<f32>, expected: vec4<f32>, normal: vec3<f32>, texel: vec2<i32>) -> f32 {
+// Bilateral weight of a blur tap landing on `source`, for the pixel seen at `point` with normal
+// `normal`, where `expected` is the point of that pixel's tangent plane along the tap pixel's ray:
+// how much the surface seen there looks like this pixel's tangent plane, by the difference of
+// camera distances (the distance of the vertical pass's β test) and of normals. Taps on another
+// object across a silhouette get no weight, so shadow does not leak over edges.
+fn bilateral_weight_of(source: BlurSource, expected: vec4<f32>, normal: vec3<f32>) -> f32 {
     if (settings.bilateral_depth <= 0.0) {
         return 1.0;
     }
-    if (other.w < 0.5 || expected.w == 0.0) {
+    if (source.eye_distance < 0.0 || expected.w == 0.0) {
         return 0.0;
     }
-    reads += 1u;
-    let eye = camera.position.xyz;
-    let gap = (distance(other.xyz, eye) - distance(expected.xyz, eye)) / scene_length(frame, settings.bilateral_depth);
-    let turn = max(dot(normal, textureLoad(gbuffer_normal, texel, 0).xyz), 0.0);
-    // The normal term falls to 1/2 at about 23°.
-    return exp(-gap * gap) * pow(turn, 8.0);
+    let gap = (source.eye_distance - distance(expected.xyz, camera.position.xyz)) / scene_length(frame, settings.bilateral_depth);
+    let turn = max(dot(normal, source.normal), 0.0);
+    // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
+    // falls to 1/2 at about 23°.
+    let turn_2 = turn * turn;
+    let turn_4 = turn_2 * turn_2;
+    return exp(-gap * gap) * turn_4 * turn_4;
+}
+
+// Whether the tap pixel seen as `source` lies within β of the tangent-plane point `expected`
+// along its ray (the vertical pass's reuse test, Sec. 4.2: "the distance is modified taking into
+// account the normal").
+fn within_beta(source: BlurSource, expected: vec4<f32>) -> bool {
+    return source.eye_distance >= 0.0 && expected.w > 0.0
+        && abs(source.eye_distance - distance(expected.xyz, camera.position.xyz)) < scene_length(frame, settings.beta);
 }

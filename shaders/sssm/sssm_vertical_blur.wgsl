@@ -2,7 +2,10 @@
 // when its camera depth differs from this pixel's tangent plane by less than β (Sec. 4.2: "the
 // distance is modified taking into account the normal"), else shadow-testing that row's points
 // of this pixel's tangent plane directly (which also covers taps past the screen's edges).
-// Also writes the share of reused rows of both steps (Fig. 10).
+// Also the share of reused rows of both steps (Fig. 10). The entry points (a fragment pass, or a
+// compute pass whose workgroups share the screen column the blur reads) are in
+// sssm_vertical_blur_fragment.wgsl and sssm_vertical_blur_compute.wgsl; each defines
+// `vertical_source(texel)`, where a blur tap's pixel comes from.
 
 // #import sssm/sssm_common.wgsl
 
@@ -10,32 +13,35 @@
 @group(2) @binding(5) var horizontal_blur: texture_2d<f32>;
 @group(2) @binding(6) var reuse_share: texture_storage_2d<r32float, write>;
 
-@fragment
-fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
-    let point = screen_point(in);
-    // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
-    let own = textureLoad(horizontal_blur, point.texel, 0);
-    if (own.w < 0.0) {
-        // Nothing computed here (background, behind the light): -1 keeps it out of the average.
-        textureStore(reuse_share, point.texel, vec4<f32>(-1.0));
-        return own.x;
+// A blur tap's pixel read from the textures: step 2's horizontal result and the G-buffer texels
+// the β test and the bilateral weight compare.
+fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
+    let value = textureLoad(horizontal_blur, texel, 0).x;
+    let position = textureLoad(gbuffer_position, texel, 0);
+    reads += 2u;
+    if (position.w < 0.5 || settings.bilateral_depth <= 0.0) {
+        return blur_source(value, position, vec4<f32>(0.0));
     }
-    reads = 3u;
-    let result = vertical(in, point, own);
-    record_reads(2u, point.texel);
-    return result;
+    reads += 1u;
+    return blur_source(value, position, textureLoad(gbuffer_normal, texel, 0));
 }
 
-fn vertical(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> f32 {
+// The vertical blur's half-width in pixels at a computed pixel whose step 2 result is `own`
+// (0 where the penumbra is under half a pixel and the horizontal value stands).
+fn vertical_radius(own: vec4<f32>) -> f32 {
+    return select(own.z, 0.0, max(own.y, own.z) < 0.5);
+}
+
+// (visibility, share of rows reused in steps 2 and 3) of the computed pixel at `centre` (pixel
+// position of its centre), whose step 2 result is `own`; each tap's pixel comes from `vertical_source`.
+fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> {
     let n = f32(max(settings.blocker_kernel, 1u));
     let radii = own.yz;
     if (max(radii.x, radii.y) < 0.5) {
         // No blur: only the blocker rows counted.
-        textureStore(reuse_share, point.texel, vec4<f32>(own.w / n));
-        return own.x;
+        return vec2<f32>(own.x, own.w / n);
     }
     let m = max(settings.blur_kernel, 1u);
-    let eye = camera.position.xyz;
     let rays = camera_rays();
     let own_hard = textureLoad(horizontal_blocker, point.texel, 0).w;
     reads += 1u;
@@ -43,42 +49,88 @@ fn vertical(in: FullscreenVertex, point: ScreenPoint, own: vec4<f32>) -> f32 {
     var blurred = 0.0;
     var total = 0.0;
     var reused = 0.0;
+    // Rows failing the β test, recomputed after the reused ones.
+    var failed_rows = FailedRows();
     for (var j = 0u; j < m; j++) {
-        let row = in.clip.xy + vec2<f32>(0.0, grid_offset(j, m) * radii.y);
-        var value = 0.0;
-        var weight = tap_weight(j, m);
+        let row = centre + vec2<f32>(0.0, grid_offset(j, m) * radii.y);
         var reuse = false;
         if (on_screen(row)) {
-            let texel = vec2<i32>(row);
-            let other = textureLoad(gbuffer_position, texel, 0);
-            reads += 1u;
+            let source = vertical_source(vec2<i32>(row));
             let expected = tangent_plane_point(rays, point.position, point.normal, row);
-            if (other.w > 0.5 && expected.w > 0.0 && abs(distance(other.xyz, eye) - distance(expected.xyz, eye)) < scene_length(frame, settings.beta)) {
-                value = textureLoad(horizontal_blur, texel, 0).x;
-                reads += 1u;
-                // The same position and tangent-plane point as the β test's: not read again.
-                weight *= bilateral_weight_of(other, expected, point.normal, texel);
-                reuse = true;
+            if (within_beta(source, expected)) {
+                let weight = tap_weight(j) * bilateral_weight_of(source, expected, point.normal);
+                blurred += weight * source.value;
+                total += weight;
                 reused += 1.0;
+                reuse = true;
             }
         }
         if (!reuse) {
-            // The row recomputed on this pixel's tangent plane, with this pixel's kernel.
-            var row_sum = 0.0;
-            var row_total = 0.0;
-            for (var i = 0u; i < m; i++) {
-                let tap = row + vec2<f32>(grid_offset(i, m) * radii.x, 0.0);
-                let plane = tangent_plane_point(rays, point.position, point.normal, tap);
-                let visible = select(own_hard, tap_visibility(plane.xyz, offset), plane.w > 0.0);
-                let inner_weight = tap_weight(i, m);
-                row_sum += inner_weight * visible;
-                row_total += inner_weight;
-            }
-            value = row_sum / row_total;
+            mark_failed_row(&failed_rows, j);
         }
-        blurred += weight * value;
+    }
+    loop {
+        let failed = pop_failed_row(&failed_rows);
+        if (failed < 0) {
+            break;
+        }
+        let row = centre + vec2<f32>(0.0, grid_offset(u32(failed), m) * radii.y);
+        let weight = tap_weight(u32(failed));
+        blurred += weight * recomputed_row(rays, point, offset, own_hard, row, radii.x, m);
         total += weight;
     }
-    textureStore(reuse_share, point.texel, vec4<f32>((own.w + reused) / (n + f32(m))));
-    return clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
+    let visibility = clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
+    return vec2<f32>(visibility, (own.w + reused) / (n + f32(m)));
+}
+
+// A row of step 2's horizontal blur recomputed on this pixel's tangent plane with this pixel's
+// kernel: the m taps along the screen row through `row`, `radius_x` pixels either side, each the
+// hard visibility of the point of the plane seen there (`own_hard` where the camera ray misses
+// the plane). That point, offset by the pixel's lookup offset, projects into the shadow map as
+// a projective function of the tap's index, so the taps are stepped in homogeneous coordinates:
+// with den = ray·normal, H = (eye + offset - light centre)·den + (point - eye)·normal · ray is the
+// looked-up point's offset from the light's centre times den, and ray, den and H are linear in
+// the index. Each tap costs a few additions and a division instead of a ray-plane intersection
+// and a light projection (mathematically the same taps as tangent_plane_point and tap_visibility).
+fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_hard: f32, row: vec2<f32>, radius_x: f32, m: u32) -> f32 {
+    let eye = camera.position.xyz;
+    let normal = point.normal;
+    let plane_offset = dot(point.position - eye, normal);
+    // Columns: the light's u, v and normal axes, so that `v * axes` is v's light-frame components.
+    let axes = mat3x3<f32>(frame.u_axis.xyz, frame.v_axis.xyz, frame.normal.xyz);
+    let eye_light = (eye - frame.centre.xyz) * axes;
+    let lookup_light = (eye + offset - frame.centre.xyz) * axes;
+    let first_ray = rays.base + (row.x + grid_offset(0u, m) * radius_x) * rays.per_x + row.y * rays.per_y;
+    let ray_step = (2.0 * radius_x / f32(m)) * rays.per_x;
+    let first_den = dot(first_ray, normal);
+    let den_step = dot(ray_step, normal);
+    let first_ray_light = first_ray * axes;
+    let ray_step_light = ray_step * axes;
+    let first_h = lookup_light * first_den + plane_offset * first_ray_light;
+    let h_step = lookup_light * den_step + plane_offset * ray_step_light;
+    // The plane point's own light depth times den (the one-sided emitter's test, without the offset).
+    let first_front = eye_light.z * first_den + plane_offset * first_ray_light.z;
+    let front_step = eye_light.z * den_step + plane_offset * ray_step_light.z;
+    var row_sum = 0.0;
+    var row_total = 0.0;
+    for (var i = 0u; i < m; i++) {
+        let index = f32(i);
+        let den = first_den + index * den_step;
+        var visible = own_hard;
+        // The ray meets the plane in front of the eye (tangent_plane_point's w).
+        if (abs(den) >= 1e-12 && plane_offset * den > 0.0) {
+            visible = 0.0;
+            // In front of the light's plane (tap_visibility's first test).
+            if ((first_front + index * front_step) * den > 0.0) {
+                let h = first_h + index * h_step;
+                let uv = 0.5 + 0.5 * h.xy / (h.z * frame.projection.xy);
+                reads += 1u;
+                visible = select(0.0, 1.0, h.z / den <= shadow_map_depth(shadow_map, uv));
+            }
+        }
+        let weight = tap_weight(i);
+        row_sum += weight * visible;
+        row_total += weight;
+    }
+    return row_sum / row_total;
 }

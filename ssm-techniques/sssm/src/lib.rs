@@ -11,7 +11,9 @@
 //! passes after the depth map, as the paper's Table 1.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{bind_group, bind_group_layout, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+};
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
 use ssm_core::shader::create_shader_with_imports;
@@ -25,13 +27,25 @@ use ssm_core::{
 pub const NAME: &str = "sssm";
 
 /// WGSL files the SSSM passes import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("sssm/sssm_common.wgsl", include_str!("../../../shaders/sssm/sssm_common.wgsl"))];
+const LOCAL_SHADERS: &[(&str, &str)] = &[
+    ("sssm/sssm_common.wgsl", include_str!("../../../shaders/sssm/sssm_common.wgsl")),
+    ("sssm/sssm_blocker_blur.wgsl", include_str!("../../../shaders/sssm/sssm_blocker_blur.wgsl")),
+    ("sssm/sssm_vertical_blur.wgsl", include_str!("../../../shaders/sssm/sssm_vertical_blur.wgsl")),
+    ("sssm/sssm_segment.wgsl", include_str!("../../../shaders/sssm/sssm_segment.wgsl")),
+];
 /// Step 1: hard shadow and horizontal partial blocker sums.
 const HORIZONTAL_BLOCKER_SHADER: &str = include_str!("../../../shaders/sssm/sssm_horizontal_blocker.wgsl");
-/// Step 2: blocker average, penumbra size, horizontal blur.
-const BLOCKER_BLUR_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur.wgsl");
-/// Step 3: vertical blur.
-const VERTICAL_BLUR_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur.wgsl");
+/// Step 2 (blocker average, penumbra size, horizontal blur) as a fragment pass.
+const BLOCKER_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur_fragment.wgsl");
+/// Step 2 as a compute pass sharing each workgroup's screen row.
+const BLOCKER_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur_compute.wgsl");
+/// Step 3 (vertical blur) as a fragment pass.
+const VERTICAL_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_fragment.wgsl");
+/// Step 3 as a compute pass sharing each workgroup's screen column.
+const VERTICAL_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_compute.wgsl");
+/// Pixels per workgroup of the compute passes: along the row in step 2, down the column in step 3
+/// (`SEGMENT_PIXELS` of `sssm_segment.wgsl`; step 3's workgroup grid is (row runs, columns)).
+const SHARED_SEGMENT_PIXELS: u32 = 64;
 
 /// The blur's weights (Sec. 4.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
@@ -40,6 +54,18 @@ pub enum BlurFilter {
     Gaussian,
     /// Equal weights: the box filter PCSS applies.
     Mean,
+}
+
+/// How steps 2 and 3 run (the same pixels either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum BlurPasses {
+    /// Full-screen fragment passes: every blur tap reads its pixel from three textures.
+    Fragment,
+    /// Compute passes whose workgroups (64 pixels of a row in step 2, of a column in step 3) load
+    /// the screen segment their blurs reach into workgroup memory once; taps read it from there.
+    /// Slower on lavapipe, where workgroup memory is the same memory as a texture and the
+    /// barriers cost; meant for GPUs, where it has not been measured yet.
+    SharedRows,
 }
 
 /// Settings of [`SeparableSoftShadowMaps`]: its parameters.
@@ -72,6 +98,9 @@ pub struct SssmSettings {
     /// Blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur).
     #[param(default = 0.005, min = 0.0, max = 1.0)]
     pub bilateral_depth: f32,
+    /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
+    #[param(choice, default = "fragment")]
+    pub blur_passes: BlurPasses,
     /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
@@ -86,7 +115,7 @@ pub struct SssmSettings {
 pub struct SssmSettingsUniform {
     blocker_kernel: u32,
     blur_kernel: u32,
-    gaussian: u32,
+    _pad0: u32,
     receiver_plane: u32,
     alpha: f32,
     beta: f32,
@@ -96,6 +125,26 @@ pub struct SssmSettingsUniform {
     count_reads: u32,
     _pad1: f32,
     _pad2: f32,
+    blur_weights: [[f32; 4]; 32],
+}
+
+/// The weights of the m blur taps (Sec. 4.4): a Gaussian of standard deviation `sigma`
+/// half-widths at the taps' offsets in [-1, 1] (the shaders' `grid_offset`), or 1 for the mean.
+fn blur_weights(settings: &SssmSettings) -> [[f32; 4]; 32] {
+    let mut weights = [[0.0; 4]; 32];
+    let taps = settings.blur_kernel.clamp(1, 128);
+    for tap in 0..taps {
+        let weight = match settings.filter {
+            BlurFilter::Mean => 1.0,
+            BlurFilter::Gaussian => {
+                let offset = (tap as f32 + 0.5) / taps as f32 * 2.0 - 1.0;
+                let x = offset / settings.sigma.max(1e-3);
+                (-0.5 * x * x).exp()
+            }
+        };
+        weights[tap as usize / 4][tap as usize % 4] = weight;
+    }
+    weights
 }
 
 impl From<&SssmSettings> for SssmSettingsUniform {
@@ -103,7 +152,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
         Self {
             blocker_kernel: settings.blocker_kernel,
             blur_kernel: settings.blur_kernel,
-            gaussian: u32::from(settings.filter == BlurFilter::Gaussian),
+            _pad0: 0,
             receiver_plane: u32::from(settings.receiver.receiver_plane),
             alpha: settings.alpha,
             beta: settings.beta,
@@ -113,6 +162,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             count_reads: u32::from(settings.count_reads),
             _pad1: 0.0,
             _pad2: 0.0,
+            blur_weights: blur_weights(settings),
         }
     }
 }
@@ -121,14 +171,34 @@ impl From<&SssmSettings> for SssmSettingsUniform {
 pub struct SeparableSoftShadowMaps {
     depth_map: LightDepthMap,
     horizontal_blocker: ScreenPass,
-    blocker_blur: ScreenPass,
-    vertical_blur: ScreenPass,
-    /// The three passes' own bind groups (the light frame is the screen pass's group 0).
-    groups: [wgpu::BindGroup; 3],
+    /// Steps 2 and 3, as fragment or compute passes.
+    blur_steps: BlurSteps,
+    /// Step 1's bind group (the light frame is the screen pass's group 0).
+    horizontal_blocker_group: wgpu::BindGroup,
     horizontal_blocker_view: wgpu::TextureView,
     horizontal_blur_view: wgpu::TextureView,
     reuse: wgpu::Texture,
     read_counts: ReadCounts,
+}
+
+/// Steps 2 and 3 as [`BlurPasses`] says.
+enum BlurSteps {
+    Fragment {
+        blocker_blur: ScreenPass,
+        vertical_blur: ScreenPass,
+        /// Step 2's and step 3's own bind groups.
+        groups: [wgpu::BindGroup; 2],
+    },
+    SharedRows {
+        blocker_blur: wgpu::ComputePipeline,
+        vertical_blur: wgpu::ComputePipeline,
+        gbuffer_group: wgpu::BindGroup,
+        blocker_blur_group: wgpu::BindGroup,
+        /// Per light: step 3's group, binding that light's visibility target.
+        vertical_blur_groups: Vec<wgpu::BindGroup>,
+        width: u32,
+        height: u32,
+    },
 }
 
 /// The names of the passes whose reads are counted, in the shaders' order.
@@ -144,8 +214,8 @@ struct Targets {
 
 impl Targets {
     fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
-        let target = |label: &str| {
-            let texture = render_texture(device, label, width, height, wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::empty());
+        let target = |label: &str, usage: wgpu::TextureUsages| {
+            let texture = render_texture(device, label, width, height, wgpu::TextureFormat::Rgba32Float, usage);
             labelled_view(&texture, label)
         };
         let reuse = device.create_texture(&wgpu::TextureDescriptor {
@@ -159,11 +229,26 @@ impl Targets {
             view_formats: &[],
         });
         Self {
-            horizontal_blocker: target("sssm_horizontal_blocker_target"),
-            horizontal_blur: target("sssm_horizontal_blur_target"),
+            horizontal_blocker: target("sssm_horizontal_blocker_target", wgpu::TextureUsages::empty()),
+            // Written by step 2's compute pass as a storage texture.
+            horizontal_blur: target("sssm_horizontal_blur_target", wgpu::TextureUsages::STORAGE_BINDING),
             reuse_view: labelled_view(&reuse, "sssm_reuse_share"),
             reuse,
         }
+    }
+}
+
+/// A write-only storage texture entry of `format`, for the fragment and compute stages.
+const fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
     }
 }
 
@@ -178,103 +263,33 @@ impl SeparableSoftShadowMaps {
         let depth_map = settings.bias.depth_map(setup, "sssm_shadow_map", settings.shadow_map_size)?;
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
-        let layouts = Self::layouts(device);
         let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES, settings.count_reads);
-        let groups = Self::bind_groups(setup, &layouts, (&settings_buffer, &depth_map, read_counts.buffer()), &targets);
-        let module = |label: &str, source: &str| create_shader_with_imports(setup.gpu, label, source, LOCAL_SHADERS);
-        let rgba = wgpu::ColorTargetState::from(wgpu::TextureFormat::Rgba32Float);
-        let [layout_a, layout_b, layout_c] = &layouts;
+        let shared =
+            Shared { setup, settings: &settings_buffer, depth_map: &depth_map, read_counts: read_counts.buffer(), targets: &targets };
+        let horizontal_blocker_layout = shared.layout("sssm_horizontal_blocker_layout", &[]);
+        let horizontal_blocker_group = shared.group("sssm_horizontal_blocker_bind_group", &horizontal_blocker_layout, &[]);
         let horizontal_blocker = ScreenPass::new(
             setup,
             NAME,
             "sssm_horizontal_blocker",
-            (&module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
-            Some(layout_a),
-            rgba.clone(),
+            (&shared.module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
+            Some(&horizontal_blocker_layout),
+            wgpu::TextureFormat::Rgba32Float.into(),
         )?;
-        let blocker_blur = ScreenPass::new(
-            setup,
-            NAME,
-            "sssm_blocker_and_horizontal_blur",
-            (&module("sssm_blocker_blur_shader", BLOCKER_BLUR_SHADER)?, "sssm_blocker_blur"),
-            Some(layout_b),
-            rgba,
-        )?;
-        let vertical_blur = ScreenPass::new(
-            setup,
-            NAME,
-            "sssm_vertical_blur",
-            (&module("sssm_vertical_blur_shader", VERTICAL_BLUR_SHADER)?, "sssm_vertical_blur"),
-            Some(layout_c),
-            VISIBILITY_FORMAT.into(),
-        )?;
+        let blur_steps = match settings.blur_passes {
+            BlurPasses::Fragment => shared.fragment_steps()?,
+            BlurPasses::SharedRows => shared.shared_row_steps()?,
+        };
         Ok(Self {
             depth_map,
             horizontal_blocker,
-            blocker_blur,
-            vertical_blur,
-            groups,
+            blur_steps,
+            horizontal_blocker_group,
             horizontal_blocker_view: targets.horizontal_blocker,
             horizontal_blur_view: targets.horizontal_blur,
             reuse: targets.reuse,
             read_counts,
         })
-    }
-
-    /// The three passes' own layouts: camera, settings and depth map, then what each reads and writes.
-    fn layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 3] {
-        let common = [uniform_entry(0), uniform_entry(1), texture_entry(2), ReadCounts::layout_entry(3)];
-        let layout = |label: &str, extra: &[wgpu::BindGroupLayoutEntry]| {
-            let entries: Vec<wgpu::BindGroupLayoutEntry> = common.iter().chain(extra).copied().collect();
-            bind_group_layout(device, label, &entries)
-        };
-        let reuse_storage = wgpu::BindGroupLayoutEntry {
-            binding: 6,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::R32Float,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
-        [
-            layout("sssm_horizontal_blocker_layout", &[]),
-            layout("sssm_blocker_blur_layout", &[texture_entry(4)]),
-            layout("sssm_vertical_blur_layout", &[texture_entry(4), texture_entry(5), reuse_storage]),
-        ]
-    }
-
-    fn bind_groups(
-        setup: &TechniqueSetup<'_>,
-        [layout_a, layout_b, layout_c]: &[wgpu::BindGroupLayout; 3],
-        (settings_buffer, depth_map, read_counts): (&wgpu::Buffer, &LightDepthMap, &wgpu::Buffer),
-        targets: &Targets,
-    ) -> [wgpu::BindGroup; 3] {
-        let device = &setup.gpu.device;
-        let group = |label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource<'_>]| {
-            let mut resources = vec![
-                setup.scene.camera_buffer.as_entire_binding(),
-                settings_buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
-                read_counts.as_entire_binding(),
-            ];
-            resources.extend_from_slice(extra);
-            bind_group(device, label, layout, &resources)
-        };
-        [
-            group("sssm_horizontal_blocker_bind_group", layout_a, &[]),
-            group("sssm_blocker_blur_bind_group", layout_b, &[wgpu::BindingResource::TextureView(&targets.horizontal_blocker)]),
-            group(
-                "sssm_vertical_blur_bind_group",
-                layout_c,
-                &[
-                    wgpu::BindingResource::TextureView(&targets.horizontal_blocker),
-                    wgpu::BindingResource::TextureView(&targets.horizontal_blur),
-                    wgpu::BindingResource::TextureView(&targets.reuse_view),
-                ],
-            ),
-        ]
     }
 
     /// The reuse share per pixel of the last light rendered (-1 where nothing was computed).
@@ -284,14 +299,189 @@ impl SeparableSoftShadowMaps {
     }
 }
 
+/// What the three passes' bind groups share (binding 0 camera, 1 settings, 2 depth map, 3 read
+/// counts), and the builders of steps 2 and 3.
+struct Shared<'a> {
+    setup: &'a TechniqueSetup<'a>,
+    settings: &'a wgpu::Buffer,
+    depth_map: &'a LightDepthMap,
+    read_counts: &'a wgpu::Buffer,
+    targets: &'a Targets,
+}
+
+impl Shared<'_> {
+    fn module(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule> {
+        create_shader_with_imports(self.setup.gpu, label, source, LOCAL_SHADERS)
+    }
+
+    /// A layout of the shared entries and `extra`.
+    fn layout(&self, label: &str, extra: &[wgpu::BindGroupLayoutEntry]) -> wgpu::BindGroupLayout {
+        let common = [uniform_entry(0), uniform_entry(1), texture_entry(2), ReadCounts::layout_entry(3)];
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = common.iter().chain(extra).copied().collect();
+        bind_group_layout(&self.setup.gpu.device, label, &entries)
+    }
+
+    /// A group of the shared resources and `extra` (bindings 4 on).
+    fn group(&self, label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource<'_>]) -> wgpu::BindGroup {
+        let mut resources = vec![
+            self.setup.scene.camera_buffer.as_entire_binding(),
+            self.settings.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.depth_map.linear_depth_view),
+            self.read_counts.as_entire_binding(),
+        ];
+        resources.extend_from_slice(extra);
+        bind_group(&self.setup.gpu.device, label, layout, &resources)
+    }
+
+    /// Step 3's inputs: step 1's and step 2's targets, and the reuse share it writes.
+    fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 3] {
+        [
+            wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
+            wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
+            wgpu::BindingResource::TextureView(&self.targets.reuse_view),
+        ]
+    }
+
+    fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
+        [texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::R32Float)]
+    }
+
+    fn fragment_steps(&self) -> Result<BlurSteps> {
+        let blocker_blur_layout = self.layout("sssm_blocker_blur_layout", &[texture_entry(4)]);
+        let vertical_blur_layout = self.layout("sssm_vertical_blur_layout", &Self::vertical_entries());
+        let groups = [
+            self.group(
+                "sssm_blocker_blur_bind_group",
+                &blocker_blur_layout,
+                &[wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker)],
+            ),
+            self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
+        ];
+        let blocker_blur = ScreenPass::new(
+            self.setup,
+            NAME,
+            "sssm_blocker_and_horizontal_blur",
+            (&self.module("sssm_blocker_blur_fragment_shader", BLOCKER_BLUR_FRAGMENT_SHADER)?, "sssm_blocker_blur"),
+            Some(&blocker_blur_layout),
+            wgpu::TextureFormat::Rgba32Float.into(),
+        )?;
+        let vertical_blur = ScreenPass::new(
+            self.setup,
+            NAME,
+            "sssm_vertical_blur",
+            (&self.module("sssm_vertical_blur_fragment_shader", VERTICAL_BLUR_FRAGMENT_SHADER)?, "sssm_vertical_blur"),
+            Some(&vertical_blur_layout),
+            VISIBILITY_FORMAT.into(),
+        )?;
+        Ok(BlurSteps::Fragment { blocker_blur, vertical_blur, groups })
+    }
+
+    fn shared_row_steps(&self) -> Result<BlurSteps> {
+        let setup = self.setup;
+        let device = &setup.gpu.device;
+        let gbuffer = setup.shared.gbuffer(NAME)?;
+        let blocker_blur_layout =
+            self.layout("sssm_blocker_blur_rows_layout", &[texture_entry(4), storage_texture_entry(5, wgpu::TextureFormat::Rgba32Float)]);
+        let mut vertical_entries = Self::vertical_entries().to_vec();
+        vertical_entries.push(storage_texture_entry(7, VISIBILITY_FORMAT));
+        let vertical_blur_layout = self.layout("sssm_vertical_blur_columns_layout", &vertical_entries);
+        let blocker_blur_group = self.group(
+            "sssm_blocker_blur_rows_bind_group",
+            &blocker_blur_layout,
+            &[
+                wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
+                wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
+            ],
+        );
+        let vertical_blur_groups = setup
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(light, output)| {
+                let mut resources = self.vertical_inputs().to_vec();
+                resources.push(wgpu::BindingResource::TextureView(output));
+                self.group(&format!("sssm_vertical_blur_columns_bind_group_{light}"), &vertical_blur_layout, &resources)
+            })
+            .collect();
+        let blocker_blur = compute_pipeline(
+            device,
+            "sssm_blocker_blur_rows_pipeline",
+            &self.module("sssm_blocker_blur_compute_shader", BLOCKER_BLUR_COMPUTE_SHADER)?,
+            "sssm_blocker_blur_rows",
+            &[&setup.scene.uniform_layout, &gbuffer.layout, &blocker_blur_layout],
+        );
+        let vertical_blur = compute_pipeline(
+            device,
+            "sssm_vertical_blur_columns_pipeline",
+            &self.module("sssm_vertical_blur_compute_shader", VERTICAL_BLUR_COMPUTE_SHADER)?,
+            "sssm_vertical_blur_columns",
+            &[&setup.scene.uniform_layout, &gbuffer.layout, &vertical_blur_layout],
+        );
+        if let Some(messages) = Some(setup.gpu.take_errors()).filter(|m| !m.is_empty()) {
+            return Err(ssm_core::Error::Gpu { during: "building SSSM's shared-row compute passes".into(), messages });
+        }
+        Ok(BlurSteps::SharedRows {
+            blocker_blur,
+            vertical_blur,
+            gbuffer_group: gbuffer.bind_group.clone(),
+            blocker_blur_group,
+            vertical_blur_groups,
+            width: setup.scene.width,
+            height: setup.scene.height,
+        })
+    }
+}
+
 impl ShadowTechnique for SeparableSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
-        let [group_a, group_b, group_c] = &self.groups;
         self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
-        self.horizontal_blocker.encode(frame, light, &self.horizontal_blocker_view, Some(group_a), Some(wgpu::Color::TRANSPARENT));
-        self.blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(group_b), Some(wgpu::Color::TRANSPARENT));
-        self.vertical_blur.encode(frame, light, output, Some(group_c), None);
+        self.horizontal_blocker.encode(
+            frame,
+            light,
+            &self.horizontal_blocker_view,
+            Some(&self.horizontal_blocker_group),
+            Some(wgpu::Color::TRANSPARENT),
+        );
+        match &self.blur_steps {
+            BlurSteps::Fragment { blocker_blur, vertical_blur, groups: [blocker_blur_group, vertical_blur_group] } => {
+                blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(blocker_blur_group), Some(wgpu::Color::TRANSPARENT));
+                vertical_blur.encode(frame, light, output, Some(vertical_blur_group), None);
+            }
+            BlurSteps::SharedRows {
+                blocker_blur,
+                vertical_blur,
+                gbuffer_group,
+                blocker_blur_group,
+                vertical_blur_groups,
+                width,
+                height,
+            } => {
+                let vertical_blur_group = vertical_blur_groups.get(light).ok_or_else(|| ssm_core::Error::Gpu {
+                    during: format!("SSSM rendering light {light}"),
+                    messages: vec![format!("only {} visibility targets", vertical_blur_groups.len())],
+                })?;
+                let light_group = &frame.scene.light_bind_groups[light];
+                // The same labels as the fragment passes, so the per-pass times line up.
+                let steps = [
+                    (
+                        "sssm_blocker_and_horizontal_blur",
+                        blocker_blur,
+                        blocker_blur_group,
+                        [width.div_ceil(SHARED_SEGMENT_PIXELS), *height],
+                    ),
+                    ("sssm_vertical_blur", vertical_blur, vertical_blur_group, [height.div_ceil(SHARED_SEGMENT_PIXELS), *width]),
+                ];
+                for (label, pipeline, group, [x, y]) in steps {
+                    let mut pass = frame.compute_pass(label);
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, light_group, &[]);
+                    pass.set_bind_group(1, gbuffer_group, &[]);
+                    pass.set_bind_group(2, group, &[]);
+                    pass.dispatch_workgroups(x, y, 1);
+                }
+            }
+        }
         Ok(())
     }
 
@@ -322,17 +512,31 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
 }
 
 /// Buades et al.'s evaluations, as sweeps.
-const PRESETS: &[ssm_core::Preset] = &[ssm_core::Preset {
-    name: "sssm-table4",
-    summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse; both with the receiver-plane model (on leaves, the plant scene's nearest)",
-    scenes: &["leaves"],
-    varies: &[
-        "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
-        "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
-        "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
-    ],
-    ..ssm_core::Preset::DEFAULT
-}];
+const PRESETS: &[ssm_core::Preset] = &[
+    ssm_core::Preset {
+        name: "sssm-table4",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse; both with the receiver-plane model (on leaves, the plant scene's nearest)",
+        scenes: &["leaves"],
+        varies: &[
+            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+            "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
+        ],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "sssm-passes",
+        summary: "SSSM's steps 2 and 3 as fragment passes and as shared-row compute passes, beside PCSS, at Table 4's kernel pairs with alpha = beta = 0.1 (on leaves): what the implementation, not the algorithm, costs on this adapter",
+        scenes: &["leaves"],
+        varies: &[
+            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+            "sssm.blur_passes=fragment,shared_rows",
+            "sssm.alpha:beta=0.1:0.1",
+        ],
+        ..ssm_core::Preset::DEFAULT
+    },
+];
 
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {

@@ -1,0 +1,26 @@
+// SSSM step 2 as a fragment pass: every blur tap reads its pixel from the textures.
+
+// #import sssm/sssm_blocker_blur.wgsl
+
+fn horizontal_source(texel: vec2<i32>) -> BlurSource {
+    return load_horizontal_source(texel);
+}
+
+// (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker rows
+// reused); w = -1 where nothing was computed (background, behind the light).
+@fragment
+fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
+    let point = screen_point(in);
+    let own = textureLoad(horizontal_blocker, point.texel, 0);
+    if (own.x < 0.0) {
+        return vec4<f32>(own.w, 0.0, 0.0, -1.0);
+    }
+    reads = 3u;
+    let searched = blocker_search(point, own);
+    var result = searched.result;
+    if (searched.blur) {
+        result = horizontal_blur(in.clip.xy, point, own, result);
+    }
+    record_reads(1u, point.texel);
+    return result;
+}
