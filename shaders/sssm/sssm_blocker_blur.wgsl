@@ -10,21 +10,14 @@
 
 @group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
 
-// A blur tap's pixel read from the textures: step 1's hard visibility, and the G-buffer texels
-// the bilateral weight compares (not read when there is no bilateral weight).
+@group(2) @binding(5) var blur_source: texture_2d<f32>;
+
+// A blur tap's pixel read from step 1's blur_source: its hard visibility, and what the bilateral
+// weight compares.
 fn load_horizontal_source(texel: vec2<i32>) -> BlurSource {
-    let value = textureLoad(horizontal_blocker, texel, 0).w;
+    let packed = textureLoad(blur_source, texel, 0);
     reads += 1u;
-    if (settings.bilateral_depth <= 0.0) {
-        return BlurSource(value, 0.0, vec3<f32>(0.0));
-    }
-    let position = textureLoad(gbuffer_position, texel, 0);
-    reads += 1u;
-    if (position.w < 0.5) {
-        return blur_source(value, position, vec4<f32>(0.0));
-    }
-    reads += 1u;
-    return blur_source(value, position, textureLoad(gbuffer_normal, texel, 0));
+    return unpack_blur_source(packed.x, packed);
 }
 
 // The blocker search of a computed pixel, its penumbra and its blur widths: (the hard or lit

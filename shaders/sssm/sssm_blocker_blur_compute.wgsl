@@ -8,7 +8,7 @@
 // #import sssm/sssm_blocker_blur.wgsl
 // #import sssm/sssm_segment.wgsl
 
-@group(2) @binding(5) var horizontal_blur_target: texture_storage_2d<rgba32float, write>;
+@group(2) @binding(6) var horizontal_blur_target: texture_storage_2d<rgba32float, write>;
 
 fn horizontal_source(texel: vec2<i32>) -> BlurSource {
     let index = segment_index(texel.x);

@@ -223,12 +223,37 @@ struct BlurSource {
     normal: vec3<f32>,
 };
 
-// The BlurSource of a pixel from its G-buffer position and normal texels.
-fn blur_source(value: f32, position: vec4<f32>, normal: vec4<f32>) -> BlurSource {
-    if (position.w < 0.5) {
+// Octahedral encoding of a unit vector in two floats (Meyer et al. 2010): the octahedron's upper
+// half unfolded onto the square, the lower half folded over its corners.
+fn octahedral_encode(unit: vec3<f32>) -> vec2<f32> {
+    let folded = unit.xy / (abs(unit.x) + abs(unit.y) + abs(unit.z));
+    let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), folded >= vec2<f32>(0.0));
+    return select(folded, (1.0 - abs(folded.yx)) * signs, unit.z < 0.0);
+}
+
+fn octahedral_decode(encoded: vec2<f32>) -> vec3<f32> {
+    let z = 1.0 - abs(encoded.x) - abs(encoded.y);
+    let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), encoded >= vec2<f32>(0.0));
+    let xy = select(encoded, (1.0 - abs(encoded.yx)) * signs, z < 0.0);
+    return normalize(vec3<f32>(xy, z));
+}
+
+// What step 1 writes per pixel for the blurs (the `blur_source` target): (hard visibility, distance
+// from the eye or -1 where nothing covers the pixel, octahedral normal), so that a blur tap reads
+// one texel instead of the hard value's and the G-buffer's two.
+fn packed_blur_source(hard: f32, point: ScreenPoint) -> vec4<f32> {
+    if (!point.covered) {
+        return vec4<f32>(hard, -1.0, 0.0, 0.0);
+    }
+    return vec4<f32>(hard, distance(point.position, camera.position.xyz), octahedral_encode(point.normal));
+}
+
+// The BlurSource of a `blur_source` texel, blurring `value`.
+fn unpack_blur_source(value: f32, packed: vec4<f32>) -> BlurSource {
+    if (packed.y < 0.0) {
         return BlurSource(value, -1.0, vec3<f32>(0.0));
     }
-    return BlurSource(value, distance(position.xyz, camera.position.xyz), normal.xyz);
+    return BlurSource(value, packed.y, octahedral_decode(packed.zw));
 }
 
 // Bilateral weight of a blur tap landing on `source`, for the pixel seen at `point` with normal

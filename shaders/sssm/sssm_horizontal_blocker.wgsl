@@ -3,7 +3,11 @@
 // position (Sec. 4.1): partial_blocker_sum(p) = Σ_x dm(x, 0) for dm < d (d, or the receiver's
 // tangent plane along each tap's ray with `receiver_plane`, as in pcss).
 
+// Also each pixel's packed_blur_source, for the blurs' taps.
+
 // #import sssm/sssm_common.wgsl
+
+@group(2) @binding(4) var blur_source: texture_storage_2d<rgba32float, write>;
 
 // (d, partial sum, partial count, hard visibility); d = -1 where there is nothing to compute.
 @fragment
@@ -11,10 +15,12 @@ fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
     let point = screen_point(in);
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
+        textureStore(blur_source, point.texel, packed_blur_source(trivial, point));
         return vec4<f32>(-1.0, 0.0, 0.0, trivial);
     }
     reads = 2u;
     let result = partial_blocker(point);
+    textureStore(blur_source, point.texel, packed_blur_source(result.w, point));
     record_reads(0u, point.texel);
     return result;
 }

@@ -13,17 +13,14 @@
 @group(2) @binding(5) var horizontal_blur: texture_2d<f32>;
 @group(2) @binding(6) var reuse_share: texture_storage_2d<r32float, write>;
 
-// A blur tap's pixel read from the textures: step 2's horizontal result and the G-buffer texels
-// the β test and the bilateral weight compare.
+@group(2) @binding(7) var blur_source: texture_2d<f32>;
+
+// A blur tap's pixel read from the textures: step 2's horizontal result, and from step 1's
+// blur_source what the β test and the bilateral weight compare.
 fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
     let value = textureLoad(horizontal_blur, texel, 0).x;
-    let position = textureLoad(gbuffer_position, texel, 0);
     reads += 2u;
-    if (position.w < 0.5 || settings.bilateral_depth <= 0.0) {
-        return blur_source(value, position, vec4<f32>(0.0));
-    }
-    reads += 1u;
-    return blur_source(value, position, textureLoad(gbuffer_normal, texel, 0));
+    return unpack_blur_source(value, textureLoad(blur_source, texel, 0));
 }
 
 // The vertical blur's half-width in pixels at a computed pixel whose step 2 result is `own`

@@ -207,6 +207,8 @@ const COUNTED_PASSES: &[&str] = &["sssm_horizontal_blocker", "sssm_blocker_and_h
 /// The intermediate targets between the three passes.
 struct Targets {
     horizontal_blocker: wgpu::TextureView,
+    /// Step 1's packed (hard value, eye distance, octahedral normal) per pixel, read by the blur taps.
+    blur_source: wgpu::TextureView,
     horizontal_blur: wgpu::TextureView,
     reuse: wgpu::Texture,
     reuse_view: wgpu::TextureView,
@@ -230,6 +232,8 @@ impl Targets {
         });
         Self {
             horizontal_blocker: target("sssm_horizontal_blocker_target", wgpu::TextureUsages::empty()),
+            // Written by step 1 as a storage texture.
+            blur_source: target("sssm_blur_source", wgpu::TextureUsages::STORAGE_BINDING),
             // Written by step 2's compute pass as a storage texture.
             horizontal_blur: target("sssm_horizontal_blur_target", wgpu::TextureUsages::STORAGE_BINDING),
             reuse_view: labelled_view(&reuse, "sssm_reuse_share"),
@@ -266,8 +270,13 @@ impl SeparableSoftShadowMaps {
         let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES, settings.count_reads);
         let shared =
             Shared { setup, settings: &settings_buffer, depth_map: &depth_map, read_counts: read_counts.buffer(), targets: &targets };
-        let horizontal_blocker_layout = shared.layout("sssm_horizontal_blocker_layout", &[]);
-        let horizontal_blocker_group = shared.group("sssm_horizontal_blocker_bind_group", &horizontal_blocker_layout, &[]);
+        let horizontal_blocker_layout =
+            shared.layout("sssm_horizontal_blocker_layout", &[storage_texture_entry(4, wgpu::TextureFormat::Rgba32Float)]);
+        let horizontal_blocker_group = shared.group(
+            "sssm_horizontal_blocker_bind_group",
+            &horizontal_blocker_layout,
+            &[wgpu::BindingResource::TextureView(&targets.blur_source)],
+        );
         let horizontal_blocker = ScreenPass::new(
             setup,
             NAME,
@@ -333,28 +342,34 @@ impl Shared<'_> {
         bind_group(&self.setup.gpu.device, label, layout, &resources)
     }
 
-    /// Step 3's inputs: step 1's and step 2's targets, and the reuse share it writes.
-    fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 3] {
+    /// Step 2's inputs (bindings 4 and 5): step 1's target and its blur sources.
+    fn blocker_blur_inputs(&self) -> [wgpu::BindingResource<'_>; 2] {
+        [
+            wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
+            wgpu::BindingResource::TextureView(&self.targets.blur_source),
+        ]
+    }
+
+    /// Step 3's inputs (bindings 4 to 7): step 1's and step 2's targets, the reuse share it
+    /// writes, and step 1's blur sources.
+    fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 4] {
         [
             wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
             wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
             wgpu::BindingResource::TextureView(&self.targets.reuse_view),
+            wgpu::BindingResource::TextureView(&self.targets.blur_source),
         ]
     }
 
-    fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
-        [texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::R32Float)]
+    fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
+        [texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::R32Float), texture_entry(7)]
     }
 
     fn fragment_steps(&self) -> Result<BlurSteps> {
-        let blocker_blur_layout = self.layout("sssm_blocker_blur_layout", &[texture_entry(4)]);
+        let blocker_blur_layout = self.layout("sssm_blocker_blur_layout", &[texture_entry(4), texture_entry(5)]);
         let vertical_blur_layout = self.layout("sssm_vertical_blur_layout", &Self::vertical_entries());
         let groups = [
-            self.group(
-                "sssm_blocker_blur_bind_group",
-                &blocker_blur_layout,
-                &[wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker)],
-            ),
+            self.group("sssm_blocker_blur_bind_group", &blocker_blur_layout, &self.blocker_blur_inputs()),
             self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
         ];
         let blocker_blur = ScreenPass::new(
@@ -380,18 +395,17 @@ impl Shared<'_> {
         let setup = self.setup;
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
-        let blocker_blur_layout =
-            self.layout("sssm_blocker_blur_rows_layout", &[texture_entry(4), storage_texture_entry(5, wgpu::TextureFormat::Rgba32Float)]);
+        let blocker_blur_layout = self.layout(
+            "sssm_blocker_blur_rows_layout",
+            &[texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float)],
+        );
         let mut vertical_entries = Self::vertical_entries().to_vec();
-        vertical_entries.push(storage_texture_entry(7, VISIBILITY_FORMAT));
+        vertical_entries.push(storage_texture_entry(8, VISIBILITY_FORMAT));
         let vertical_blur_layout = self.layout("sssm_vertical_blur_columns_layout", &vertical_entries);
         let blocker_blur_group = self.group(
             "sssm_blocker_blur_rows_bind_group",
             &blocker_blur_layout,
-            &[
-                wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
-                wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
-            ],
+            &[self.blocker_blur_inputs().as_slice(), &[wgpu::BindingResource::TextureView(&self.targets.horizontal_blur)]].concat(),
         );
         let vertical_blur_groups = setup
             .outputs
