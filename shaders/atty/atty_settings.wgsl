@@ -14,6 +14,23 @@ struct AttySettings {
     self_shadow_tolerance: f32,
     // Constant depth tolerance of the hidden-receiver test, a fraction of the scene's diagonal (as the baselines' constant bias).
     receiver_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
+    // 1: each micro-patch's penumbra rectangle is bounded by the deepest receiver under it (the
+    // receiver_bounds pyramid); 0: by the frame's far plane.
+    receiver_bounded: f32,
+    // Neighbouring occluder texels whose depths differ by at most this many micro-patch widths
+    // are drawn as one micro-patch (0: never).
+    merge_tolerance: f32,
+};
+
+// One micro-patch of the accumulation's list (ssm-techniques/atty's 32-byte record).
+struct MicroPatchRecord {
+    // Centre and half extent of its penumbra rectangle on the soft shadow map, in [-1, 1] coordinates.
+    ndc_centre: vec2<f32>,
+    half_ndc: vec2<f32>,
+    // Its depth z_O, and the distance behind it within which a receiver is its own surface.
+    depth: f32,
+    self_shadow_depth: f32,
+    // Occluder texels per side (1, or 2^level for a merged block).
+    span: f32,
+    _pad: f32,
 };

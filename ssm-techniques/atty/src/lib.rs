@@ -12,13 +12,16 @@
 //! receivers. The two-sided variant does this for the nearest front faces and
 //! the farthest back faces and keeps the larger occlusion (Sec. 3.5).
 //!
-//! Unlike the paper, nothing goes back to the CPU: the instanced quad of each
-//! occluder texel is built in the vertex stage (the paper's stated next step,
-//! Sec. 4.3 and 7), so the cost no longer grows with a readback.
+//! Unlike the paper, nothing goes back to the CPU: a compute pass lists the
+//! micro-patches and an indirect instanced draw accumulates them (the paper's
+//! stated next step, Sec. 4.3 and 7), so the cost no longer grows with a
+//! readback. Neighbouring texels at one depth are listed as one patch (their
+//! back-projections join exactly, Sec. 5.1.2).
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, color_attachment, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+    bind_group, bind_group_layout, color_attachment, compute_pipeline, labelled_view, render_texture, storage_entry, texture_entry,
+    uniform_buffer, uniform_entry,
 };
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
@@ -36,6 +39,33 @@ const LOCAL_SHADERS: &[(&str, &str)] = &[("atty/atty_settings.wgsl", include_str
 const ACCUMULATE_SHADER: &str = include_str!("../../../shaders/atty/atty_accumulate.wgsl");
 /// The projection of the SSM onto the screen.
 const PROJECT_SHADER: &str = include_str!("../../../shaders/atty/atty_project.wgsl");
+/// The micro-patch list the accumulation draws.
+const PATCHES_SHADER: &str = include_str!("../../../shaders/atty/atty_patches.wgsl");
+/// Bytes of one micro-patch record (`MicroPatchRecord` in `atty_settings.wgsl`).
+const PATCH_RECORD_BYTES: u64 = 32;
+/// The receiver map's max-pyramid.
+const RECEIVER_BOUNDS_SHADER: &str = include_str!("../../../shaders/atty/atty_receiver_bounds.wgsl");
+/// An occluder map's min-max pyramid.
+const PATCH_MERGE_SHADER: &str = include_str!("../../../shaders/atty/atty_patch_merge.wgsl");
+
+/// An occluder map's depth range per block.
+const PATCH_MERGE: PyramidKind = PyramidKind {
+    label: "atty_patch_merge",
+    format: wgpu::TextureFormat::Rg32Float,
+    shader: PATCH_MERGE_SHADER,
+    base: "atty_merge_base",
+    reduce: "atty_merge_reduce",
+};
+
+/// What bounds each micro-patch's penumbra rectangle on the soft shadow map (the same SSM either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum PenumbraBound {
+    /// The frame's far plane, conservative for every receiver (the straightforward bound).
+    FarPlane,
+    /// The deepest receiver under the rectangle, from a max-pyramid of the receiver map: smaller
+    /// rectangles, and no quad at all for a patch with no receiver behind it.
+    Receivers,
+}
 
 /// The format the micro-patches' occlusions are summed in (Sec. 4.1, Appendix A).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
@@ -81,6 +111,12 @@ pub struct AttySettings {
     /// A micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper).
     #[param(default = 0.0, min = 0.0, max = 16.0)]
     pub self_shadow_tolerance: f32,
+    /// What bounds each micro-patch's penumbra rectangle: the far plane, or the deepest receiver under it (same result; less fill for a pyramid pass, which did not pay on lavapipe).
+    #[param(choice, default = "far_plane")]
+    pub penumbra_bound: PenumbraBound,
+    /// Aligned blocks of occluder texels whose depths differ by at most this many micro-patch widths are drawn as one micro-patch (Sec. 5.1.2: neighbours at one depth join exactly; 0: one patch per texel).
+    #[param(default = 0.01, min = 0.0, max = 16.0)]
+    pub merge_tolerance: f32,
 }
 
 /// The settings uniform both Atty shaders read (`AttySettings` in `shaders/atty/atty_settings.wgsl`).
@@ -93,8 +129,8 @@ pub struct AttySettingsUniform {
     receiver_tolerance: f32,
     self_shadow_tolerance: f32,
     receiver_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
+    receiver_bounded: f32,
+    merge_tolerance: f32,
 }
 
 impl From<&AttySettings> for AttySettingsUniform {
@@ -107,8 +143,8 @@ impl From<&AttySettings> for AttySettingsUniform {
             self_shadow_tolerance: settings.self_shadow_tolerance,
             // The baselines' default constant bias, a fraction of the scene's diagonal.
             receiver_bias: ShadowMapBias::default().constant_bias,
-            _pad0: 0.0,
-            _pad1: 0.0,
+            receiver_bounded: if settings.penumbra_bound == PenumbraBound::Receivers { 1.0 } else { 0.0 },
+            merge_tolerance: settings.merge_tolerance,
         }
     }
 }
@@ -116,20 +152,140 @@ impl From<&AttySettings> for AttySettingsUniform {
 /// One soft shadow map and the pass that fills it from one occluder map.
 struct SideAccumulation {
     occluder_map: LightDepthMap,
+    /// The indirect draw's arguments: 4 vertices, then the patch count the list pass counts up.
+    draw_arguments: wgpu::Buffer,
+    /// The list pass's bind group (occluder map, settings, pyramids, patch list, draw arguments).
+    patches_group: wgpu::BindGroup,
+    /// The occluder map's depth range per block, when micro-patches merge.
+    patch_merge: Option<DepthPyramid>,
     soft_shadow_map: wgpu::TextureView,
     bind_group: wgpu::BindGroup,
     label: &'static str,
 }
 
+/// A pyramid of depth bounds over a light map: the receiver map's largest depth per block
+/// (`atty_receiver_bounds.wgsl`, bounding the penumbra rectangles) or an occluder map's depth
+/// range per block (`atty_patch_merge.wgsl`, merging micro-patches). Level 0 is built from the
+/// map by the shader's `base` entry point, each level above from the one below by `reduce`.
+struct DepthPyramid {
+    /// Every level, for the accumulation's vertex stage.
+    view: wgpu::TextureView,
+    base: wgpu::ComputePipeline,
+    reduce: wgpu::ComputePipeline,
+    /// Per level: its bind group (the level below, or the map, and this level) and size.
+    levels: Vec<(wgpu::BindGroup, u32)>,
+    label: &'static str,
+}
+
+/// What a [`DepthPyramid`] holds and how it is built.
+struct PyramidKind {
+    label: &'static str,
+    format: wgpu::TextureFormat,
+    shader: &'static str,
+    base: &'static str,
+    reduce: &'static str,
+}
+
+/// The receiver map's largest depth per block.
+const RECEIVER_BOUNDS: PyramidKind = PyramidKind {
+    label: "atty_receiver_bounds",
+    format: wgpu::TextureFormat::R32Float,
+    shader: RECEIVER_BOUNDS_SHADER,
+    base: "atty_bounds_base",
+    reduce: "atty_bounds_reduce",
+};
+
+impl DepthPyramid {
+    /// The pyramid of `kind` over `map`, `size`² texels at level 0 (1 where it is bound but not read).
+    fn new(setup: &TechniqueSetup<'_>, kind: &PyramidKind, label: &'static str, map: &wgpu::TextureView, size: u32) -> Result<Self> {
+        let device = &setup.gpu.device;
+        let level_count = u32::BITS - size.leading_zeros();
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: level_count,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: kind.format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+            view_formats: &[],
+        });
+        let layout = bind_group_layout(
+            device,
+            &format!("{}_layout", kind.label),
+            &[
+                texture_entry(0),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: kind.format,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        );
+        let views: Vec<wgpu::TextureView> = (0..level_count)
+            .map(|level| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some(&format!("{label}_level_{level}_view")),
+                    base_mip_level: level,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let levels = views
+            .iter()
+            .enumerate()
+            .map(|(level, view)| {
+                let finer = if level == 0 { map } else { &views[level - 1] };
+                let group = bind_group(
+                    device,
+                    &format!("{label}_level_{level}_bind_group"),
+                    &layout,
+                    &[wgpu::BindingResource::TextureView(finer), wgpu::BindingResource::TextureView(view)],
+                );
+                (group, (size >> level).max(1))
+            })
+            .collect();
+        let module = create_shader_with_imports(setup.gpu, &format!("{}_shader", kind.label), kind.shader, LOCAL_SHADERS)?;
+        let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout]);
+        let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout]);
+        let messages = setup.gpu.take_errors();
+        if !messages.is_empty() {
+            return Err(Error::Gpu { during: format!("building Atty's {label}"), messages });
+        }
+        let view = texture.create_view(&wgpu::TextureViewDescriptor { label: Some(&format!("{label}_view")), ..Default::default() });
+        Ok(Self { view, base, reduce, levels, label })
+    }
+
+    /// Builds the pyramid from its map just rendered, in one timed compute pass.
+    fn encode(&self, frame: &mut Frame<'_>) {
+        let mut pass = frame.compute_pass(self.label);
+        for (level, (group, size)) in self.levels.iter().enumerate() {
+            pass.set_pipeline(if level == 0 { &self.base } else { &self.reduce });
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(size.div_ceil(8), size.div_ceil(8), 1);
+        }
+    }
+}
+
 /// Atty et al.'s soft shadow maps.
 pub struct SoftShadowMaps {
     receiver_map: LightDepthMap,
+    /// The receiver map's max-pyramid, when it bounds the penumbra rectangles.
+    receiver_bounds: Option<DepthPyramid>,
     /// Front faces (or every face, one-sided), then back faces when two-sided.
     accumulations: Vec<SideAccumulation>,
     accumulate_pipeline: wgpu::RenderPipeline,
+    patches_pipeline: wgpu::ComputePipeline,
+    /// Occluder-map side, texels: the list pass runs one invocation per texel.
+    occluder_map_size: u32,
     project: ScreenPass,
     project_group: wgpu::BindGroup,
-    patches: u32,
 }
 
 /// A linear depth map of the occluders or receivers, without bias: micro-patches and receivers sit at their true depths.
@@ -157,16 +313,28 @@ impl SoftShadowMaps {
         check_receivers_resolved(setup, settings.ssm_size)?;
         let settings_buffer = uniform_buffer(&setup.gpu.device, "atty_settings_uniform", &AttySettingsUniform::from(&settings));
         let receiver_map = unbiased_depth_map(setup, "atty_receiver_map", settings.ssm_size, Geometry::Receivers, (None, false))?;
-        let accumulations = Self::accumulations(setup, &settings, &receiver_map, &settings_buffer)?;
+        let bounded = settings.penumbra_bound == PenumbraBound::Receivers;
+        // Unbounded, the accumulation still binds a pyramid, of one texel, that it never reads.
+        let receiver_bounds = DepthPyramid::new(
+            setup,
+            &RECEIVER_BOUNDS,
+            "atty_receiver_bounds",
+            &receiver_map.linear_depth_view,
+            if bounded { settings.ssm_size } else { 1 },
+        )?;
+        let accumulations = Self::accumulations(setup, &settings, (&receiver_map, &receiver_bounds.view), &settings_buffer)?;
         let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation)?;
+        let patches_pipeline = Self::patches_pipeline(setup)?;
         let (project, project_group) = Self::projection(setup, &accumulations, &receiver_map, &settings_buffer)?;
         Ok(Self {
             receiver_map,
+            receiver_bounds: bounded.then_some(receiver_bounds),
             accumulations,
             accumulate_pipeline,
+            patches_pipeline,
+            occluder_map_size: settings.occluder_map_size,
             project,
             project_group,
-            patches: settings.occluder_map_size * settings.occluder_map_size,
         })
     }
 
@@ -175,7 +343,7 @@ impl SoftShadowMaps {
     fn accumulations(
         setup: &TechniqueSetup<'_>,
         settings: &AttySettings,
-        receiver_map: &LightDepthMap,
+        (receiver_map, receiver_bounds): (&LightDepthMap, &wgpu::TextureView),
         settings_buffer: &wgpu::Buffer,
     ) -> Result<Vec<SideAccumulation>> {
         let device = &setup.gpu.device;
@@ -192,6 +360,15 @@ impl SoftShadowMaps {
             .iter()
             .map(|&(map_label, pass_label, cull, farthest)| {
                 let occluder_map = unbiased_depth_map(setup, map_label, settings.occluder_map_size, Geometry::Occluders, (cull, farthest))?;
+                let merging = settings.merge_tolerance > 0.0;
+                // Without merging, the accumulation still binds a pyramid, of one texel, that it never reads.
+                let patch_merge = DepthPyramid::new(
+                    setup,
+                    &PATCH_MERGE,
+                    if farthest { "atty_patch_merge_back" } else { "atty_patch_merge" },
+                    &occluder_map.linear_depth_view,
+                    if merging { settings.occluder_map_size } else { 1 },
+                )?;
                 let texture_label = format!("{pass_label}_soft_shadow_map");
                 let texture = render_texture(
                     device,
@@ -201,18 +378,48 @@ impl SoftShadowMaps {
                     settings.accumulation.format(),
                     wgpu::TextureUsages::empty(),
                 );
+                let patches = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(&format!("{pass_label}_patches")),
+                    size: u64::from(settings.occluder_map_size).pow(2) * PATCH_RECORD_BYTES,
+                    usage: wgpu::BufferUsages::STORAGE,
+                    mapped_at_creation: false,
+                });
+                let draw_arguments = wgpu::util::DeviceExt::create_buffer_init(
+                    device,
+                    &wgpu::util::BufferInitDescriptor {
+                        label: Some(&format!("{pass_label}_draw_arguments")),
+                        contents: bytemuck::cast_slice(&[4u32, 0, 0, 0]),
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                    },
+                );
+                let patches_group = bind_group(
+                    device,
+                    &format!("{pass_label}_patches_bind_group"),
+                    &Self::patches_layout(device),
+                    &[
+                        wgpu::BindingResource::TextureView(&occluder_map.linear_depth_view),
+                        settings_buffer.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(receiver_bounds),
+                        wgpu::BindingResource::TextureView(&patch_merge.view),
+                        patches.as_entire_binding(),
+                        draw_arguments.as_entire_binding(),
+                    ],
+                );
                 let bind_group = bind_group(
                     device,
                     &format!("{pass_label}_bind_group"),
                     &layout,
                     &[
-                        wgpu::BindingResource::TextureView(&occluder_map.linear_depth_view),
+                        patches.as_entire_binding(),
                         wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view),
                         settings_buffer.as_entire_binding(),
                     ],
                 );
                 Ok(SideAccumulation {
                     occluder_map,
+                    draw_arguments,
+                    patches_group,
+                    patch_merge: merging.then_some(patch_merge),
                     soft_shadow_map: labelled_view(&texture, &texture_label),
                     bind_group,
                     label: pass_label,
@@ -222,7 +429,33 @@ impl SoftShadowMaps {
     }
 
     fn accumulate_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        bind_group_layout(device, "atty_accumulate_layout", &[texture_entry(0), texture_entry(1), uniform_entry(2)])
+        bind_group_layout(device, "atty_accumulate_layout", &[storage_entry(0, true), texture_entry(1), uniform_entry(2)])
+    }
+
+    fn patches_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        bind_group_layout(
+            device,
+            "atty_patches_layout",
+            &[texture_entry(0), uniform_entry(1), texture_entry(2), texture_entry(3), storage_entry(4, false), storage_entry(5, false)],
+        )
+    }
+
+    /// The pass that lists the micro-patches (`atty_patches.wgsl`).
+    fn patches_pipeline(setup: &TechniqueSetup<'_>) -> Result<wgpu::ComputePipeline> {
+        let device = &setup.gpu.device;
+        let module = create_shader_with_imports(setup.gpu, "atty_patches_shader", PATCHES_SHADER, LOCAL_SHADERS)?;
+        let pipeline = compute_pipeline(
+            device,
+            "atty_patches_pipeline",
+            &module,
+            "atty_patches",
+            &[setup.gpu.uniform_layout(), &Self::patches_layout(device)],
+        );
+        let messages = setup.gpu.take_errors();
+        if !messages.is_empty() {
+            return Err(Error::Gpu { during: "building Atty's micro-patch list pass".into(), messages });
+        }
+        Ok(pipeline)
     }
 
     /// The instanced micro-patch pipeline: one quad per occluder texel, summed by additive
@@ -332,8 +565,23 @@ impl ShadowTechnique for SoftShadowMaps {
             .get(light)
             .ok_or_else(|| Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
         self.receiver_map.encode(frame, light);
+        if let Some(bounds) = &self.receiver_bounds {
+            bounds.encode(frame);
+        }
         for accumulation in &self.accumulations {
             accumulation.occluder_map.encode(frame, light);
+            if let Some(merge) = &accumulation.patch_merge {
+                merge.encode(frame);
+            }
+            // The patch count back to 0 (bytes 4 to 8; the 4 vertices stay).
+            frame.clear_buffer("atty_patch_count_reset", &accumulation.draw_arguments, 4, Some(4));
+            {
+                let mut pass = frame.compute_pass(&format!("{}_patches", accumulation.label));
+                pass.set_pipeline(&self.patches_pipeline);
+                pass.set_bind_group(0, light_frame, &[]);
+                pass.set_bind_group(1, &accumulation.patches_group, &[]);
+                pass.dispatch_workgroups(self.occluder_map_size.div_ceil(8), self.occluder_map_size.div_ceil(8), 1);
+            }
             let mut pass = frame.render_pass(
                 accumulation.label,
                 &[color_attachment(&accumulation.soft_shadow_map, Some(wgpu::Color::TRANSPARENT))],
@@ -342,8 +590,8 @@ impl ShadowTechnique for SoftShadowMaps {
             pass.set_pipeline(&self.accumulate_pipeline);
             pass.set_bind_group(0, light_frame, &[]);
             pass.set_bind_group(1, &accumulation.bind_group, &[]);
-            // One quad (4-vertex strip) per occluder texel.
-            pass.draw(0..4, 0..self.patches);
+            // One quad (4-vertex strip) per listed micro-patch.
+            pass.draw_indirect(&accumulation.draw_arguments, 0);
         }
         self.project.encode(frame, light, output, Some(&self.project_group), None);
         Ok(())

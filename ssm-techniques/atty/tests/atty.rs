@@ -91,8 +91,9 @@ fn fp16_accumulation_fails_at_high_resolution_and_fp32_does_not() {
         hidden_by_one_patch(128.0) > 2f32.powi(-10) && hidden_by_one_patch(1024.0) < 2f32.powi(-10),
         "the paper's condition separates the two sizes"
     );
+    // One micro-patch per texel, as the paper (no merging).
     let error = |n: &str, accumulation: &str| {
-        parallel_square_error(&[("occluder_map_size", n), ("accumulation", accumulation), ("ssm_size", "128")])
+        parallel_square_error(&[("occluder_map_size", n), ("accumulation", accumulation), ("ssm_size", "128"), ("merge_tolerance", "0")])
     };
     let (f16_low, f16_high) = (error("128", "f16"), error("1024", "f16"));
     let (f32_low, f32_high) = (error("128", "f32"), error("1024", "f32"));
@@ -100,6 +101,11 @@ fn fp16_accumulation_fails_at_high_resolution_and_fp32_does_not() {
     assert!(f16_high > 10.0 * f16_low, "FP16 at 1024² ({f16_high}) must be far worse than at 128² ({f16_low})");
     assert!(f16_high > 0.1, "{f16_high}");
     assert!(f32_low < 0.03 && f32_high < 0.03, "FP32 stays accurate: {f32_low}, {f32_high}");
+    // Merging the square's equal-depth texels into blocks (the default) draws a few large patches
+    // instead of 1024² tiny ones: each hides far more than 2⁻¹⁰ of the light, so FP16 recovers.
+    let merged = parallel_square_error(&[("occluder_map_size", "1024"), ("accumulation", "f16"), ("ssm_size", "128")]);
+    println!("f16 at 1024² with merged patches: {merged:.4}");
+    assert!(merged < 0.03, "merged patches keep FP16 accurate: {merged}");
 }
 
 /// Sec. 3.5: the two-sided variant adds the farthest back faces as a second layer of micro-patches
@@ -187,4 +193,58 @@ role = "receiver"
     );
     println!("platform: penumbra MAE with receiver_tolerance 2 (default) {default:.4}, 64 {unbounded:.4}");
     assert!(default < 0.5 * unbounded, "{default} vs {unbounded}");
+}
+
+/// Bounding each micro-patch's penumbra rectangle by the deepest receiver under it (a max-pyramid
+/// of the receiver map) instead of the far plane drops only SSM texels the patch hides nothing
+/// at: the same visibility, one- and two-sided, on a floating occluder, an occluder touching its
+/// receiver, foliage, a receiver with objects of role `both`, and an SSM whose side is not a
+/// power of two (the pyramid's odd levels).
+#[test]
+fn bounding_rectangles_by_the_receivers_keeps_every_pixel() {
+    let gpu = gpu();
+    let cases: [(&str, &[(&str, &str)]); 6] = [
+        ("floating-sphere", &[]),
+        ("floating-sphere", &[("two_sided", "true")]),
+        ("contact", &[]),
+        ("leaves", &[("occluder_map_size", "200")]),
+        ("sphere-cube", &[("two_sided", "true"), ("self_shadow_tolerance", "2")]),
+        ("parallel-square", &[("ssm_size", "300"), ("occluder_map_size", "127")]),
+    ];
+    for (scene_name, settings) in cases {
+        let scene = builtin(scene_name).unwrap().build();
+        let with = |bound: &'static str| {
+            let mut all = settings.to_vec();
+            all.push(("penumbra_bound", bound));
+            render(&gpu, &scene, &ssm_atty::INFO, &all, SIZE.0, SIZE.1).unwrap().visibility
+        };
+        let (receivers, far) = (with("receivers"), with("far_plane"));
+        let largest = receivers.iter().zip(&far).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        let shadowed = far.iter().filter(|v| **v < 0.999).count();
+        println!("{scene_name} {settings:?}: largest difference {largest:e}, {shadowed} pixels in shadow or penumbra");
+        assert!(shadowed > 0, "{scene_name}: the case has shadow");
+        assert!(largest <= 1e-4, "{scene_name} {settings:?}: bounded and unbounded differ by {largest}");
+    }
+}
+
+/// Sec. 5.1.2: micro-patches at one depth hide parts of the light that join exactly, so drawing
+/// an aligned block of equal-depth texels as one patch changes nothing: on parallel-square (a
+/// flat occluder parallel to the light) merged and unmerged patches give the same pixels, and on
+/// floating-sphere (depths that change from texel to texel) the default tolerance of 0.01 patch
+/// widths changes them by no more than 0.01.
+#[test]
+fn merging_equal_depth_texels_keeps_the_pixels() {
+    let gpu = gpu();
+    for (scene_name, bound) in [("parallel-square", 1e-4f32), ("floating-sphere", 0.01)] {
+        let scene = builtin(scene_name).unwrap().build();
+        let with = |merge: &'static str| {
+            render(&gpu, &scene, &ssm_atty::INFO, &[("merge_tolerance", merge), ("occluder_map_size", "256")], SIZE.0, SIZE.1)
+                .unwrap()
+                .visibility
+        };
+        let (merged, unmerged) = (with("0.01"), with("0"));
+        let largest = merged.iter().zip(&unmerged).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        println!("{scene_name}: merged and unmerged patches differ by at most {largest:e}");
+        assert!(largest <= bound, "{scene_name}: {largest}");
+    }
 }

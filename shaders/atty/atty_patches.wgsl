@@ -1,0 +1,146 @@
+// Atty et al. 2006, Soft Shadow Maps: the micro-patch list. Each occluder-map texel becomes a
+// micro-patch (Sec. 3.2), merged with its neighbours into one where their depths agree, and its
+// penumbra rectangle on the soft shadow map (Sec. 3.3) is bounded by the deepest receiver under
+// it; the patches that can hide anything are appended to a list that the accumulation draws with
+// one indirect instanced draw, so its vertex work follows the patches drawn, not the map's texels.
+
+// #import common/light_frame.wgsl
+// #import common/shadow_map.wgsl
+// #import atty/atty_settings.wgsl
+
+@group(0) @binding(0) var<uniform> frame: LightFrame;
+@group(1) @binding(0) var occluder_map: texture_2d<f32>;
+@group(1) @binding(1) var<uniform> settings: AttySettings;
+// The receiver map's max-pyramid (atty_receiver_bounds.wgsl).
+@group(1) @binding(2) var receiver_bounds: texture_2d<f32>;
+// The occluder map's min-max pyramid (atty_patch_merge.wgsl).
+@group(1) @binding(3) var patch_merge: texture_2d<f32>;
+@group(1) @binding(4) var<storage, read_write> patches: array<MicroPatchRecord>;
+// The accumulation's indirect draw: (4 vertices, patch count, 0, 0).
+@group(1) @binding(5) var<storage, read_write> draw_arguments: array<atomic<u32>, 4>;
+
+// The deepest receiver among the SSM texels whose centres lie in the rectangle [low, high] (SSM
+// coordinates, [-1, 1]), from the max-pyramid at the finest level where the texels span at most
+// 2×2; 0 when the rectangle holds no texel centre.
+fn deepest_receiver(low: vec2<f32>, high: vec2<f32>) -> f32 {
+    let size = settings.soft_shadow_map_size;
+    let last_texel = vec2<i32>(i32(size) - 1);
+    // Texels t whose centres t + 1/2 lie in the rectangle.
+    let first = max(vec2<i32>(ceil((low * 0.5 + 0.5) * size - 0.5)), vec2<i32>(0));
+    let last = min(vec2<i32>(floor((high * 0.5 + 0.5) * size - 0.5)), last_texel);
+    if (any(last < first)) {
+        return 0.0;
+    }
+    let levels = textureNumLevels(receiver_bounds);
+    var level = 0u;
+    while (level + 1u < levels && any((last >> vec2<u32>(level)) - (first >> vec2<u32>(level)) > vec2<i32>(1))) {
+        level++;
+    }
+    // Texel t of level L covers t·2^L to (t + 1)·2^L − 1, the last one to the map's end.
+    // Mip sizes halve rounding down. (Computed, not asked of textureDimensions(t, level): lavapipe
+    // answered that wrongly for a level not known at compile time, which dropped shadow here.)
+    let level_last = max(vec2<i32>(i32(size) >> level) - 1, vec2<i32>(0));
+    let a = min(first >> vec2<u32>(level), level_last);
+    let b = min(last >> vec2<u32>(level), level_last);
+    let lower = max(textureLoad(receiver_bounds, a, level).x, textureLoad(receiver_bounds, vec2<i32>(b.x, a.y), level).x);
+    let upper = max(textureLoad(receiver_bounds, vec2<i32>(a.x, b.y), level).x, textureLoad(receiver_bounds, b, level).x);
+    return max(lower, upper);
+}
+
+// Neighbouring micro-patches at one depth hide, from any receiver point, parts of the light that
+// join exactly (Sec. 5.1.2: the overlap or gap of Eq. 3 grows with their depth difference δh and
+// vanishes with it), so an aligned block of texels whose depths agree within `merge_tolerance`
+// micro-patch widths is drawn as one patch: the same occlusion for a fraction of the quads.
+// Returns (level, depth) for the block of 2^level texels whose first texel is `texel`, the depth
+// the middle of its range; level -1 when `texel` is not the first of its block.
+fn merged_block(texel: vec2<u32>, depth: f32) -> vec2<f32> {
+    var level = 0u;
+    var patch_depth = depth;
+    if (settings.merge_tolerance <= 0.0) {
+        return vec2<f32>(0.0, depth);
+    }
+    let levels = textureNumLevels(patch_merge);
+    let tan_half = max(frame.projection.x, frame.projection.y);
+    loop {
+        if (level + 1u >= levels) {
+            break;
+        }
+        let block = texel >> vec2<u32>(level + 1u);
+        // The level's size, halving rounding down (not textureDimensions(t, level): see deepest_receiver).
+        if (any(block >= vec2<u32>(u32(settings.occluder_map_size) >> (level + 1u)))) {
+            break;
+        }
+        let range = textureLoad(patch_merge, vec2<i32>(block), i32(level + 1u)).xy;
+        let width = 2.0 * range.x * tan_half / settings.occluder_map_size;
+        if (range.y >= NO_SURFACE || range.y - range.x > settings.merge_tolerance * width) {
+            break;
+        }
+        level++;
+        patch_depth = 0.5 * (range.x + range.y);
+    }
+    if (any((texel & vec2<u32>((1u << level) - 1u)) != vec2<u32>(0u))) {
+        return vec2<f32>(-1.0, 0.0);
+    }
+    return vec2<f32>(f32(level), patch_depth);
+}
+
+// One invocation per occluder-map texel: its micro-patch (or its block's, Sec. 3.2), appended to
+// the patch list with its penumbra rectangle (Sec. 3.3) unless an empty texel, another texel of
+// its block, or no receiver behind it means it hides nothing.
+@compute @workgroup_size(8, 8, 1)
+fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = u32(settings.occluder_map_size);
+    if (any(id.xy >= vec2<u32>(n))) {
+        return;
+    }
+    let texel = id.xy;
+    let depth = textureLoad(occluder_map, vec2<i32>(texel), 0).x;
+    if (depth >= NO_SURFACE || depth <= 0.0) {
+        return;
+    }
+    let tan_half = frame.projection.xy;
+    // The aligned block of 2^level texels starting at this one that is drawn as one micro-patch.
+    let merged = merged_block(texel, depth);
+    if (merged.x < 0.0) {
+        // Another texel of its block draws it.
+        return;
+    }
+    let span = exp2(merged.x);
+    let patch_depth = merged.y;
+    // Sec. 3.2: the texel (or block) as a micro-patch parallel to the light, at its depth, covering its image area.
+    let texel_ndc = (vec2<f32>(texel) + 0.5 * span) / settings.occluder_map_size * 2.0 - 1.0;
+    let half_size = patch_depth * tan_half * span / settings.occluder_map_size;
+    let self_shadow_depth = settings.self_shadow_tolerance * 2.0 * max(half_size.x, half_size.y) / span;
+    let light_half = vec2<f32>(frame.u_axis.w, frame.v_axis.w);
+    // Sec. 3.3: the penumbra extent is the pyramid of apex O, C_L O = r/(1+r) C_L C_P with
+    // r = LL'/PP' = l/p per axis, at depth z_apex = r/(1+r) z_O. On the plane at depth z_R it is
+    // the rectangle of centre C_L C_R = (z_R/z_apex) C_L O = (z_R/z_O) C_P and half-width
+    // l (z_R - z_apex)/z_apex = (l + p) z_R/z_O - l: the same formulas written without dividing
+    // by r, so that a point light (r = 0, apex at the light) needs no special case.
+    // Projected into the SSM from the light's centre (divide by z_R tan), the centre is the
+    // texel's own and the half extent is (l + p)/(z_O tan) - l/(z_R tan), growing with z_R:
+    // evaluated at the far plane, the rectangle covers every receiver (conservative).
+    // As reach - shrink / z_R per axis.
+    let reach = (light_half + half_size) / (patch_depth * tan_half);
+    let shrink = light_half / tan_half;
+    var bound = frame.projection.w;
+    if (settings.receiver_bounded != 0.0) {
+        // Bounded by the deepest receiver under the rectangle instead: the rectangle at the far
+        // plane holds every texel the patch can shade; the deepest receiver among them, z₁, gives
+        // a smaller rectangle that still holds them (each receiver's own rectangle lies within the
+        // one at any depth behind it), and the deepest receiver in that, z₂, a smaller one again.
+        // The texels dropped are those whose receiver is not behind the patch: the same pixels.
+        for (var refinement = 0; refinement < 2; refinement++) {
+            let half_extent = reach - shrink / bound;
+            let deepest = deepest_receiver(texel_ndc - half_extent, texel_ndc + half_extent);
+            // No receiver behind the patch under its rectangle: it hides nothing anywhere.
+            if (deepest <= patch_depth + self_shadow_depth) {
+                return;
+            }
+            bound = min(bound, deepest);
+        }
+    }
+    let half_ndc = reach - shrink / bound;
+    let slot = atomicAdd(&draw_arguments[1], 1u);
+    patches[slot] = MicroPatchRecord(texel_ndc, half_ndc, patch_depth, self_shadow_depth, span, 0.0);
+}
