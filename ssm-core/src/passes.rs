@@ -127,6 +127,22 @@ pub fn compute_pipeline(
     })
 }
 
+/// A bind-group-layout entry for a write-only `texture_storage_2d<format, write>` in fragment
+/// and compute stages (a pass's own target written by `textureStore`).
+#[must_use]
+pub const fn write_storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 /// A bind-group-layout entry for the visibility target as a read-write
 /// `texture_storage_2d<r32float, read_write>` in compute shaders.
 #[must_use]

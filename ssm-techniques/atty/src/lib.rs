@@ -21,7 +21,7 @@
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
     bind_group, bind_group_layout, color_attachment, compute_pipeline, labelled_view, render_texture, storage_entry, texture_entry,
-    uniform_buffer, uniform_entry,
+    uniform_buffer, uniform_entry, write_storage_texture_entry,
 };
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
@@ -210,23 +210,8 @@ impl DepthPyramid {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
             view_formats: &[],
         });
-        let layout = bind_group_layout(
-            device,
-            &format!("{}_layout", kind.label),
-            &[
-                texture_entry(0),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: kind.format,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        );
+        let layout =
+            bind_group_layout(device, &format!("{}_layout", kind.label), &[texture_entry(0), write_storage_texture_entry(1, kind.format)]);
         let views: Vec<wgpu::TextureView> = (0..level_count)
             .map(|level| {
                 texture.create_view(&wgpu::TextureViewDescriptor {

@@ -25,7 +25,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec2};
 use ssm_core::passes::{
     bind_group, bind_group_layout, compute_pipeline, readback_buffer, storage_buffer, storage_entry, texture_entry, uniform_buffer,
-    uniform_entry, visibility_storage_entry,
+    uniform_entry, visibility_storage_entry, write_storage_texture_entry,
 };
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
@@ -732,19 +732,7 @@ impl Layouts {
             mip: bind_group_layout(
                 device,
                 "pvsm_low_res_mip_layout",
-                &[
-                    texture_entry(0),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 1,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::StorageTexture {
-                            access: wgpu::StorageTextureAccess::WriteOnly,
-                            format: LightDepthMap::FORMAT,
-                            view_dimension: wgpu::TextureViewDimension::D2,
-                        },
-                        count: None,
-                    },
-                ],
+                &[texture_entry(0), write_storage_texture_entry(1, LightDepthMap::FORMAT)],
             ),
             kernel: bind_group_layout(
                 device,

@@ -13,6 +13,7 @@
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
     bind_group, bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+    write_storage_texture_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
@@ -242,20 +243,6 @@ impl Targets {
     }
 }
 
-/// A write-only storage texture entry of `format`, for the fragment and compute stages.
-const fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-        count: None,
-    }
-}
-
 impl SeparableSoftShadowMaps {
     /// Builds the depth map, the intermediate targets and the three passes.
     ///
@@ -271,7 +258,7 @@ impl SeparableSoftShadowMaps {
         let shared =
             Shared { setup, settings: &settings_buffer, depth_map: &depth_map, read_counts: read_counts.buffer(), targets: &targets };
         let horizontal_blocker_layout =
-            shared.layout("sssm_horizontal_blocker_layout", &[storage_texture_entry(4, wgpu::TextureFormat::Rgba32Float)]);
+            shared.layout("sssm_horizontal_blocker_layout", &[write_storage_texture_entry(4, wgpu::TextureFormat::Rgba32Float)]);
         let horizontal_blocker_group = shared.group(
             "sssm_horizontal_blocker_bind_group",
             &horizontal_blocker_layout,
@@ -362,7 +349,7 @@ impl Shared<'_> {
     }
 
     fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
-        [texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::R32Float), texture_entry(7)]
+        [texture_entry(4), texture_entry(5), write_storage_texture_entry(6, wgpu::TextureFormat::R32Float), texture_entry(7)]
     }
 
     fn fragment_steps(&self) -> Result<BlurSteps> {
@@ -397,10 +384,10 @@ impl Shared<'_> {
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let blocker_blur_layout = self.layout(
             "sssm_blocker_blur_rows_layout",
-            &[texture_entry(4), texture_entry(5), storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float)],
+            &[texture_entry(4), texture_entry(5), write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float)],
         );
         let mut vertical_entries = Self::vertical_entries().to_vec();
-        vertical_entries.push(storage_texture_entry(8, VISIBILITY_FORMAT));
+        vertical_entries.push(write_storage_texture_entry(8, VISIBILITY_FORMAT));
         let vertical_blur_layout = self.layout("sssm_vertical_blur_columns_layout", &vertical_entries);
         let blocker_blur_group = self.group(
             "sssm_blocker_blur_rows_bind_group",
