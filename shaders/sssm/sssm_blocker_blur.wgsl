@@ -17,7 +17,7 @@
 fn load_horizontal_source(texel: vec2<i32>) -> BlurSource {
     let packed = textureLoad(blur_source, texel, 0);
     reads += 1u;
-    return unpack_blur_source(packed.x, packed);
+    return unpack_blur_source(packed_hard_value(packed), packed);
 }
 
 // The blocker search of a computed pixel, its penumbra and its blur widths: (the hard or lit
@@ -118,7 +118,7 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
             let source = horizontal_source(vec2<i32>(tap));
             value = source.value;
             if (settings.bilateral_depth > 0.0) {
-                weight *= bilateral_weight_of(source, tangent_plane_point(rays, point.position, point.normal, tap), point.normal);
+                weight *= bilateral_weight_of(source, tangent_plane_distance(rays, point.position, point.normal, tap), point.normal);
             }
         } else {
             // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.

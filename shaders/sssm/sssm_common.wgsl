@@ -100,6 +100,19 @@ fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pi
     return vec4<f32>(eye + direction * t, select(0.0, 1.0, t > 0.0));
 }
 
+// Distance from the eye to where the camera ray through pixel position `pixel` meets the plane
+// through `point` with normal `normal` (tangent_plane_point's point, as |t|·|ray|); -1 where the
+// ray runs along the plane or meets it behind the eye.
+fn tangent_plane_distance(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
+    let direction = rays.base + pixel.x * rays.per_x + pixel.y * rays.per_y;
+    let denominator = dot(direction, normal);
+    if (abs(denominator) < 1e-12) {
+        return -1.0;
+    }
+    let t = dot(point - camera.position.xyz, normal) / denominator;
+    return select(-1.0, t * length(direction), t > 0.0);
+}
+
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
 fn hard_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
     return tap_visibility(world, lookup_offset(world, normal));
@@ -223,52 +236,46 @@ struct BlurSource {
     normal: vec3<f32>,
 };
 
-// Octahedral encoding of a unit vector in two floats (Meyer et al. 2010): the octahedron's upper
-// half unfolded onto the square, the lower half folded over its corners.
-fn octahedral_encode(unit: vec3<f32>) -> vec2<f32> {
-    let folded = unit.xy / (abs(unit.x) + abs(unit.y) + abs(unit.z));
-    let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), folded >= vec2<f32>(0.0));
-    return select(folded, (1.0 - abs(folded.yx)) * signs, unit.z < 0.0);
-}
-
-fn octahedral_decode(encoded: vec2<f32>) -> vec3<f32> {
-    let z = 1.0 - abs(encoded.x) - abs(encoded.y);
-    let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), encoded >= vec2<f32>(0.0));
-    let xy = select(encoded, (1.0 - abs(encoded.yx)) * signs, z < 0.0);
-    return normalize(vec3<f32>(xy, z));
-}
-
-// What step 1 writes per pixel for the blurs (the `blur_source` target): (hard visibility, distance
-// from the eye or -1 where nothing covers the pixel, octahedral normal), so that a blur tap reads
-// one texel instead of the hard value's and the G-buffer's two.
+// What step 1 writes per pixel for the blurs (the `blur_source` target), so that a blur tap
+// reads one texel instead of the hard value's and the G-buffer's two: the unit normal in xyz, and
+// in w the distance from the eye, negated where the hard shadow test failed (the hard value is 0
+// or 1, and a covered pixel lies beyond the near plane, so the distance is never 0); w = 0 where
+// nothing covers the pixel.
 fn packed_blur_source(hard: f32, point: ScreenPoint) -> vec4<f32> {
     if (!point.covered) {
-        return vec4<f32>(hard, -1.0, 0.0, 0.0);
+        return vec4<f32>(0.0);
     }
-    return vec4<f32>(hard, distance(point.position, camera.position.xyz), octahedral_encode(point.normal));
+    let eye_distance = distance(point.position, camera.position.xyz);
+    return vec4<f32>(point.normal, select(-eye_distance, eye_distance, hard >= 0.5));
+}
+
+// The hard value of a `blur_source` texel (1 where nothing covers the pixel).
+fn packed_hard_value(packed: vec4<f32>) -> f32 {
+    return select(1.0, 0.0, packed.w < 0.0);
 }
 
 // The BlurSource of a `blur_source` texel, blurring `value`.
 fn unpack_blur_source(value: f32, packed: vec4<f32>) -> BlurSource {
-    if (packed.y < 0.0) {
+    if (packed.w == 0.0) {
         return BlurSource(value, -1.0, vec3<f32>(0.0));
     }
-    return BlurSource(value, packed.y, octahedral_decode(packed.zw));
+    return BlurSource(value, abs(packed.w), packed.xyz);
 }
 
-// Bilateral weight of a blur tap landing on `source`, for the pixel seen at `point` with normal
-// `normal`, where `expected` is the point of that pixel's tangent plane along the tap pixel's ray:
-// how much the surface seen there looks like this pixel's tangent plane, by the difference of
-// camera distances (the distance of the vertical pass's β test) and of normals. Taps on another
-// object across a silhouette get no weight, so shadow does not leak over edges.
-fn bilateral_weight_of(source: BlurSource, expected: vec4<f32>, normal: vec3<f32>) -> f32 {
+// Bilateral weight of a blur tap landing on `source`, for the pixel seen with normal `normal`,
+// where `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
+// pixel's ray (tangent_plane_distance): how much the surface seen there looks like this pixel's
+// tangent plane, by the difference of camera distances (the distance of the vertical pass's β
+// test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
+// not leak over edges.
+fn bilateral_weight_of(source: BlurSource, expected_distance: f32, normal: vec3<f32>) -> f32 {
     if (settings.bilateral_depth <= 0.0) {
         return 1.0;
     }
-    if (source.eye_distance < 0.0 || expected.w == 0.0) {
+    if (source.eye_distance < 0.0 || expected_distance < 0.0) {
         return 0.0;
     }
-    let gap = (source.eye_distance - distance(expected.xyz, camera.position.xyz)) / scene_length(frame, settings.bilateral_depth);
+    let gap = (source.eye_distance - expected_distance) / scene_length(frame, settings.bilateral_depth);
     let turn = max(dot(normal, source.normal), 0.0);
     // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
     // falls to 1/2 at about 23°.
@@ -277,10 +284,10 @@ fn bilateral_weight_of(source: BlurSource, expected: vec4<f32>, normal: vec3<f32
     return exp(-gap * gap) * turn_4 * turn_4;
 }
 
-// Whether the tap pixel seen as `source` lies within β of the tangent-plane point `expected`
-// along its ray (the vertical pass's reuse test, Sec. 4.2: "the distance is modified taking into
-// account the normal").
-fn within_beta(source: BlurSource, expected: vec4<f32>) -> bool {
-    return source.eye_distance >= 0.0 && expected.w > 0.0
-        && abs(source.eye_distance - distance(expected.xyz, camera.position.xyz)) < scene_length(frame, settings.beta);
+// Whether the tap pixel seen as `source` lies within β of this pixel's tangent plane along its ray
+// (`expected_distance` from the eye; the vertical pass's reuse test, Sec. 4.2: "the distance is
+// modified taking into account the normal").
+fn within_beta(source: BlurSource, expected_distance: f32) -> bool {
+    return source.eye_distance >= 0.0 && expected_distance >= 0.0
+        && abs(source.eye_distance - expected_distance) < scene_length(frame, settings.beta);
 }

@@ -53,7 +53,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         var reuse = false;
         if (on_screen(row)) {
             let source = vertical_source(vec2<i32>(row));
-            let expected = tangent_plane_point(rays, point.position, point.normal, row);
+            let expected = tangent_plane_distance(rays, point.position, point.normal, row);
             if (within_beta(source, expected)) {
                 let weight = tap_weight(j) * bilateral_weight_of(source, expected, point.normal);
                 blurred += weight * source.value;
