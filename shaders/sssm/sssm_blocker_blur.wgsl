@@ -9,7 +9,6 @@
 // #import sssm/sssm_common.wgsl
 
 @group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
-
 @group(2) @binding(5) var blur_source: texture_2d<f32>;
 
 // A blur tap's pixel read from step 1's blur_source: its hard visibility, and what the bilateral
@@ -102,7 +101,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
 }
 
 // The horizontal blur over m taps of the pixel at `centre` (pixel position of its centre) after
-// its blocker search `searched` (blur_search's result with blur = true); each tap's pixel comes
+// its blocker search `searched` (blocker_search's result with blur = true); each tap's pixel comes
 // from `horizontal_source`.
 fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
     let radii = searched.yz;

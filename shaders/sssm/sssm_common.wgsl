@@ -9,26 +9,21 @@ struct SssmSettings {
     // Samples per axis of the blocker search (n) and of the blur (m).
     blocker_kernel: u32,
     blur_kernel: u32,
-    // Unused (the blur's weights are in blur_weights).
-    _pad0: u32,
     // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
     receiver_plane: u32,
+    // 1: count each computed pixel's texture reads into read_counts (profiling; atomics cost time).
+    count_reads: u32,
     // Reuse thresholds as fractions of the scene's diagonal (scene_length): light-depth
     // difference (α) and normal-adjusted camera-depth difference (β).
     alpha: f32,
     beta: f32,
-    // Standard deviation of the Gaussian, in units of the kernel's half-width.
-    sigma: f32,
     // Normal offset of shadow-map lookups, texels.
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    // 1: count each computed pixel's texture reads into read_counts (profiling; atomics cost time).
-    count_reads: u32,
-    _pad1: f32,
-    _pad2: f32,
-    // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian, or 1 for
-    // the mean filter), computed once on the CPU instead of an exponential per tap.
+    // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
+    // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
+    // exponential per tap.
     blur_weights: array<vec4<f32>, 32>,
 };
 
@@ -232,7 +227,7 @@ struct BlurSource {
     value: f32,
     // Distance from the eye to the surface seen there; -1 where nothing covers the pixel.
     eye_distance: f32,
-    // Its unit normal (zero where nothing covers the pixel or the weight does not need it).
+    // Its unit normal (zero where nothing covers the pixel).
     normal: vec3<f32>,
 };
 

@@ -116,16 +116,12 @@ pub struct SssmSettings {
 pub struct SssmSettingsUniform {
     blocker_kernel: u32,
     blur_kernel: u32,
-    _pad0: u32,
     receiver_plane: u32,
+    count_reads: u32,
     alpha: f32,
     beta: f32,
-    sigma: f32,
     normal_offset: f32,
     bilateral_depth: f32,
-    count_reads: u32,
-    _pad1: f32,
-    _pad2: f32,
     blur_weights: [[f32; 4]; 32],
 }
 
@@ -153,16 +149,12 @@ impl From<&SssmSettings> for SssmSettingsUniform {
         Self {
             blocker_kernel: settings.blocker_kernel,
             blur_kernel: settings.blur_kernel,
-            _pad0: 0,
             receiver_plane: u32::from(settings.receiver.receiver_plane),
+            count_reads: u32::from(settings.count_reads),
             alpha: settings.alpha,
             beta: settings.beta,
-            sigma: settings.sigma,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
-            count_reads: u32::from(settings.count_reads),
-            _pad1: 0.0,
-            _pad2: 0.0,
             blur_weights: blur_weights(settings),
         }
     }
@@ -208,7 +200,7 @@ const COUNTED_PASSES: &[&str] = &["sssm_horizontal_blocker", "sssm_blocker_and_h
 /// The intermediate targets between the three passes.
 struct Targets {
     horizontal_blocker: wgpu::TextureView,
-    /// Step 1's packed (hard value, eye distance, octahedral normal) per pixel, read by the blur taps.
+    /// Step 1's packed blur source per pixel (normal, eye distance signed by the hard value), read by the blur taps.
     blur_source: wgpu::TextureView,
     horizontal_blur: wgpu::TextureView,
     reuse: wgpu::Texture,
@@ -418,7 +410,8 @@ impl Shared<'_> {
             "sssm_vertical_blur_columns",
             &[&setup.scene.uniform_layout, &gbuffer.layout, &vertical_blur_layout],
         );
-        if let Some(messages) = Some(setup.gpu.take_errors()).filter(|m| !m.is_empty()) {
+        let messages = setup.gpu.take_errors();
+        if !messages.is_empty() {
             return Err(ssm_core::Error::Gpu { during: "building SSSM's shared-row compute passes".into(), messages });
         }
         Ok(BlurSteps::SharedRows {
