@@ -82,30 +82,30 @@ fn camera_rays() -> CameraRays {
     return CameraRays(origin, at_x - origin, at_y - origin);
 }
 
+// The camera ray through pixel position `pixel` (xyz, unnormalised) and the parameter t (w) at
+// which it meets the plane through `point` with normal `normal`; t = -1 where the ray runs along
+// the plane or meets it behind the eye.
+fn tangent_plane_hit(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> vec4<f32> {
+    let direction = rays.base + pixel.x * rays.per_x + pixel.y * rays.per_y;
+    let denominator = dot(direction, normal);
+    if (abs(denominator) < 1e-12) {
+        return vec4<f32>(direction, -1.0);
+    }
+    let t = dot(point - camera.position.xyz, normal) / denominator;
+    return vec4<f32>(direction, select(-1.0, t, t > 0.0));
+}
+
 // Where the camera ray through pixel position `pixel` meets the plane through `point` with
 // normal `normal`; w = 0 when the ray runs along the plane or meets it behind the eye.
 fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> vec4<f32> {
-    let direction = rays.base + pixel.x * rays.per_x + pixel.y * rays.per_y;
-    let denominator = dot(direction, normal);
-    if (abs(denominator) < 1e-12) {
-        return vec4<f32>(point, 0.0);
-    }
-    let eye = camera.position.xyz;
-    let t = dot(point - eye, normal) / denominator;
-    return vec4<f32>(eye + direction * t, select(0.0, 1.0, t > 0.0));
+    let hit = tangent_plane_hit(rays, point, normal, pixel);
+    return vec4<f32>(camera.position.xyz + hit.xyz * max(hit.w, 0.0), select(0.0, 1.0, hit.w > 0.0));
 }
 
-// Distance from the eye to where the camera ray through pixel position `pixel` meets the plane
-// through `point` with normal `normal` (tangent_plane_point's point, as |t|·|ray|); -1 where the
-// ray runs along the plane or meets it behind the eye.
+// Distance from the eye to that point, |t|·|ray|; -1 where there is none.
 fn tangent_plane_distance(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
-    let direction = rays.base + pixel.x * rays.per_x + pixel.y * rays.per_y;
-    let denominator = dot(direction, normal);
-    if (abs(denominator) < 1e-12) {
-        return -1.0;
-    }
-    let t = dot(point - camera.position.xyz, normal) / denominator;
-    return select(-1.0, t * length(direction), t > 0.0);
+    let hit = tangent_plane_hit(rays, point, normal, pixel);
+    return select(-1.0, hit.w * length(hit.xyz), hit.w > 0.0);
 }
 
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
