@@ -9,11 +9,9 @@
 
 // #import sssm/sssm_common.wgsl
 
-@group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
-@group(2) @binding(5) var horizontal_blur: texture_2d<f32>;
-@group(2) @binding(6) var reuse_share: texture_storage_2d<r32float, write>;
-
-@group(2) @binding(7) var blur_source: texture_2d<f32>;
+@group(2) @binding(4) var horizontal_blur: texture_2d<f32>;
+@group(2) @binding(5) var reuse_share: texture_storage_2d<r32float, write>;
+@group(2) @binding(6) var blur_source: texture_2d<f32>;
 
 // A blur tap's pixel read from the textures: step 2's horizontal result, and from step 1's
 // blur_source what the β test and the bilateral weight compare.
@@ -40,7 +38,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     }
     let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
-    let own_hard = textureLoad(horizontal_blocker, point.texel, 0).w;
+    let own_hard = packed_hard_value(textureLoad(blur_source, point.texel, 0));
     reads += 1u;
     let offset = lookup_offset(point.position, point.normal);
     var blurred = 0.0;

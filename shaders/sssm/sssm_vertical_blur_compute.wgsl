@@ -7,7 +7,7 @@
 // #import sssm/sssm_vertical_blur.wgsl
 // #import sssm/sssm_segment.wgsl
 
-@group(2) @binding(8) var visibility_target: texture_storage_2d<r32float, write>;
+@group(2) @binding(7) var visibility_target: texture_storage_2d<r32float, write>;
 
 fn vertical_source(texel: vec2<i32>) -> BlurSource {
     let index = segment_index(texel.y);

@@ -329,19 +329,18 @@ impl Shared<'_> {
         ]
     }
 
-    /// Step 3's inputs (bindings 4 to 7): step 1's and step 2's targets, the reuse share it
-    /// writes, and step 1's blur sources.
-    fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 4] {
+    /// Step 3's inputs (bindings 4 to 6): step 2's target, the reuse share it writes, and step 1's
+    /// blur sources (which also hold each pixel's own hard value).
+    fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 3] {
         [
-            wgpu::BindingResource::TextureView(&self.targets.horizontal_blocker),
             wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
             wgpu::BindingResource::TextureView(&self.targets.reuse_view),
             wgpu::BindingResource::TextureView(&self.targets.blur_source),
         ]
     }
 
-    fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
-        [texture_entry(4), texture_entry(5), write_storage_texture_entry(6, wgpu::TextureFormat::R32Float), texture_entry(7)]
+    fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
+        [texture_entry(4), write_storage_texture_entry(5, wgpu::TextureFormat::R32Float), texture_entry(6)]
     }
 
     fn fragment_steps(&self) -> Result<BlurSteps> {
@@ -379,7 +378,7 @@ impl Shared<'_> {
             &[texture_entry(4), texture_entry(5), write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float)],
         );
         let mut vertical_entries = Self::vertical_entries().to_vec();
-        vertical_entries.push(write_storage_texture_entry(8, VISIBILITY_FORMAT));
+        vertical_entries.push(write_storage_texture_entry(7, VISIBILITY_FORMAT));
         let vertical_blur_layout = self.layout("sssm_vertical_blur_columns_layout", &vertical_entries);
         let blocker_blur_group = self.group(
             "sssm_blocker_blur_rows_bind_group",
