@@ -37,8 +37,9 @@ fn deepest_receiver(low: vec2<f32>, high: vec2<f32>) -> f32 {
         level++;
     }
     // Texel t of level L covers t·2^L to (t + 1)·2^L − 1, the last one to the map's end.
-    // Mip sizes halve rounding down. (Computed, not asked of textureDimensions(t, level): lavapipe
-    // answered that wrongly for a level not known at compile time, which dropped shadow here.)
+    // Mip sizes halve rounding down. (Computed, not asked of textureDimensions(t, level): on
+    // lavapipe that gave wrong sizes for a level not known at compile time, which dropped shadow
+    // here; not traced further, to naga's SPIR-V or to the driver.)
     let level_last = max(vec2<i32>(i32(size) >> level) - 1, vec2<i32>(0));
     let a = min(first >> vec2<u32>(level), level_last);
     let b = min(last >> vec2<u32>(level), level_last);
@@ -54,11 +55,11 @@ fn deepest_receiver(low: vec2<f32>, high: vec2<f32>) -> f32 {
 // Returns (level, depth) for the block of 2^level texels whose first texel is `texel`, the depth
 // the middle of its range; level -1 when `texel` is not the first of its block.
 fn merged_block(texel: vec2<u32>, depth: f32) -> vec2<f32> {
-    var level = 0u;
-    var patch_depth = depth;
     if (settings.merge_tolerance <= 0.0) {
         return vec2<f32>(0.0, depth);
     }
+    var level = 0u;
+    var patch_depth = depth;
     let levels = textureNumLevels(patch_merge);
     let tan_half = max(frame.projection.x, frame.projection.y);
     loop {

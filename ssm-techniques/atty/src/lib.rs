@@ -156,6 +156,8 @@ struct SideAccumulation {
     draw_arguments: wgpu::Buffer,
     /// The list pass's bind group (occluder map, settings, pyramids, patch list, draw arguments).
     patches_group: wgpu::BindGroup,
+    /// The list pass's name, `<label>_patches`.
+    patches_label: String,
     /// The occluder map's depth range per block, when micro-patches merge.
     patch_merge: Option<DepthPyramid>,
     soft_shadow_map: wgpu::TextureView,
@@ -404,6 +406,7 @@ impl SoftShadowMaps {
                     occluder_map,
                     draw_arguments,
                     patches_group,
+                    patches_label: format!("{pass_label}_patches"),
                     patch_merge: merging.then_some(patch_merge),
                     soft_shadow_map: labelled_view(&texture, &texture_label),
                     bind_group,
@@ -561,7 +564,7 @@ impl ShadowTechnique for SoftShadowMaps {
             // The patch count back to 0 (bytes 4 to 8; the 4 vertices stay).
             frame.clear_buffer("atty_patch_count_reset", &accumulation.draw_arguments, 4, Some(4));
             {
-                let mut pass = frame.compute_pass(&format!("{}_patches", accumulation.label));
+                let mut pass = frame.compute_pass(&accumulation.patches_label);
                 pass.set_pipeline(&self.patches_pipeline);
                 pass.set_bind_group(0, light_frame, &[]);
                 pass.set_bind_group(1, &accumulation.patches_group, &[]);
