@@ -58,20 +58,43 @@ fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
     return light_depth(frame, world) > 0.0;
 }
 
+// The receiver's tangent plane as seen from the light, prepared once per receiver point so that
+// each tap costs one multiply-add and a division: along the ray from the light's centre through
+// shadow-map coordinates `uv`, the plane's linear depth is numerator / (c.x + c.y u + c.z v)
+// (the ray's direction, scaled to a unit component along the light's normal, is affine in uv).
+struct TapPlane {
+    coefficients: vec3<f32>,
+    numerator: f32,
+    // The depth returned where the ray misses the plane or runs along it.
+    fallback: f32,
+}
+
+// The tangent plane through `point` with normal `normal`; `fallback` where a ray misses it.
+fn tap_plane(frame: LightFrame, point: vec3<f32>, normal: vec3<f32>, fallback: f32) -> TapPlane {
+    // direction(uv) = N + (2u - 1) p_x U + (2v - 1) p_y V.
+    let along_u = frame.projection.x * dot(frame.u_axis.xyz, normal);
+    let along_v = frame.projection.y * dot(frame.v_axis.xyz, normal);
+    let constant = dot(frame.normal.xyz, normal) - along_u - along_v;
+    return TapPlane(vec3<f32>(constant, 2.0 * along_u, 2.0 * along_v), dot(point - frame.centre.xyz, normal), fallback);
+}
+
+// A plane that every tap sees at `depth` (the receiver's own depth for every tap, Fernando 2005).
+fn constant_tap_plane(depth: f32) -> TapPlane {
+    return TapPlane(vec3<f32>(1.0, 0.0, 0.0), depth, depth);
+}
+
+// The plane's linear depth along the ray through `uv`; its fallback where the ray misses it.
+fn tap_plane_depth(plane: TapPlane, uv: vec2<f32>) -> f32 {
+    let denominator = plane.coefficients.x + plane.coefficients.y * uv.x + plane.coefficients.z * uv.y;
+    let depth = plane.numerator / denominator;
+    return select(depth, plane.fallback, abs(denominator) < 1e-6 || !(depth > 0.0));
+}
+
 // Linear depth, along the ray from the light's centre through shadow-map
 // coordinates `uv`, of the plane through `point` with normal `normal`: the
 // receiver's own tangent plane seen at another texel (an exact, perspective
 // form of the receiver-plane depth bias of Isidoro 2006). Returns
 // `fallback` where the ray misses the plane or runs along it.
 fn receiver_plane_depth(frame: LightFrame, point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, fallback: f32) -> f32 {
-    let ndc = uv * 2.0 - vec2<f32>(1.0);
-    // The ray's direction scaled so that its component along the light's normal is 1: its parameter is the linear depth.
-    let direction = frame.normal.xyz + ndc.x * frame.projection.x * frame.u_axis.xyz + ndc.y * frame.projection.y * frame.v_axis.xyz;
-    let denominator = dot(direction, normal);
-    let numerator = dot(point - frame.centre.xyz, normal);
-    let depth = numerator / denominator;
-    if (abs(denominator) < 1e-6 || depth <= 0.0) {
-        return fallback;
-    }
-    return depth;
+    return tap_plane_depth(tap_plane(frame, point, normal, fallback), uv);
 }

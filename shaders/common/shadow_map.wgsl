@@ -46,3 +46,12 @@ fn tap_receiver_depth(frame: LightFrame, position: vec3<f32>, normal: vec3<f32>,
     }
     return receiver_plane_depth(frame, position, normal, uv, receiver_depth);
 }
+
+// What tap_receiver_depth compares each tap with, prepared once per receiver point: read it at a
+// tap's uv with tap_plane_depth.
+fn receiver_tap_plane(frame: LightFrame, position: vec3<f32>, normal: vec3<f32>, receiver_depth: f32, plane: bool) -> TapPlane {
+    if (!plane) {
+        return constant_tap_plane(receiver_depth);
+    }
+    return tap_plane(frame, position, normal, receiver_depth);
+}

@@ -45,11 +45,6 @@ struct PcssSettings {
 // Texture reads of this invocation: the G-buffer's two and every shadow-map tap.
 var<private> reads: u32;
 
-// The depth a tap at `uv` is compared with (common/shadow_map.wgsl).
-fn compared_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
-    return tap_receiver_depth(frame, position, normal, uv, receiver_depth, settings.receiver_plane != 0u);
-}
-
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
@@ -73,6 +68,8 @@ fn soft_visibility(point: ScreenPoint) -> f32 {
     let lookup = normal_offset_position(frame, shadow_map, point.position, normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let receiver_depth = uvd.z;
+    // What each tap is compared with (the settings' receiver model; common/shadow_map.wgsl), prepared once.
+    let receiver = receiver_tap_plane(frame, lookup, normal, receiver_depth, settings.receiver_plane != 0u);
 
     // 1. Blocker search over the light's back-projection through the near plane.
     let search = light_half_extent_uv(frame, frame.projection.z, receiver_depth);
@@ -84,7 +81,7 @@ fn soft_visibility(point: ScreenPoint) -> f32 {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
             let depth = shadow_map_depth(shadow_map, uv);
             reads += 1u;
-            if (depth < compared_depth(lookup, normal, uv, receiver_depth)) {
+            if (depth < tap_plane_depth(receiver, uv)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
             }
@@ -102,7 +99,7 @@ fn soft_visibility(point: ScreenPoint) -> f32 {
     for (var j = 0u; j < m; j++) {
         for (var i = 0u; i < m; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
-            lit += select(0.0, 1.0, compared_depth(lookup, normal, uv, receiver_depth) <= shadow_map_depth(shadow_map, uv));
+            lit += select(0.0, 1.0, tap_plane_depth(receiver, uv) <= shadow_map_depth(shadow_map, uv));
             reads += 1u;
         }
     }

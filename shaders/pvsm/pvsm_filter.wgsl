@@ -51,6 +51,8 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
     let stride = select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u);
     let step = max(max(vec2<f32>(1.0), stride), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
     let slope = select(0.0, uy / ux, ux > 1e-6);
+    // What each texel is compared with (the settings' receiver model), prepared once.
+    let receiver = receiver_tap_plane(frame, position, normal, depth, settings.receiver_plane != 0u);
     var visible = 0.0;
     var covered = 0.0;
     var column = floor(x_low / step.x) * step.x;
@@ -82,7 +84,7 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
                 if (height > 0.0) {
                     let z = textureLoad(tile_map, vec2<i32>(min(texel, tile.size - vec2<f32>(0.5))), 0).x;
                     let uv = tile.uv_min + texel / scale;
-                    let compared = tap_receiver_depth(frame, position, normal, uv, depth, settings.receiver_plane != 0u);
+                    let compared = tap_plane_depth(receiver, uv);
                     let area = select(width, step.x, settings.point_samples != 0u) * height;
                     // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2); the
                     // tile map's depths carry the depth bias already.

@@ -19,11 +19,6 @@
 // [pixels with a filter, fully lit pixels]
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, 2>;
 
-// The depth shadow-map taps at `uv` are compared with, for the pixel's point (settings' receiver model).
-fn compared_depth(point: ScreenPoint, uv: vec2<f32>, d: f32) -> f32 {
-    return tap_receiver_depth(frame, point.position, point.normal, uv, d, settings.receiver_plane != 0u);
-}
-
 // How much the pixel's tangent plane's depth changes over `half_texel` (shadow-map coordinates)
 // along both axes: the receiver's own depth spread within a texel of that size.
 fn plane_change(point: ScreenPoint, uv: vec2<f32>, d: f32, half_texel: vec2<f32>) -> f32 {
@@ -101,6 +96,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     let bias = scene_length(frame, settings.constant_bias) + texel;
     let coarse_tolerance = bias + min(plane_change(point, uvd.xy, d, 0.5 / level_size), f32(1u << level) * texel);
     let fine_tolerance = bias + min(plane_change(point, uvd.xy, d, 0.5 / base_size), texel);
+    // What each tap is compared with (the settings' receiver model), prepared once.
+    let receiver = receiver_tap_plane(frame, point.position, point.normal, d, settings.receiver_plane != 0u);
     let low = vec2<i32>(floor((uvd.xy - search) * level_size));
     let high = vec2<i32>(floor((uvd.xy + search) * level_size));
     let limit = vec2<i32>(level_size) - 1;
@@ -110,7 +107,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = max(low.x, 0); x <= min(high.x, limit.x); x++) {
             let depth = textureLoad(low_res_map, vec2<i32>(x, y), i32(level)).x;
             let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / level_size;
-            if (depth < compared_depth(point, uv, d) - coarse_tolerance) {
+            if (depth < tap_plane_depth(receiver, uv) - coarse_tolerance) {
                 coarse_sum += depth;
                 coarse_count += 1.0;
             }
@@ -123,7 +120,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var i = 0u; i < n; i++) {
                 let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
                 let depth = shadow_map_depth(low_res_map, uv);
-                if (depth < compared_depth(point, uv, d) - fine_tolerance) {
+                if (depth < tap_plane_depth(receiver, uv) - fine_tolerance) {
                     sum += depth;
                     count += 1.0;
                 }

@@ -31,6 +31,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     let d = own.x;
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
+    let receiver = compared_plane(lookup, point.normal, d);
     let search = light_half_extent_uv(frame, frame.projection.z, d);
     let n = max(settings.blocker_kernel, 1u);
     var sum = 0.0;
@@ -71,7 +72,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
             let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
             let depth = shadow_map_depth(shadow_map, tap);
             reads += 1u;
-            if (depth < compared_depth(lookup, point.normal, tap, d)) {
+            if (depth < tap_plane_depth(receiver, tap)) {
                 sum += depth;
                 count += 1.0;
             }

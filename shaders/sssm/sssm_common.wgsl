@@ -175,9 +175,10 @@ fn facing_radius(world: vec3<f32>, half_width: f32) -> f32 {
     return half_width / max(dot(world - eye, forward) * pixel_scale, 1e-9);
 }
 
-// Shadow-map taps compare with this depth (the receiver model shared with pcss).
-fn compared_depth(position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, receiver_depth: f32) -> f32 {
-    return tap_receiver_depth(frame, position, normal, uv, receiver_depth, settings.receiver_plane != 0u);
+// What shadow-map taps compare with, prepared once per point (the receiver model shared with pcss):
+// read at a tap with tap_plane_depth.
+fn compared_plane(position: vec3<f32>, normal: vec3<f32>, receiver_depth: f32) -> TapPlane {
+    return receiver_tap_plane(frame, position, normal, receiver_depth, settings.receiver_plane != 0u);
 }
 
 // Pixel position of a world point, w = 0 behind the eye.

@@ -28,6 +28,7 @@ fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
 fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
+    let receiver = compared_plane(lookup, point.normal, uvd.z);
     let hard = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
     reads += 1u;
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
@@ -39,7 +40,7 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
         let tap = uvd.xy + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
         let depth = shadow_map_depth(shadow_map, tap);
         reads += 1u;
-        if (depth < compared_depth(lookup, point.normal, tap, uvd.z)) {
+        if (depth < tap_plane_depth(receiver, tap)) {
             sum += depth;
             count += 1.0;
         }
