@@ -35,7 +35,7 @@ fn preset_benches(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("{}/{scene_spec}/{width}x{height}", preset.name));
         group.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1));
         for (scene_point, overrides) in plan.scene_points.iter().zip(&plan.scene_overrides) {
-            let scene = overrides.apply(&base).unwrap_or_else(|e| panic!("{e:#}"));
+            let scene = overrides.base_scene(scene_spec, &base).and_then(|base| overrides.apply(&base)).unwrap_or_else(|e| panic!("{e:#}"));
             let mut renderer = Renderer::new(&gpu, &scene, width, height, &needs).unwrap_or_else(|e| panic!("{e}"));
             for (info, params, point) in &plan.points {
                 let Ok(mut technique) = renderer.create_technique(info, params) else {

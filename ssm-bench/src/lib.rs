@@ -56,9 +56,41 @@ pub fn output_requirements() -> Requirements {
     Requirements { gbuffer: true, ..Requirements::NONE }
 }
 
+/// The debug outputs to ask of `info`: those named in `asked` (`all`: every one it declares),
+/// plus its overlays when `overlays` (the HTML report draws them).
+#[must_use]
+pub fn debug_outputs_for(info: &TechniqueInfo, asked: &[String], overlays: bool) -> Vec<&'static str> {
+    let all = asked.iter().any(|a| a == DEBUG_OUTPUT_ALL);
+    info.debug_outputs.iter().filter(|o| all || asked.iter().any(|a| a == o.name) || (overlays && o.overlay)).map(|o| o.name).collect()
+}
+
+/// `--debug-output all`: every debug output of every technique run.
+pub const DEBUG_OUTPUT_ALL: &str = "all";
+
+/// Checks that every name in `asked` is a debug output of at least one of `infos` (or `all`).
+///
+/// # Errors
+/// A name none of them offers; the message lists what each offers.
+pub fn check_debug_outputs(asked: &[String], infos: &[&TechniqueInfo]) -> anyhow::Result<()> {
+    for name in asked.iter().filter(|a| *a != DEBUG_OUTPUT_ALL) {
+        if !infos.iter().any(|info| info.debug_outputs.iter().any(|o| o.name == name)) {
+            let offered: Vec<String> = infos
+                .iter()
+                .map(|info| {
+                    let names: Vec<&str> = info.debug_outputs.iter().map(|o| o.name).collect();
+                    format!("{}: {}", info.name, if names.is_empty() { "none".to_owned() } else { names.join(", ") })
+                })
+                .collect();
+            anyhow::bail!("--debug-output {name}: no technique run offers it ({}; `ssm list` describes them)", offered.join("; "));
+        }
+    }
+    Ok(())
+}
+
 /// Renders `info` with `params` for one warm-up and `frames` timed frames
 /// and writes, under `dir`, `visibility.exr`/`.png` (light 0;
-/// `visibility-light<k>.*` for the others), `shaded.png` and `timings.json`.
+/// `visibility-light<k>.*` for the others), `shaded.png`, `timings.json` and
+/// `<name>.exr`/`.png` for each of the debug outputs named in `debug` that it offers.
 ///
 /// # Errors
 /// Technique, GPU or file errors.
@@ -67,9 +99,10 @@ pub fn render_technique(
     info: &'static TechniqueInfo,
     params: &ParamValues,
     frames: u32,
+    debug: &[&str],
     dir: &Path,
 ) -> ssm_core::Result<report::Measured> {
-    let measured = report::measure(renderer, info, params, frames)?;
+    let measured = report::measure(renderer, info, params, frames, debug)?;
     let coverage = report::pixel_mask(renderer, report::PixelSet::All)?;
     report::write_images(dir, &measured, (renderer.width(), renderer.height()), &coverage, None)?;
     let report = json!({

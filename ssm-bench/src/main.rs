@@ -7,7 +7,9 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use ssm_bench::{output_requirements, registry, render_technique, report, support_on, sweep, write_positions};
+use ssm_bench::{
+    check_debug_outputs, debug_outputs_for, output_requirements, registry, render_technique, report, support_on, sweep, write_positions,
+};
 use ssm_core::{GpuContext, ParamValues, Renderer, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
 
@@ -38,8 +40,8 @@ struct SweepArgs {
     #[arg(long, required_unless_present_any = ["list_presets", "preset"])]
     scene: Option<String>,
     /// `<technique>.<param>[:<param>...]=<value>[:<value>...],...`: values of one axis (colon-joined parameters vary in step);
-    /// `scene.light_scale`, `scene.occluder_lift` and `scene.lights` vary the scene; a bare `<technique>` runs it at its
-    /// defaults; repeatable.
+    /// `scene.light_scale`, `scene.occluder_lift`, `scene.occluder_shift`, `scene.lights` and a built-in scene's own
+    /// parameters (`scene.segments`) vary the scene; a bare `<technique>` runs it at its defaults; repeatable.
     #[arg(long = "vary", value_name = "TECHNIQUE.PARAM=V1,V2,...")]
     varies: Vec<String>,
     /// A named set of --vary axes (see `ssm sweep --list-presets`).
@@ -97,6 +99,10 @@ struct CompareArgs {
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1).
     #[arg(long, value_enum, default_value = "all")]
     pixels: report::PixelSet,
+    /// Debug outputs to write beside each technique's visibility, comma-separated (`ssm list`
+    /// shows what each technique offers; `all`: every one).
+    #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
+    debug_outputs: Vec<String>,
     /// Output directory: results.csv, report.md, index.html and one folder of images per technique.
     #[arg(long)]
     out: PathBuf,
@@ -122,6 +128,10 @@ struct RenderArgs {
     /// Frames timed after one warm-up frame; timings.json holds each and the median.
     #[arg(long, default_value_t = 1)]
     frames: u32,
+    /// Debug outputs to write beside each technique's visibility, comma-separated (`ssm list`
+    /// shows what each technique offers; `all`: every one).
+    #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
+    debug_outputs: Vec<String>,
     /// Output directory: <out>/<technique>/{visibility.exr,visibility.png,shaded.png,timings.json} and <out>/position.exr.
     #[arg(long)]
     out: PathBuf,
@@ -195,6 +205,9 @@ fn list() -> Result<()> {
         for spec in info.params {
             say!("  --set {}.{}={}  ({}; {})", info.name, spec.name, spec.default_value(), spec.range_text(), spec.doc);
         }
+        for output in info.debug_outputs {
+            say!("  --debug-output {}  ({})", output.name, output.doc);
+        }
         say!("");
     }
     Ok(())
@@ -236,6 +249,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         needs = needs.union((info.requirements)(&params)?);
         runs.push((info, params));
     }
+    check_debug_outputs(&args.debug_outputs, &runs.iter().map(|(info, _)| *info).collect::<Vec<_>>())?;
     let gpu = GpuContext::new()?;
     let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
@@ -247,7 +261,8 @@ fn render(args: &RenderArgs) -> Result<()> {
         progress.set_message(info.name);
         let dir = args.out.join(info.name);
         // Technique errors name the technique already.
-        let run = render_technique(&mut renderer, info, params, args.frames, &dir)?;
+        let debug = debug_outputs_for(info, &args.debug_outputs, false);
+        let run = render_technique(&mut renderer, info, params, args.frames, &debug, &dir)?;
         let time = match run.gpu_ms_median() {
             Some(ms) => format!("{ms:.3} ms GPU"),
             None => format!("{:.3} ms CPU wall (no timestamps)", run.cpu_ms_median()),
@@ -313,6 +328,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
             bail!("--set names technique `{technique}`, which is not compared");
         }
     }
+    check_debug_outputs(&args.debug_outputs, &runs.iter().map(|(info, _)| *info).collect::<Vec<_>>())?;
     let reference_params = params_for(reference_info, &settings)?;
     let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
     for (info, params) in &runs {
@@ -325,7 +341,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let progress = ProgressBar::new(runs.len() as u64 + 1);
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     progress.set_message(format!("{} (ground truth)", reference_info.name));
-    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
+    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
     let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
     let size = (args.width, args.height);
     report::write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;
@@ -334,7 +350,9 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let mut rows = Vec::new();
     for (info, params) in &runs {
         progress.set_message(info.name);
-        let measured = report::measure(&mut renderer, info, params, args.frames)?;
+        // The overlays always: the HTML report draws them over the visibility.
+        let debug = debug_outputs_for(info, &args.debug_outputs, true);
+        let measured = report::measure(&mut renderer, info, params, args.frames, &debug)?;
         report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
         rows.extend(report::rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
         progress.inc(1);
@@ -419,6 +437,9 @@ fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&
         .context("--scene is required (the preset names no scene)")?;
     let out = args.out.clone().context("--out is required")?;
     let plan = sweep::SweepPlan::new(registry, &specs, settings)?;
+    for overrides in &plan.scene_overrides {
+        overrides.check_scene(&scene_spec)?;
+    }
     let x_axis = args.x.clone().or_else(|| preset.as_ref().map(|p| p.x_axis.clone())).unwrap_or_else(|| "time".to_owned());
     if x_axis != "time" && !plan.varied.contains(&x_axis) {
         bail!("--x {x_axis}: not a varied parameter (give `time` or one of the --vary parameters as <technique>.<param>)");
@@ -450,7 +471,10 @@ fn run_sweep(
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     let (mut rows, mut varied) = (Vec::new(), Vec::new());
     for (scene_point, overrides) in plan.scene_points.iter().zip(&plan.scene_overrides) {
-        let scene = overrides.apply(&base_scene).with_context(|| format!("scene {} with {scene_point:?}", sweep.scene_spec))?;
+        let scene = overrides
+            .base_scene(&sweep.scene_spec, &base_scene)
+            .and_then(|base| overrides.apply(&base))
+            .with_context(|| format!("scene {} with {scene_point:?}", sweep.scene_spec))?;
         let scene_name = if scene_point.is_empty() {
             sweep.scene_spec.clone()
         } else {
@@ -458,12 +482,12 @@ fn run_sweep(
         };
         let mut renderer = Renderer::new(gpu, &scene, args.width, args.height, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
-        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1)?;
+        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
         let covered = report::pixel_mask(&renderer, sweep.pixels)?;
         progress.inc(1);
         for (info, params, technique_point) in &plan.points {
             progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
-            let measured = report::measure(&mut renderer, info, params, args.frames)?;
+            let measured = report::measure(&mut renderer, info, params, args.frames, &[])?;
             rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
             let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
             all.extend(technique_point.iter().cloned());

@@ -25,7 +25,7 @@ pub struct Measured {
     pub visibility: Vec<Vec<f32>>,
     /// The shaded image, RGBA8 sRGB.
     pub shaded: Vec<u8>,
-    /// The technique's extra images.
+    /// The debug outputs asked of the technique.
     pub extra_images: Vec<ssm_core::ExtraImage>,
 }
 
@@ -107,11 +107,20 @@ impl Measured {
 /// its frames, measured by wgpu's allocation counters.
 pub const MEMORY_DIAGNOSTIC: &str = "memory_mib";
 
-/// Renders `info` with `params`: one warm-up frame, then `frames` timed frames; reads every light's visibility and the shaded image.
+/// Renders `info` with `params`: one warm-up frame, then `frames` timed frames; reads every
+/// light's visibility, the shaded image and the debug outputs named in `debug` (those of
+/// [`TechniqueInfo::debug_outputs`]; others are ignored).
 ///
 /// # Errors
-/// Technique or GPU errors, or visibility outside [0, 1].
-pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &ParamValues, frames: u32) -> Result<Measured> {
+/// Technique or GPU errors, visibility outside [0, 1], or a debug output the technique returned
+/// under a name it does not declare.
+pub fn measure(
+    renderer: &mut Renderer,
+    info: &'static TechniqueInfo,
+    params: &ParamValues,
+    frames: u32,
+    debug: &[&str],
+) -> Result<Measured> {
     let memory_before = renderer.gpu.allocated_bytes();
     let mut technique = renderer.create_technique(info, params)?;
     // Pipeline compilation and first-use allocation are not the technique's cost.
@@ -127,7 +136,16 @@ pub fn measure(renderer: &mut Renderer, info: &'static TechniqueInfo, params: &P
     let shaded = renderer.shade()?;
     let mut diagnostics = technique.diagnostics(&renderer.gpu);
     diagnostics.push((MEMORY_DIAGNOSTIC.to_owned(), memory_mib));
-    let extra_images = technique.extra_images(&renderer.gpu)?;
+    let requested: Vec<&str> = info.debug_outputs.iter().map(|o| o.name).filter(|name| debug.contains(name)).collect();
+    let extra_images = if requested.is_empty() { Vec::new() } else { technique.debug_outputs(&renderer.gpu, &requested)? };
+    for image in &extra_images {
+        if !info.debug_outputs.iter().any(|o| o.name == image.name && o.overlay == image.overlay) {
+            return Err(ssm_core::Error::Technique {
+                technique: info.name.to_owned(),
+                message: format!("debug output `{}` is not declared in its TechniqueInfo::debug_outputs as returned", image.name),
+            });
+        }
+    }
     Ok(Measured { info, params: params.clone(), frames: timings, diagnostics, visibility, shaded, extra_images })
 }
 

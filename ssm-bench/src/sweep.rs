@@ -226,33 +226,43 @@ impl SweepPlan {
 /// The pseudo-technique whose varies change the scene instead of a technique.
 pub const SCENE_AXIS: &str = "scene";
 
-/// Changes to the scene a sweep can vary, by name after `scene.`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Changes to the scene a sweep can vary, by name after `scene.`: the sweep's own (below), and a
+/// built-in scene's own parameters (`scene.segments`, `scene.triangles`: `ssm scenes` lists them).
+#[derive(Clone, Debug, PartialEq)]
 pub struct SceneOverrides {
     /// Every light's size is multiplied by this (`scene.light_scale`).
     pub light_scale: f32,
     /// Occluder-only instances move this far towards the first light, along its normal, world units (`scene.occluder_lift`).
     pub occluder_lift: f32,
+    /// Occluder-only instances move sideways under the first light, along its first axis, by this
+    /// fraction of its width after `light_scale` (`scene.occluder_shift`; Atty et al., Fig. 19).
+    pub occluder_shift: f32,
     /// The number of lights (`scene.lights`): the scene's first ones, then copies of its first
     /// light when it has fewer. Copies cost what the first costs, so a frame's time against the
     /// light count shows what a technique repeats per light and what it shares.
     pub lights: Option<usize>,
+    /// The built-in scene's own parameters, `(name, value)`, over those its specification gives.
+    pub scene_params: Vec<(String, String)>,
 }
 
 impl Default for SceneOverrides {
     fn default() -> Self {
-        Self { light_scale: 1.0, occluder_lift: 0.0, lights: None }
+        Self { light_scale: 1.0, occluder_lift: 0.0, occluder_shift: 0.0, lights: None, scene_params: Vec::new() }
     }
 }
 
 /// Most lights `scene.lights` asks for.
 pub const MAX_SWEPT_LIGHTS: usize = 8;
 
+/// The scene parameters every sweep has, whatever the scene.
+pub const SWEEP_SCENE_PARAMS: &str = "light_scale, occluder_lift, occluder_shift, lights";
+
 impl SceneOverrides {
-    /// The overrides of one grid point.
+    /// The overrides of one grid point. A name that is not one of [`SWEEP_SCENE_PARAMS`] is taken
+    /// as a parameter of the built-in scene, checked against it by [`SceneOverrides::check_scene`].
     ///
     /// # Errors
-    /// An unknown scene parameter or a non-numeric value.
+    /// A non-numeric value, or a value outside a sweep parameter's range.
     pub fn from_point(point: &[(String, String)]) -> Result<Self> {
         let mut overrides = Self::default();
         for (name, value) in point {
@@ -262,14 +272,62 @@ impl SceneOverrides {
                 "light_scale" if number >= 0.0 => overrides.light_scale = number,
                 "light_scale" => bail!("scene.light_scale={value}: must be non-negative"),
                 "occluder_lift" => overrides.occluder_lift = number,
+                "occluder_shift" => overrides.occluder_shift = number,
                 "lights" if number.fract() == 0.0 && (1.0..=MAX_SWEPT_LIGHTS as f32).contains(&number) => {
                     overrides.lights = Some(number as usize);
                 }
                 "lights" => bail!("scene.lights={value}: must be a whole number from 1 to {MAX_SWEPT_LIGHTS}"),
-                other => bail!("unknown scene parameter `scene.{other}`; scene parameters: light_scale, occluder_lift, lights"),
+                other => overrides.scene_params.push((other.to_owned(), value.clone())),
             }
         }
         Ok(overrides)
+    }
+
+    /// `spec` (a scene name or file, as `--scene` takes it) with this point's built-in
+    /// parameters appended, `name:param=value,...`.
+    #[must_use]
+    pub fn scene_spec(&self, spec: &str) -> String {
+        if self.scene_params.is_empty() {
+            return spec.to_owned();
+        }
+        let assignments: Vec<String> = self.scene_params.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        let separator = if spec.contains(':') { ',' } else { ':' };
+        format!("{spec}{separator}{}", assignments.join(","))
+    }
+
+    /// Checks, without building it, that the scene of `spec` takes this point's built-in parameters.
+    ///
+    /// # Errors
+    /// Built-in parameters on a scene that is no built-in one, or ones it does not have or
+    /// accept (the message lists the sweep's scene parameters and the scene's).
+    pub fn check_scene(&self, spec: &str) -> Result<()> {
+        if self.scene_params.is_empty() {
+            return Ok(());
+        }
+        let names = self.scene_params.iter().map(|(k, _)| format!("scene.{k}")).collect::<Vec<_>>().join(", ");
+        let name = spec.split_once(':').map_or(spec, |(name, _)| name);
+        let entry = ssm_scene::BUILTIN_SCENES.iter().find(|s| s.name == name).with_context(|| {
+            format!("{names}: `{spec}` is not a built-in scene, so its only scene parameters are the sweep's: {SWEEP_SCENE_PARAMS}")
+        })?;
+        let full = self.scene_spec(spec);
+        let assignments = full.split_once(':').map_or("", |(_, a)| a);
+        entry.args(assignments).with_context(|| format!("{names}: the sweep's own scene parameters are {SWEEP_SCENE_PARAMS}"))?;
+        Ok(())
+    }
+
+    /// The scene of `spec` built with this point's built-in parameters; `base` (the scene of
+    /// `spec` as loaded) when the point has none.
+    ///
+    /// # Errors
+    /// As [`SceneOverrides::check_scene`].
+    pub fn base_scene(&self, spec: &str, base: &ssm_scene::Scene) -> Result<ssm_scene::Scene> {
+        if self.scene_params.is_empty() {
+            return Ok(base.clone());
+        }
+        self.check_scene(spec)?;
+        let full = self.scene_spec(spec);
+        let built = ssm_scene::parse_builtin(&full).with_context(|| format!("`{spec}` is not a built-in scene"))?;
+        Ok(built.map(|(_, scene)| scene)?)
     }
 
     /// The scene with the overrides applied (and validated).
@@ -285,7 +343,8 @@ impl SceneOverrides {
             light.half_size *= self.light_scale;
         }
         if let Some(first) = scene.lights.first() {
-            let lift = glam::Mat4::from_translation(-first.normal() * self.occluder_lift);
+            let shift = first.u_axis.normalize_or_zero() * (2.0 * first.half_size.x * self.occluder_shift);
+            let lift = glam::Mat4::from_translation(shift - first.normal() * self.occluder_lift);
             for instance in scene.instances.iter_mut().filter(|i| i.role == ssm_scene::Role::Occluder) {
                 instance.transform = lift * instance.transform;
             }
@@ -682,8 +741,38 @@ mod tests {
         let occluder = changed.bounds_where(|r| r == ssm_scene::Role::Occluder);
         assert!((occluder.min.y - 3.0).abs() < 1e-5, "lifted towards the light: {}", occluder.min.y);
         assert_eq!(changed.bounds_where(|r| r == ssm_scene::Role::Receiver), scene.bounds_where(|r| r == ssm_scene::Role::Receiver));
-        assert!(SceneOverrides::from_point(&[("size".into(), "1".into())]).is_err());
         assert!(SceneOverrides::from_point(&[("light_scale".into(), "-1".into())]).is_err());
+        // Sideways by a quarter of the light's width (1 × 0.5 after the scale), along its first axis.
+        let shifted = SceneOverrides::from_point(&[("light_scale".into(), "0.5".into()), ("occluder_shift".into(), "0.25".into())])
+            .unwrap()
+            .apply(&scene)
+            .unwrap();
+        let occluder = shifted.bounds_where(|r| r == ssm_scene::Role::Occluder);
+        assert!((occluder.min.x - (-0.5 + 0.125)).abs() < 1e-5 && (occluder.min.y - 2.0).abs() < 1e-5, "{occluder:?}");
+    }
+
+    #[test]
+    fn a_built_in_scenes_own_parameters_are_scene_parameters_of_a_sweep() {
+        let point = |name: &str, value: &str| SceneOverrides::from_point(&[(name.to_owned(), value.to_owned())]).unwrap();
+        let tessellated = point("segments", "4");
+        assert_eq!(tessellated.scene_spec("floating-sphere"), "floating-sphere:segments=4");
+        assert_eq!(tessellated.scene_spec("floating-sphere:rings=3"), "floating-sphere:rings=3,segments=4");
+        let base = ssm_scene::builtin("floating-sphere").unwrap().build();
+        let coarse = point("segments", "4").base_scene("floating-sphere:rings=3", &base).unwrap();
+        // Ground (2 triangles) and a sphere of 2 · 4 · (3 − 1).
+        assert_eq!((base.triangle_count(), coarse.triangle_count()), (2 + 2 * 48 * 23, 2 + 16));
+        // Unknown to the scene, out of its range, or on a scene that has no parameters: refused before any GPU work.
+        for (spec, name, value) in [
+            ("floating-sphere", "size", "1"),
+            ("floating-sphere", "segments", "1"),
+            ("parallel-square", "segments", "4"),
+            ("scene.toml", "segments", "4"),
+        ] {
+            let error = point(name, value).check_scene(spec).unwrap_err();
+            assert!(format!("{error:#}").contains(&format!("scene.{name}")), "{spec} {name}={value}: {error:#}");
+        }
+        // The sweep's own parameters need no built-in scene.
+        assert!(point("occluder_shift", "0.5").check_scene("scene.toml").is_ok());
     }
 
     #[test]

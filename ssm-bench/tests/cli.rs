@@ -171,6 +171,12 @@ fn list_and_scenes_name_everything() {
             assert!(text.contains(&line), "`{line}` missing from:\n{text}");
         }
     }
+    for info in ssm_bench::registry().unwrap().iter() {
+        for output in info.debug_outputs {
+            let line = format!("--debug-output {}  ({})", output.name, output.doc);
+            assert!(text.contains(&line), "`{line}` missing from:\n{text}");
+        }
+    }
     for needle in ["runs here: yes", "needs: G-buffer"] {
         assert!(text.contains(needle), "`{needle}` missing from:\n{text}");
     }
@@ -208,4 +214,50 @@ fn bad_arguments_fail_with_one_line() {
         &ssm(&["render", "--scene", "parallel-square", "--technique", first.name, "--width", "0", "--out", out]),
         "invalid",
     );
+}
+
+/// `--debug-output all` writes every debug output each technique declares (as `.png` and `.exr`),
+/// nothing is written unasked, and a name no technique offers is refused before any GPU work.
+#[test]
+fn debug_outputs_are_written_when_asked_and_only_then() {
+    let offering: Vec<_> = common::runnable().into_iter().filter(|i| !i.debug_outputs.is_empty()).collect();
+    assert!(!offering.is_empty(), "no technique declares a debug output");
+    let names = offering.iter().map(|i| i.name).collect::<Vec<_>>().join(",");
+    let render = |out: &PathBuf, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            "floating-sphere",
+            "--technique",
+            &names,
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        ssm(&args)
+    };
+    let asked = out_dir("debug-asked");
+    let output = render(&asked, &["--debug-output", "all"]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let unasked = out_dir("debug-unasked");
+    assert!(render(&unasked, &[]).status.success());
+    for info in &offering {
+        for debug in info.debug_outputs {
+            for extension in ["png", "exr"] {
+                let file = format!("{}.{extension}", debug.name);
+                assert!(asked.join(info.name).join(&file).is_file(), "{}/{file} not written", info.name);
+                assert!(!unasked.join(info.name).join(&file).exists(), "{}/{file} written unasked", info.name);
+            }
+        }
+    }
+    assert_one_line_error(
+        &render(&unasked, &["--debug-output", "no_such_output"]),
+        "--debug-output no_such_output: no technique run offers it",
+    );
+    let _ = std::fs::remove_dir_all(&asked);
+    let _ = std::fs::remove_dir_all(&unasked);
 }

@@ -220,7 +220,8 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
     assert!(svg.contains("scene.light_scale") && !svg.contains("Pareto front"), "parameter axis, no Pareto front");
     let bad =
         ssm(&["sweep", "--scene", "parallel-square", "--vary", "scene.colour=1", "--vary", &fixed_point, "--out", out.to_str().unwrap()]);
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown scene parameter"));
+    let message = String::from_utf8_lossy(&bad.stderr);
+    assert!(message.contains("scene.colour") && message.contains("unknown parameter `colour`"), "{message}");
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }
@@ -238,7 +239,7 @@ fn the_memory_a_technique_holds_is_reported() {
     let mut memory = |size: &str| {
         let mut params = defaults.clone();
         params.set("shadow_map_size", size).unwrap();
-        let measured = ssm_bench::report::measure(&mut renderer, hard, &params, 1).unwrap();
+        let measured = ssm_bench::report::measure(&mut renderer, hard, &params, 1, &[]).unwrap();
         measured.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).map(|(_, v)| *v).unwrap()
     };
     let (small, large) = (memory("512"), memory("1024"));

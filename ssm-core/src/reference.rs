@@ -919,6 +919,7 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     create,
     presets: &[],
     trade: None,
+    debug_outputs: &[],
     uniforms: &[],
 };
 

@@ -87,6 +87,7 @@ mod tests {
         create: no_create,
         presets: &[],
         trade: None,
+        debug_outputs: &[],
         uniforms: &[],
     };
     static ALPHA_AGAIN: TechniqueInfo = TechniqueInfo {
@@ -99,6 +100,7 @@ mod tests {
         create: no_create,
         presets: &[],
         trade: None,
+        debug_outputs: &[],
         uniforms: &[],
     };
     static BETA: TechniqueInfo = TechniqueInfo {
@@ -111,6 +113,7 @@ mod tests {
         create: no_create,
         presets: &[],
         trade: None,
+        debug_outputs: &[],
         uniforms: &[],
     };
 

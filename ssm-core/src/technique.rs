@@ -128,15 +128,29 @@ pub trait ShadowTechnique {
         Vec::new()
     }
 
-    /// Extra per-pixel images of the last frame (a share of work reused per pixel, say),
-    /// written beside the visibility by `ssm render` and `ssm compare`. Empty
-    /// by default.
+    /// The images of the last frame named in `requested`, among the debug outputs its
+    /// [`TechniqueInfo::debug_outputs`] declares (a share of work reused per pixel, say), each
+    /// named as declared; `ssm render --debug-output NAME` writes them beside the visibility. Only
+    /// what is asked is read back. Empty by default.
     ///
     /// # Errors
     /// A readback error.
-    fn extra_images(&mut self, _gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
+    fn debug_outputs(&mut self, _gpu: &GpuContext, _requested: &[&str]) -> Result<Vec<ExtraImage>> {
         Ok(Vec::new())
     }
+}
+
+/// An image a technique can write besides its visibility when asked (`--debug-output NAME`),
+/// listed by `ssm list`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DebugOutput {
+    /// File stem and the name `--debug-output` takes.
+    pub name: &'static str,
+    /// What each pixel holds, and in which unit.
+    pub doc: &'static str,
+    /// A map of regions of the frame, drawn over the visibility in `ssm compare`'s HTML report,
+    /// which therefore always asks for it.
+    pub overlay: bool,
 }
 
 /// A named single-channel image a technique outputs besides its visibility.
@@ -176,7 +190,8 @@ pub struct Preset {
     /// the one `ssm sweep --preset` uses without `--scene`.
     pub scenes: &'static [&'static str],
     /// `--vary` specifications: `<technique>.<param>[:<param>...]=<values>`,
-    /// or `scene.light_scale=...` / `scene.occluder_lift=...`.
+    /// or `scene.<param>=...` (`light_scale`, `occluder_lift`, `occluder_shift`, `lights`, or
+    /// a parameter of the built-in scene).
     pub varies: &'static [&'static str],
     /// The plot's x axis: `time` or a varied parameter (`mine.map_size`).
     pub x_axis: &'static str,
@@ -253,6 +268,8 @@ pub struct TechniqueInfo {
     pub trade: Option<&'static str>,
     /// Its uniforms, checked against the WGSL structs that read them.
     pub uniforms: &'static [UniformCheck],
+    /// The images it can write besides its visibility when asked ([`ShadowTechnique::debug_outputs`]).
+    pub debug_outputs: &'static [DebugOutput],
 }
 
 impl TechniqueInfo {

@@ -72,9 +72,23 @@ impl BuiltinScene {
     /// The scene's origin records the assignments, `builtin:<name>:<assignments>`.
     ///
     /// # Errors
+    /// As [`BuiltinScene::args`].
+    pub fn build_with(&self, assignments: &str) -> Result<Scene> {
+        let args = self.args(assignments)?;
+        let mut scene = (self.build)(&args);
+        if !assignments.trim().is_empty() {
+            scene.origin = PathBuf::from(format!("builtin:{}:{}", self.name, assignments.trim()));
+        }
+        Ok(scene)
+    }
+
+    /// The parameter values `assignments` (`param=value`, comma-separated) give, over the
+    /// defaults; a parameter assigned twice takes its last value. Checks without building.
+    ///
+    /// # Errors
     /// [`SceneError::BuiltinParameter`] for an unknown parameter, a value that is not a finite
     /// number, or one outside the parameter's range.
-    pub fn build_with(&self, assignments: &str) -> Result<Scene> {
+    pub fn args(&self, assignments: &str) -> Result<BuiltinArgs> {
         let problem = |problem: String| SceneError::BuiltinParameter { scene: format!("{}:{assignments}", self.name), problem };
         let mut args = self.defaults();
         for assignment in assignments.split(',').map(str::trim).filter(|a| !a.is_empty()) {
@@ -94,11 +108,7 @@ impl BuiltinScene {
                 slot.1 = value;
             }
         }
-        let mut scene = (self.build)(&args);
-        if !assignments.trim().is_empty() {
-            scene.origin = PathBuf::from(format!("builtin:{}:{}", self.name, assignments.trim()));
-        }
-        Ok(scene)
+        Ok(args)
     }
 }
 
@@ -124,8 +134,17 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     BuiltinScene {
         name: "floating-sphere",
         summary: "a closed sphere floating above a receiver plane",
-        params: &[],
-        build: |_| floating_sphere(),
+        params: &[
+            BuiltinParam { name: "segments", doc: "segments around the sphere", default: 48.0, min: 3.0, max: 2048.0 },
+            BuiltinParam {
+                name: "rings",
+                doc: "rings from pole to pole (2·segments·(rings − 1) triangles; 4 and 3 give 16, 512 and 256 give 261,632)",
+                default: 24.0,
+                min: 2.0,
+                max: 2048.0,
+            },
+        ],
+        build: floating_sphere,
     },
     BuiltinScene {
         name: "contact",
@@ -238,9 +257,9 @@ fn parallel_square() -> Scene {
     b.scene
 }
 
-fn floating_sphere() -> Scene {
+fn floating_sphere(args: &BuiltinArgs) -> Scene {
     let mut b = SceneBuilder::new("floating-sphere", downward_light(Vec3::new(0.0, 4.0, 0.0), 1.0)).ground(8.0);
-    let ball = b.mesh(sphere("sphere", 0.6, 48, 24));
+    let ball = b.mesh(sphere("sphere", 0.6, args.get("segments") as u32, args.get("rings") as u32));
     b.place("sphere", ball, Mat4::from_translation(Vec3::new(0.0, 1.4, 0.0)), Role::Occluder);
     b.scene
 }

@@ -614,6 +614,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("occluder_map_size=64,128,256,512"),
+    debug_outputs: &[],
     uniforms: &[UniformCheck {
         wgsl_struct: "AttySettings",
         wgsl_source: PROJECT_SHADER,
@@ -657,6 +658,33 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
         x_axis: "scene.occluder_lift",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-occluder-shift",
+        summary: "Atty et al., Fig. 19: error as the occluder moves sideways under the light (scene.occluder_shift, in light widths from its centre), 128² map, one- and two-sided",
+        scenes: &["floating-sphere"],
+        varies: &["scene.occluder_shift=-1,-0.5,-0.25,0,0.25,0.5,1", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
+        x_axis: "scene.occluder_shift",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-polygons",
+        summary: "Atty et al., Fig. 21: error (and time, with --error time) against the occluder's polygon count, a sphere tessellated from 16 to 261,632 triangles (scene.segments, rings in step), 128² map",
+        scenes: &["floating-sphere"],
+        varies: &["scene.segments:rings=4:3,16:8,64:32,256:128,512:256", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
+        x_axis: "scene.segments",
+        pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-small-maps",
+        summary: "Atty et al., Fig. 23: large lights with small occluder maps, the error of 32², 64², 128² maps as the light grows (one to four times floating-sphere's)",
+        scenes: &["floating-sphere"],
+        varies: &["scene.light_scale=1,2,3,4", "atty.occluder_map_size=32,64,128", "atty.two_sided=true"],
+        x_axis: "scene.light_scale",
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },

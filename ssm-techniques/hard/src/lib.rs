@@ -105,6 +105,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: &[],
     trade: Some("shadow_map_size=512,1024,2048,4096"),
+    debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "HardSettings", wgsl_source: SHADER, imports: &[], rust: HardSettingsUniform::LAYOUT }],
 };
 

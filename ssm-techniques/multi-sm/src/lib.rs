@@ -209,6 +209,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("samples=1,4,16,64"),
+    debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "MultiSmSettings", wgsl_source: SHADER, imports: &[], rust: MultiSmSettingsUniform::LAYOUT }],
 };
 

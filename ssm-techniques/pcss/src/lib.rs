@@ -172,6 +172,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41"),
+    debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "PcssSettings", wgsl_source: SHADER, imports: &[], rust: PcssSettingsUniform::LAYOUT }],
 };
 

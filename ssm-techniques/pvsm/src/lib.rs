@@ -29,9 +29,9 @@ use ssm_core::passes::{
 };
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    Choice, DepthBiasUniform, Error, ExtraImage, Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc, LightFrameUniform,
-    ParamValues, Preset, ReceiverModel, Requirements, Result, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind,
-    TechniqueSetup, UniformCheck, UniformStruct, register_technique,
+    Choice, DebugOutput, DepthBiasUniform, Error, ExtraImage, Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc,
+    LightFrameUniform, ParamValues, Preset, ReceiverModel, Requirements, Result, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo,
+    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, register_technique,
 };
 
 pub use kdtree::{Pyramid, Tile, Tiling};
@@ -961,7 +961,25 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
     /// `tiles`: each pixel shaded by the tile its filter's centre falls in (Fig. 10's inset), of the
     /// last light; `low_res_coverage`: the texels of the conservative low-resolution map that hold a
     /// surface (1) or none (0).
-    fn extra_images(&mut self, gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
+    fn debug_outputs(&mut self, gpu: &GpuContext, requested: &[&str]) -> Result<Vec<ExtraImage>> {
+        let mut images = Vec::new();
+        if requested.contains(&"tiles") {
+            images.push(self.tile_image(gpu)?);
+        }
+        if requested.contains(&"low_res_coverage") {
+            let side = self.settings.low_res_size;
+            let depth: Vec<f32> =
+                bytemuck::pod_collect_to_vec(&ssm_core::readback::read_texture(gpu, &self.low_res.texture, 4, "PVSM low-res map")?);
+            let coverage = depth.iter().map(|d| f32::from(u8::from(*d < ssm_core::NO_SURFACE))).collect();
+            images.push(ExtraImage { name: "low_res_coverage".into(), width: side, height: side, values: coverage, overlay: false });
+        }
+        Ok(images)
+    }
+}
+
+impl PredictedVirtualShadowMaps {
+    /// The `tiles` debug output.
+    fn tile_image(&self, gpu: &GpuContext) -> Result<ExtraImage> {
         let bytes = ssm_core::readback::read_buffer(gpu, &self.buffers.kernels, self.buffers.kernels.size(), "PVSM kernels")?;
         let words: Vec<[u32; 12]> = bytemuck::pod_collect_to_vec(&bytes);
         let tiles = self.last.tilings.last().map(|t| t.tiles.clone()).unwrap_or_default();
@@ -978,14 +996,7 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
                     .map_or(0.0, |index| (index + 1) as f32 / tiles.len() as f32)
             })
             .collect();
-        let side = self.settings.low_res_size;
-        let depth: Vec<f32> =
-            bytemuck::pod_collect_to_vec(&ssm_core::readback::read_texture(gpu, &self.low_res.texture, 4, "PVSM low-res map")?);
-        let coverage = depth.iter().map(|d| f32::from(u8::from(*d < ssm_core::NO_SURFACE))).collect();
-        Ok(vec![
-            ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values, overlay: true },
-            ExtraImage { name: "low_res_coverage".into(), width: side, height: side, values: coverage, overlay: false },
-        ])
+        Ok(ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values, overlay: true })
     }
 }
 
@@ -1048,6 +1059,18 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("max_tile_size=512,1024,2048,4096"),
+    debug_outputs: &[
+        DebugOutput {
+            name: "tiles",
+            doc: "each pixel shaded by the tile its filter's centre falls in, (index + 1) / tiles, of the last light; 0 where skipped as fully lit (Fig. 10's inset)",
+            overlay: true,
+        },
+        DebugOutput {
+            name: "low_res_coverage",
+            doc: "the conservative low-resolution map's texels: 1 where a surface was drawn, 0 where none (its side, not the frame's)",
+            overlay: false,
+        },
+    ],
     uniforms: &[
         UniformCheck { wgsl_struct: "PvsmSettings", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: PvsmSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "RasterSettings", wgsl_source: CONSERVATIVE_SHADER, imports: &[], rust: RasterSettingsUniform::LAYOUT },

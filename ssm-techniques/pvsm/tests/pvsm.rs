@@ -22,7 +22,7 @@ fn run(scene: &Scene, settings: &[(&str, &str)], size: (u32, u32)) -> (Rendered,
     renderer.render(technique.as_mut(), info.name).unwrap();
     let visibility = renderer.read_visibility(0, info.name).unwrap();
     let diagnostics = technique.diagnostics(&renderer.gpu);
-    let extra = technique.extra_images(&renderer.gpu).unwrap();
+    let extra = technique.debug_outputs(&renderer.gpu, &["tiles", "low_res_coverage"]).unwrap();
     (Rendered { renderer, visibility }, diagnostics, extra)
 }
 

@@ -19,9 +19,9 @@ use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    Choice, ExtraImage, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE,
-    SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
-    UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
+    Choice, DebugOutput, ExtraImage, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result,
+    SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -490,7 +490,10 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
         out
     }
 
-    fn extra_images(&mut self, gpu: &GpuContext) -> Result<Vec<ExtraImage>> {
+    fn debug_outputs(&mut self, gpu: &GpuContext, requested: &[&str]) -> Result<Vec<ExtraImage>> {
+        if !requested.contains(&"reuse_share") {
+            return Ok(Vec::new());
+        }
         let values = self.reuse_share(gpu)?.into_iter().map(|v| v.max(0.0)).collect();
         Ok(vec![ExtraImage { name: "reuse_share".into(), width: self.reuse.width(), height: self.reuse.height(), values, overlay: false }])
     }
@@ -529,6 +532,38 @@ const PRESETS: &[ssm_core::Preset] = &[
         ],
         ..ssm_core::Preset::DEFAULT
     },
+    ssm_core::Preset {
+        name: "sssm-steps",
+        summary: "Buades et al., Tables 2 and 3: milliseconds per step (depth map, horizontal blocker, blocker + horizontal blur, vertical blur) at 29/41 as alpha = beta grow, with a 1024² and a 4096² depth map (on leaves; the per-pass times are in sweep.csv's passes_ms)",
+        scenes: &["leaves"],
+        varies: &[
+            "sssm.alpha:beta=0:0,0.01:0.01,0.02:0.02,0.05:0.05,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
+            "sssm.shadow_map_size=1024,4096",
+            "sssm.blocker_kernel:blur_kernel=29:41",
+        ],
+        x_axis: "sssm.alpha",
+        y_axis: "time",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "sssm-table6",
+        summary: "Buades et al., Table 6: PSNR and SSIM against the ground truth of PCSS and SSSM (several alpha = beta) at 29/41, for the default light and one 2.5 times larger (their 0.04 and 0.10)",
+        scenes: &["leaves"],
+        varies: &[
+            "scene.light_scale=1,2.5",
+            "pcss.blocker_kernel:pcf_kernel=29:41",
+            "sssm.blocker_kernel:blur_kernel=29:41",
+            "sssm.alpha:beta=0.01:0.01,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
+        ],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "sssm-filter",
+        summary: "Buades et al., Fig. 5: the mean filter against the Gaussian, error against the ground truth at Table 4's kernel pairs (the images: ssm compare with --set sssm.filter=mean)",
+        scenes: &["leaves"],
+        varies: &["sssm.filter=mean,gaussian", "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41"],
+        ..ssm_core::Preset::DEFAULT
+    },
 ];
 
 /// The registration.
@@ -542,6 +577,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("blocker_kernel:blur_kernel=3:5,7:15,11:21,29:41"),
+    debug_outputs: &[DebugOutput {
+        name: "reuse_share",
+        doc: "the share of blocker and blur rows reused (not recomputed) per pixel, 0 to 1, of the last light; 0 where not computed (the paper's Fig. 10: white reused, black recomputed)",
+        overlay: false,
+    }],
     uniforms: &[UniformCheck {
         wgsl_struct: "SssmSettings",
         wgsl_source: HORIZONTAL_BLOCKER_SHADER,

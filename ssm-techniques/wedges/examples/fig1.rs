@@ -38,10 +38,15 @@ fn main() -> Result<()> {
     let info = &ssm_wedges::INFO;
     let needs = (info.requirements)(&info.default_params())?.union(Requirements { gbuffer: true, ..Requirements::NONE });
     let mut renderer = Renderer::new(&gpu, &scene, size.0, size.1, &needs)?;
-    let truth =
-        measure(&mut renderer, &ssm_core::reference::INFO, &ssm_core::reference::INFO.params_from([("samples", samples.as_str())])?, 1)?
-            .visibility
-            .swap_remove(0);
+    let truth = measure(
+        &mut renderer,
+        &ssm_core::reference::INFO,
+        &ssm_core::reference::INFO.params_from([("samples", samples.as_str())])?,
+        1,
+        &[],
+    )?
+    .visibility
+    .swap_remove(0);
     let covered: Vec<bool> = renderer.read_positions()?.iter().map(|p| p[3] > 0.5).collect();
     let classes = classify(&truth, &covered);
     println!(
@@ -53,7 +58,7 @@ fn main() -> Result<()> {
     );
     for blending in ["none", "forest"] {
         let params = info.params_from([("blending", blending), ("silhouette_buffers", buffers.as_str())])?;
-        let measured = measure(&mut renderer, info, &params, 3)?;
+        let measured = measure(&mut renderer, info, &params, 3, &[])?;
         let image = &measured.visibility[0];
         let signed: Vec<f64> = classes
             .iter()

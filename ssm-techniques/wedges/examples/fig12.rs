@@ -102,7 +102,7 @@ fn main() -> Result<()> {
         let mut renderer = Renderer::new(&gpu, &scene, options.size.0, options.size.1, &needs)?;
         let truth = if options.error {
             let values = ssm_core::reference::INFO.params_from([("samples", "16")])?;
-            Some(measure(&mut renderer, &ssm_core::reference::INFO, &values, 1)?.visibility.swap_remove(0))
+            Some(measure(&mut renderer, &ssm_core::reference::INFO, &values, 1, &[])?.visibility.swap_remove(0))
         } else {
             None
         };

@@ -1038,6 +1038,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("silhouette_buffers=1,4,16,64"),
+    debug_outputs: &[],
     uniforms: &[
         UniformCheck {
             wgsl_struct: "WedgesSettings",

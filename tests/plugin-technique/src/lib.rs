@@ -101,6 +101,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: &[],
     trade: None,
+    debug_outputs: &[],
     uniforms: &[],
 };
 
