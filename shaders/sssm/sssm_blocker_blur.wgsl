@@ -4,12 +4,52 @@
 // blur of the hard shadow over m taps (Sec. 4.2). The entry points (a fragment pass, or a
 // compute pass whose workgroups share the screen row the blur reads) are in
 // sssm_blocker_blur_fragment.wgsl and sssm_blocker_blur_compute.wgsl; each defines
-// `horizontal_source(texel)`, where a blur tap's pixel comes from.
+// `horizontal_source(texel)`, where a blur tap's pixel comes from, and binds `penumbra_error`, the
+// target of the Table 5 measurement (with settings.penumbra_error: per pixel, (the penumbra width
+// from the reused rows − the width from every row read)², shadow-map texels²; -1 where step 2
+// computed no penumbra either way).
 
 // #import sssm/sssm_common.wgsl
 
 @group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
 @group(2) @binding(5) var blur_source: texture_2d<f32>;
+// This invocation's value for penumbra_error (blocker_search sets it).
+var<private> penumbra_error_value: f32 = -1.0;
+
+// Writes the pixel's penumbra error, when measured.
+fn store_penumbra_error(texel: vec2<i32>) {
+    if (settings.penumbra_error != 0u) {
+        textureStore(penumbra_error, texel, vec4<f32>(penumbra_error_value));
+    }
+}
+
+// The blocker sum and count over every row of the n×n window, none reused: PCSS's search, and
+// what SSSM's rows add up to with α = 0.
+fn full_blocker_search(uvd: vec3<f32>, search: vec2<f32>, receiver: TapPlane, n: u32) -> vec2<f32> {
+    var sum = 0.0;
+    var count = 0.0;
+    for (var j = 0u; j < n; j++) {
+        for (var i = 0u; i < n; i++) {
+            let tap = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
+            let depth = shadow_map_depth(shadow_map, tap);
+            if (depth < tap_plane_depth(receiver, tap)) {
+                sum += depth;
+                count += 1.0;
+            }
+        }
+    }
+    return vec2<f32>(sum, count);
+}
+
+// Full width in shadow-map texels (along u) of the penumbra of a blocker sum and count seen from
+// light depth d: Eq. 1's w_penumbra; 0 without a blocker.
+fn penumbra_texels(sum_count: vec2<f32>, d: f32) -> f32 {
+    if (sum_count.y == 0.0) {
+        return 0.0;
+    }
+    let extent = light_half_extent_uv(frame, sum_count.x / sum_count.y, d);
+    return 2.0 * extent.x * f32(textureDimensions(shadow_map).x);
+}
 
 // A blur tap's pixel read from step 1's blur_source: its hard visibility, and what the bilateral
 // weight compares.
@@ -76,6 +116,14 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
                 sum += depth;
                 count += 1.0;
             }
+        }
+    }
+    if (settings.penumbra_error != 0u) {
+        // Table 5: the error the reuse (α) brings into the penumbra estimate.
+        let full = full_blocker_search(uvd, search, receiver, n);
+        if (full.y > 0.0 || count > 0.0) {
+            let difference = penumbra_texels(vec2<f32>(sum, count), d) - penumbra_texels(full, d);
+            penumbra_error_value = difference * difference;
         }
     }
     // No blocker: fully lit (Sec. 4.2).

@@ -9,6 +9,7 @@
 // #import sssm/sssm_segment.wgsl
 
 @group(2) @binding(6) var horizontal_blur_target: texture_storage_2d<rgba32float, write>;
+@group(2) @binding(7) var penumbra_error: texture_storage_2d<r32float, write>;
 
 fn horizontal_source(texel: vec2<i32>) -> BlurSource {
     let index = segment_index(texel.x);
@@ -48,6 +49,7 @@ fn sssm_blocker_blur_rows(
                 reach_for(result.y);
             }
         }
+        store_penumbra_error(texel);
     }
     workgroupBarrier();
     place_segment(i32(group.x * SEGMENT_PIXELS));

@@ -2,6 +2,8 @@
 
 // #import sssm/sssm_blocker_blur.wgsl
 
+@group(2) @binding(6) var penumbra_error: texture_storage_2d<r32float, write>;
+
 fn horizontal_source(texel: vec2<i32>) -> BlurSource {
     return load_horizontal_source(texel);
 }
@@ -13,10 +15,12 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
     if (own.x < 0.0) {
+        store_penumbra_error(point.texel);
         return vec4<f32>(own.w, 0.0, 0.0, -1.0);
     }
     reads = 3u;
     let searched = blocker_search(point, own);
+    store_penumbra_error(point.texel);
     var result = searched.result;
     if (searched.blur) {
         result = horizontal_blur(in.clip.xy, point, own, result);

@@ -21,6 +21,12 @@ struct SssmSettings {
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
+    // 1: step 2 also searches every blocker row (no reuse) and writes the squared difference of the
+    // two penumbra widths, in shadow-map texels², to penumbra_error (Table 5; costs a full search).
+    penumbra_error: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
     // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
     // exponential per tap.

@@ -105,6 +105,9 @@ pub struct SssmSettings {
     /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
+    /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostic `sssm_penumbra_mse_texels2`, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
+    #[param(default = false)]
+    pub penumbra_error: bool,
     /// Depth bias and normal offset.
     #[param(flatten)]
     pub bias: ShadowMapBias,
@@ -122,6 +125,10 @@ pub struct SssmSettingsUniform {
     beta: f32,
     normal_offset: f32,
     bilateral_depth: f32,
+    penumbra_error: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     blur_weights: [[f32; 4]; 32],
 }
 
@@ -155,6 +162,10 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             beta: settings.beta,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
+            penumbra_error: u32::from(settings.penumbra_error),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
             blur_weights: blur_weights(settings),
         }
     }
@@ -171,6 +182,8 @@ pub struct SeparableSoftShadowMaps {
     horizontal_blocker_view: wgpu::TextureView,
     horizontal_blur_view: wgpu::TextureView,
     reuse: wgpu::Texture,
+    /// Step 2's squared penumbra-width error per pixel, with `penumbra_error`; `None` without.
+    penumbra_error: Option<wgpu::Texture>,
     read_counts: ReadCounts,
 }
 
@@ -205,6 +218,9 @@ struct Targets {
     horizontal_blur: wgpu::TextureView,
     reuse: wgpu::Texture,
     reuse_view: wgpu::TextureView,
+    /// Step 2's squared penumbra-width error per pixel (written with `penumbra_error`).
+    penumbra_error: wgpu::Texture,
+    penumbra_error_view: wgpu::TextureView,
 }
 
 impl Targets {
@@ -213,16 +229,21 @@ impl Targets {
             let texture = render_texture(device, label, width, height, wgpu::TextureFormat::Rgba32Float, usage);
             labelled_view(&texture, label)
         };
-        let reuse = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("sssm_reuse_share"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        // Per-pixel values a pass writes and the CPU reads back.
+        let readable = |label: &str| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Float,
+                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let reuse = readable("sssm_reuse_share");
+        let penumbra_error = readable("sssm_penumbra_error");
         Self {
             horizontal_blocker: target("sssm_horizontal_blocker_target", wgpu::TextureUsages::empty()),
             // Written by step 1 as a storage texture.
@@ -231,6 +252,8 @@ impl Targets {
             horizontal_blur: target("sssm_horizontal_blur_target", wgpu::TextureUsages::STORAGE_BINDING),
             reuse_view: labelled_view(&reuse, "sssm_reuse_share"),
             reuse,
+            penumbra_error_view: labelled_view(&penumbra_error, "sssm_penumbra_error"),
+            penumbra_error,
         }
     }
 }
@@ -276,8 +299,16 @@ impl SeparableSoftShadowMaps {
             horizontal_blocker_view: targets.horizontal_blocker,
             horizontal_blur_view: targets.horizontal_blur,
             reuse: targets.reuse,
+            penumbra_error: settings.penumbra_error.then_some(targets.penumbra_error),
             read_counts,
         })
+    }
+
+    /// Step 2's squared penumbra-width error per pixel (texels²; -1 where no penumbra was
+    /// computed), when measured.
+    fn penumbra_error(&self, gpu: &GpuContext) -> Result<Option<Vec<f32>>> {
+        let Some(texture) = &self.penumbra_error else { return Ok(None) };
+        Ok(Some(bytemuck::pod_collect_to_vec(&read_texture(gpu, texture, 4, "SSSM penumbra error")?)))
     }
 
     /// The reuse share per pixel of the last light rendered (-1 where nothing was computed).
@@ -329,6 +360,12 @@ impl Shared<'_> {
         ]
     }
 
+    /// Step 2's penumbra-error target, after the entry point's other bindings (6 in the fragment
+    /// pass, 7 in the compute pass).
+    fn penumbra_error_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        write_storage_texture_entry(binding, wgpu::TextureFormat::R32Float)
+    }
+
     /// Step 3's inputs (bindings 4 to 6): step 2's target, the reuse share it writes, and step 1's
     /// blur sources (which also hold each pixel's own hard value).
     fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 3] {
@@ -344,10 +381,15 @@ impl Shared<'_> {
     }
 
     fn fragment_steps(&self) -> Result<BlurSteps> {
-        let blocker_blur_layout = self.layout("sssm_blocker_blur_layout", &[texture_entry(4), texture_entry(5)]);
+        let blocker_blur_layout =
+            self.layout("sssm_blocker_blur_layout", &[texture_entry(4), texture_entry(5), Self::penumbra_error_entry(6)]);
         let vertical_blur_layout = self.layout("sssm_vertical_blur_layout", &Self::vertical_entries());
         let groups = [
-            self.group("sssm_blocker_blur_bind_group", &blocker_blur_layout, &self.blocker_blur_inputs()),
+            self.group(
+                "sssm_blocker_blur_bind_group",
+                &blocker_blur_layout,
+                &[self.blocker_blur_inputs().as_slice(), &[wgpu::BindingResource::TextureView(&self.targets.penumbra_error_view)]].concat(),
+            ),
             self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
         ];
         let blocker_blur = ScreenPass::new(
@@ -375,7 +417,12 @@ impl Shared<'_> {
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let blocker_blur_layout = self.layout(
             "sssm_blocker_blur_rows_layout",
-            &[texture_entry(4), texture_entry(5), write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float)],
+            &[
+                texture_entry(4),
+                texture_entry(5),
+                write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float),
+                Self::penumbra_error_entry(7),
+            ],
         );
         let mut vertical_entries = Self::vertical_entries().to_vec();
         vertical_entries.push(write_storage_texture_entry(7, VISIBILITY_FORMAT));
@@ -383,7 +430,14 @@ impl Shared<'_> {
         let blocker_blur_group = self.group(
             "sssm_blocker_blur_rows_bind_group",
             &blocker_blur_layout,
-            &[self.blocker_blur_inputs().as_slice(), &[wgpu::BindingResource::TextureView(&self.targets.horizontal_blur)]].concat(),
+            &[
+                self.blocker_blur_inputs().as_slice(),
+                &[
+                    wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
+                    wgpu::BindingResource::TextureView(&self.targets.penumbra_error_view),
+                ],
+            ]
+            .concat(),
         );
         let vertical_blur_groups = setup
             .outputs
@@ -487,15 +541,31 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
         }
         let mut out = vec![("sssm_reuse_share".to_owned(), computed.iter().sum::<f64>() / computed.len() as f64)];
         out.extend(self.read_counts.diagnostics(gpu));
+        if let Ok(Some(errors)) = self.penumbra_error(gpu) {
+            // Table 5: the mean over the pixels where either search found a blocker.
+            let measured: Vec<f64> = errors.iter().filter(|v| **v >= 0.0).map(|v| f64::from(*v)).collect();
+            if !measured.is_empty() {
+                out.push(("sssm_penumbra_mse_texels2".to_owned(), measured.iter().sum::<f64>() / measured.len() as f64));
+            }
+        }
         out
     }
 
     fn debug_outputs(&mut self, gpu: &GpuContext, requested: &[&str]) -> Result<Vec<ExtraImage>> {
-        if !requested.contains(&"reuse_share") {
-            return Ok(Vec::new());
+        let (width, height) = (self.reuse.width(), self.reuse.height());
+        let mut images = Vec::new();
+        if requested.contains(&"reuse_share") {
+            let values = self.reuse_share(gpu)?.into_iter().map(|v| v.max(0.0)).collect();
+            images.push(ExtraImage { name: "reuse_share".into(), width, height, values, overlay: false });
         }
-        let values = self.reuse_share(gpu)?.into_iter().map(|v| v.max(0.0)).collect();
-        Ok(vec![ExtraImage { name: "reuse_share".into(), width: self.reuse.width(), height: self.reuse.height(), values, overlay: false }])
+        if requested.contains(&"penumbra_error") {
+            // Zero where not measured: the parameter is off, or no penumbra was computed.
+            let values = self
+                .penumbra_error(gpu)?
+                .map_or_else(|| vec![0.0; (width * height) as usize], |v| v.into_iter().map(|e| e.max(0.0)).collect());
+            images.push(ExtraImage { name: "penumbra_error".into(), width, height, values, overlay: false });
+        }
+        Ok(images)
     }
 }
 
@@ -546,6 +616,14 @@ const PRESETS: &[ssm_core::Preset] = &[
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
+        name: "sssm-table5",
+        summary: "Buades et al., Table 5: the mean squared error, in shadow-map texels², that reusing rows (alpha) brings into the penumbra width, against every row searched (PCSS's search), for 7, 11 and 29 blocker rows (diagnostic sssm_penumbra_mse_texels2; on leaves)",
+        scenes: &["leaves"],
+        varies: &["sssm.alpha=0.01,0.1,0.15,0.2,0.5", "sssm.blocker_kernel=7,11,29", "sssm.penumbra_error=true"],
+        x_axis: "sssm.alpha",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
         name: "sssm-table6",
         summary: "Buades et al., Table 6: PSNR and SSIM against the ground truth of PCSS and SSSM (several alpha = beta) at 29/41, for the default light and one 2.5 times larger (their 0.04 and 0.10)",
         scenes: &["leaves"],
@@ -577,11 +655,18 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     presets: PRESETS,
     trade: Some("blocker_kernel:blur_kernel=3:5,7:15,11:21,29:41"),
-    debug_outputs: &[DebugOutput {
-        name: "reuse_share",
-        doc: "the share of blocker and blur rows reused (not recomputed) per pixel, 0 to 1, of the last light; 0 where not computed (the paper's Fig. 10: white reused, black recomputed)",
-        overlay: false,
-    }],
+    debug_outputs: &[
+        DebugOutput {
+            name: "reuse_share",
+            doc: "the share of blocker and blur rows reused (not recomputed) per pixel, 0 to 1, of the last light; 0 where not computed (the paper's Fig. 10: white reused, black recomputed)",
+            overlay: false,
+        },
+        DebugOutput {
+            name: "penumbra_error",
+            doc: "with penumbra_error=true, the squared difference between the penumbra width from the reused rows and from every row, shadow-map texels², of the last light (the paper's Table 5); 0 where not measured",
+            overlay: false,
+        },
+    ],
     uniforms: &[UniformCheck {
         wgsl_struct: "SssmSettings",
         wgsl_source: HORIZONTAL_BLOCKER_SHADER,

@@ -333,3 +333,28 @@ fn the_optimised_passes_keep_the_error_of_the_straightforward_ones() {
     }
     assert!(worse.is_empty(), "{worse:#?}");
 }
+
+/// The paper's Table 5: with every row recomputed (α = 0) the penumbra width is PCSS's to the last
+/// bit, and the error reuse brings in grows with α, in both step-2 entry points. Measured on
+/// `leaves` at 160×120 with 11 blocker rows (texels² of the 1024² map).
+#[test]
+fn the_penumbra_error_reuse_brings_in_is_zero_without_reuse_and_grows_with_alpha() {
+    let scene = builtin("leaves").unwrap().build();
+    let mut errors = Vec::new();
+    for alpha in ["0", "0.01", "0.1", "0.5"] {
+        let mut per_entry = Vec::new();
+        for passes in ["fragment", "shared_rows"] {
+            let settings = [("alpha", alpha), ("blocker_kernel", "11"), ("penumbra_error", "true"), ("blur_passes", passes)];
+            per_entry.push(value(&diagnostics_of(&ssm_sssm::INFO, &scene, &settings), "sssm_penumbra_mse_texels2"));
+        }
+        println!("alpha = {alpha}: penumbra MSE {:.4} texels² (fragment), {:.4} (shared rows)", per_entry[0], per_entry[1]);
+        assert_eq!(per_entry[0], per_entry[1], "the two entry points search the same rows");
+        errors.push(per_entry[0]);
+    }
+    assert_eq!(errors[0], 0.0, "no reuse: PCSS's search exactly");
+    for pair in errors.windows(2) {
+        assert!(pair[1] > pair[0], "the error grows with α: {errors:?}");
+    }
+    // Off by default: no diagnostic, no full search.
+    assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| k != "sssm_penumbra_mse_texels2"));
+}
