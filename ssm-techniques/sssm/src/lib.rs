@@ -105,7 +105,7 @@ pub struct SssmSettings {
     /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
-    /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostic `sssm_penumbra_mse_texels2`, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
+    /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostics `sssm_penumbra_mse_texels2` over the pixels either search finds a blocker for and `sssm_penumbra_mse_all_texels2` over every pixel computed, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
     #[param(default = false)]
     pub penumbra_error: bool,
     /// Depth bias and normal offset.
@@ -542,10 +542,13 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
         let mut out = vec![("sssm_reuse_share".to_owned(), computed.iter().sum::<f64>() / computed.len() as f64)];
         out.extend(self.read_counts.diagnostics(gpu));
         if let Ok(Some(errors)) = self.penumbra_error(gpu) {
-            // Table 5: the mean over the pixels where either search found a blocker.
+            // Table 5: the mean over the pixels where either search found a blocker, and over every
+            // pixel computed (the reuse share is -1 where nothing was), the lit ones counting 0.
             let measured: Vec<f64> = errors.iter().filter(|v| **v >= 0.0).map(|v| f64::from(*v)).collect();
             if !measured.is_empty() {
-                out.push(("sssm_penumbra_mse_texels2".to_owned(), measured.iter().sum::<f64>() / measured.len() as f64));
+                let total: f64 = measured.iter().sum();
+                out.push(("sssm_penumbra_mse_texels2".to_owned(), total / measured.len() as f64));
+                out.push(("sssm_penumbra_mse_all_texels2".to_owned(), total / computed.len() as f64));
             }
         }
         out
