@@ -76,3 +76,30 @@ fn each_light_of_three_equals_that_light_alone_for_every_technique() {
     assert!(checked >= 6, "only {checked} techniques ran");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Each light's colour tints its own contribution to the shaded image and nothing else: under a
+/// red light and a blue one, a lit ground pixel is red plus blue with no green beyond the
+/// ambient term, and the visibility is the same as under white lights.
+#[test]
+fn light_colours_tint_the_shaded_image_only() {
+    let gpu = gpu();
+    let lights = three_lights();
+    let coloured = vec![lights[0].with_colour(Vec3::new(1.0, 0.0, 0.0)), lights[1].with_colour(Vec3::new(0.0, 0.0, 1.0))];
+    let white = vec![lights[0], lights[1]];
+    let hard = registry().get("hard").unwrap();
+    let mut shaded = Vec::new();
+    let mut visibility = Vec::new();
+    for lights in [coloured, white] {
+        let mut rendered = render(&gpu, &scene_with(lights), hard, &[], WIDTH, HEIGHT).unwrap();
+        visibility.push(rendered.visibility.clone());
+        shaded.push(rendered.renderer.shade().unwrap());
+    }
+    assert_eq!(visibility[0], visibility[1], "colour does not change visibility");
+    // A ground pixel near the bottom corner, lit by both lights.
+    let pixel = ((HEIGHT - 4) * WIDTH + 6) as usize * 4;
+    let (tinted, plain) = (&shaded[0][pixel..pixel + 3], &shaded[1][pixel..pixel + 3]);
+    println!("shaded pixel: coloured lights {tinted:?}, white lights {plain:?}");
+    let ambient = tinted[1];
+    assert!(tinted[0] > ambient + 20 && tinted[2] > ambient + 20, "red and blue over the ambient green: {tinted:?}");
+    assert!(plain[1] > ambient + 20, "white lights light green too: {plain:?}");
+}

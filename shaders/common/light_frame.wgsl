@@ -20,6 +20,8 @@ struct LightFrame {
     projection: vec4<f32>,
     // x: the diagonal of the scene's bounding box, the scale of scene-relative settings; y, z, w: unused.
     scene: vec4<f32>,
+    // xyz: the light's linear RGB colour (the composite shading's; visibility ignores it); w: unused.
+    colour: vec4<f32>,
 };
 
 // A length given as a fraction of the scene's diagonal (biases, thresholds), in world units.

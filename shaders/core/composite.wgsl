@@ -27,5 +27,5 @@ fn composite_light(in: FullscreenVertex) -> @location(0) vec4<f32> {
     let lambert = max(dot(point.normal, direction), 0.0) * max(dot(-direction, frame.normal.xyz), 0.0);
     let lit = clamp(textureLoad(visibility, point.texel, 0).x, 0.0, 1.0);
     let radiance = ALBEDO * (1.0 - AMBIENT) * frame.centre.w * lambert * lit;
-    return vec4<f32>(vec3<f32>(radiance), 1.0);
+    return vec4<f32>(radiance * frame.colour.xyz, 1.0);
 }

@@ -17,6 +17,9 @@ use ssm_core::{GpuContext, Renderer};
 use ssm_scene::Scene;
 
 fn preset_benches(c: &mut Criterion) {
+    // A preset names scene files relative to the workspace's root (where `ssm sweep --preset` is
+    // run); cargo runs benches from this crate's folder.
+    std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).unwrap_or_else(|e| panic!("the workspace root: {e}"));
     let registry = registry().unwrap_or_else(|e| panic!("{e}"));
     let gpu = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
     let (width, height) = bench_size().unwrap_or_else(|e| panic!("{e}"));

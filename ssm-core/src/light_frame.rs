@@ -274,6 +274,8 @@ pub struct LightFrameUniform {
     pub projection: [f32; 4],
     /// The scene's bounding-box diagonal; y, z, w unused.
     pub scene: [f32; 4],
+    /// The light's linear RGB colour; w unused.
+    pub colour: [f32; 4],
 }
 
 impl From<&LightFrame> for LightFrameUniform {
@@ -288,6 +290,7 @@ impl From<&LightFrame> for LightFrameUniform {
             normal: light.normal().extend(light.area()).to_array(),
             projection: [frame.tan_half.x, frame.tan_half.y, frame.near, frame.far],
             scene: [frame.scene_diagonal, 0.0, 0.0, 0.0],
+            colour: light.colour.extend(0.0).to_array(),
         }
     }
 }

@@ -221,7 +221,7 @@ fn standard_camera() -> Camera {
 
 /// A square light of side `size` centred at `centre`, facing down, first side along +X.
 fn downward_light(centre: Vec3, size: f32) -> RectLight {
-    RectLight { centre, u_axis: Vec3::X, v_axis: Vec3::Z, half_size: Vec2::splat(size * 0.5), intensity: 1.0 }
+    RectLight { centre, u_axis: Vec3::X, v_axis: Vec3::Z, half_size: Vec2::splat(size * 0.5), intensity: 1.0, colour: Vec3::ONE }
 }
 
 struct SceneBuilder {

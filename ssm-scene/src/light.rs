@@ -23,6 +23,9 @@ pub struct RectLight {
     pub half_size: Vec2,
     /// Radiant intensity scale used by the composite shading, `>= 0`.
     pub intensity: f32,
+    /// Linear RGB colour the composite shading multiplies the light's radiance by, each
+    /// component finite and `>= 0` (white: `Vec3::ONE`). Visibility does not depend on it.
+    pub colour: Vec3,
 }
 
 impl RectLight {
@@ -37,7 +40,13 @@ impl RectLight {
         let u_axis = (u_hint - normal * u_hint.dot(normal)).try_normalize()?;
         // u × v = normal, so v = normal × u.
         let v_axis = normal.cross(u_axis);
-        Some(Self { centre, u_axis, v_axis, half_size: size * 0.5, intensity })
+        Some(Self { centre, u_axis, v_axis, half_size: size * 0.5, intensity, colour: Vec3::ONE })
+    }
+
+    /// The same light with colour `colour` (linear RGB).
+    #[must_use]
+    pub fn with_colour(self, colour: Vec3) -> Self {
+        Self { colour, ..self }
     }
 
     /// The direction the light emits towards.
@@ -82,6 +91,9 @@ impl RectLight {
         }
         if !self.intensity.is_finite() || self.intensity < 0.0 {
             return fail(format!("intensity must be finite and non-negative, got {}", self.intensity));
+        }
+        if !self.colour.is_finite() || self.colour.min_element() < 0.0 {
+            return fail(format!("colour must be finite and non-negative in every component, got {}", self.colour));
         }
         let orthonormal = (self.u_axis.length() - 1.0).abs() < 1e-4
             && (self.v_axis.length() - 1.0).abs() < 1e-4

@@ -70,6 +70,9 @@ pub struct LightSpec {
     /// Intensity; default 1.
     #[serde(default = "default_intensity")]
     pub intensity: f32,
+    /// Linear RGB colour of the light in the shaded image; default white, `[1, 1, 1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<[f32; 3]>,
 }
 
 /// `[[object]]`: a model file or a primitive, placed and given a role.
@@ -259,7 +262,7 @@ impl Manifest {
                         index,
                         problem: "normal is zero or not finite, or u_axis is parallel to it".into(),
                     })?;
-            scene.lights.push(built);
+            scene.lights.push(built.with_colour(light.colour.map_or(Vec3::ONE, Vec3::from_array)));
         }
         for mesh in &scene.meshes {
             mesh.validate(origin)?;
@@ -374,6 +377,7 @@ pub fn stage_model(model: &Path) -> Result<Manifest> {
             u_axis: Some([1.0, 0.0, 0.0]),
             size: [0.3 * extent; 2],
             intensity: 1.0,
+            colour: None,
         }],
         objects: vec![
             object(Some(file_name), None, Vec::new(), Role::Both, [0.0; 3]),
@@ -431,6 +435,11 @@ role = "occluder"
         assert!((occluder.centre() - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-5);
         // The box is 1 wide, scaled by 0.5 and turned 45° about Y: its half-diagonal is 0.5·√2/2.
         assert!((occluder.max.x - 0.25 * std::f32::consts::SQRT_2).abs() < 1e-4, "{}", occluder.max.x);
+        assert_eq!(scene.lights[0].colour, Vec3::ONE, "white unless given");
+        let orange = EXAMPLE.replace("size = [1.0, 1.0]", "size = [1.0, 1.0]\ncolour = [1.0, 0.5, 0.25]");
+        let manifest = Manifest::parse(&orange, Path::new("m.toml")).unwrap();
+        assert_eq!(manifest, Manifest::parse(&manifest.to_toml(), Path::new("m.toml")).unwrap());
+        assert_eq!(manifest.build(Path::new("m.toml"), Path::new(".")).unwrap().lights[0].colour, Vec3::new(1.0, 0.5, 0.25));
     }
 
     #[test]
@@ -452,6 +461,10 @@ role = "occluder"
         let zero_normal = EXAMPLE.replace("normal = [0.0, -1.0, 0.0]", "normal = [0.0, 0.0, 0.0]");
         let err = Manifest::parse(&zero_normal, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
         assert!(matches!(err, SceneError::InvalidLight { index: 0, .. }), "{err}");
+
+        let dark_red = EXAMPLE.replace("size = [1.0, 1.0]", "size = [1.0, 1.0]\ncolour = [1.0, -0.5, 0.0]");
+        let err = Manifest::parse(&dark_red, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();
+        assert!(matches!(err, SceneError::InvalidLight { index: 0, .. }) && err.to_string().contains("colour"), "{err}");
 
         let nan_light = EXAMPLE.replace("size = [1.0, 1.0]", "size = [nan, 1.0]");
         let err = Manifest::parse(&nan_light, Path::new("m.toml")).unwrap().build(Path::new("m.toml"), Path::new(".")).unwrap_err();

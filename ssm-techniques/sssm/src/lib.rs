@@ -639,6 +639,15 @@ const PRESETS: &[ssm_core::Preset] = &[
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
+        name: "sssm-lights",
+        summary: "Buades et al., Fig. 11: a scene lit by 1, 2 and 3 lights of different size and colour (the manifest's first N), SSSM and PCSS; frame time against the lights (run from the workspace's root)",
+        scenes: &["ssm-techniques/sssm/scenes/fig11-three-lights.toml"],
+        varies: &["scene.lights=1,2,3", "sssm", "pcss"],
+        x_axis: "scene.lights",
+        y_axis: "time",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
         name: "sssm-filter",
         summary: "Buades et al., Fig. 5: the mean filter against the Gaussian, error against the ground truth at Table 4's kernel pairs (the images: ssm compare with --set sssm.filter=mean)",
         scenes: &["leaves"],
