@@ -71,6 +71,10 @@ struct SweepArgs {
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
     pixels: Option<report::PixelSet>,
+    /// Also write every point's images (visibility, shaded, heat map against the ground truth, and
+    /// each scene point's ground truth) under `<out>/images/<scene point>/<technique>/<point>/`.
+    #[arg(long)]
+    images: bool,
     /// Output directory: sweep.csv, sweep.md (a Markdown table), sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
@@ -484,10 +488,21 @@ fn run_sweep(
         progress.set_message(format!("reference {scene_name}"));
         let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
         let covered = report::pixel_mask(&renderer, sweep.pixels)?;
+        let size = (args.width, args.height);
+        // Under <out>/images/<scene point>/ when asked: the ground truth, then each technique's points.
+        let images = args.images.then(|| sweep.out.join("images").join(sweep::path_component(&sweep::assignment_label(scene_point))));
+        let coverage = if images.is_some() { report::pixel_mask(&renderer, report::PixelSet::All)? } else { Vec::new() };
+        if let Some(dir) = &images {
+            report::write_images(&dir.join(reference_info.name), &reference, size, &coverage, None)?;
+        }
         progress.inc(1);
         for (info, params, technique_point) in &plan.points {
             progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
             let measured = report::measure(&mut renderer, info, params, args.frames, &[])?;
+            if let Some(dir) = &images {
+                let point_dir = dir.join(info.name).join(sweep::path_component(&sweep::assignment_label(technique_point)));
+                report::write_images(&point_dir, &measured, size, &coverage, Some((&reference, &covered)))?;
+            }
             rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
             let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
             all.extend(technique_point.iter().cloned());

@@ -192,6 +192,15 @@ impl SweepPlan {
     /// A malformed specification, an unknown technique or parameter, a bad value, or no technique varied.
     pub fn new(registry: &Registry, varies: &[String], settings: &[(&str, &str, &str)]) -> Result<Self> {
         let varies: Vec<Vary> = varies.iter().map(|s| Vary::parse(s)).collect::<Result<_>>()?;
+        // A parameter on two axes would be set twice per point, the later value silently winning.
+        let mut seen = std::collections::HashSet::new();
+        for vary in &varies {
+            for param in &vary.params {
+                if !seen.insert(format!("{}.{param}", vary.technique)) {
+                    bail!("{}.{param} is varied twice (by a --vary and the preset, say); give it one axis", vary.technique);
+                }
+            }
+        }
         let scene_axes: Vec<&Vary> = varies.iter().filter(|v| v.technique == SCENE_AXIS).collect();
         let mut techniques: Vec<&'static TechniqueInfo> = Vec::new();
         for vary in varies.iter().filter(|v| v.technique != SCENE_AXIS) {
@@ -473,6 +482,23 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
 #[must_use]
 pub fn point_label(varied: &[(String, String)]) -> String {
     varied.iter().map(|(_, v)| v.as_str()).collect::<Vec<_>>().join("/")
+}
+
+/// `name=value;name=value` of a grid point (the parameter names without their technique), or
+/// `defaults` for the empty point.
+#[must_use]
+pub fn assignment_label(point: &[(String, String)]) -> String {
+    if point.is_empty() {
+        return "defaults".to_owned();
+    }
+    point.iter().map(|(k, v)| format!("{}={v}", k.rsplit('.').next().unwrap_or(k))).collect::<Vec<_>>().join(";")
+}
+
+/// `label` as one file-name component: characters other than letters, digits, `.`, `-`, `_`
+/// and `=` become `_`.
+#[must_use]
+pub fn path_component(label: &str) -> String {
+    label.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_' | '=') { c } else { '_' }).collect()
 }
 
 /// One point of a plot.
@@ -773,6 +799,15 @@ mod tests {
         }
         // The sweep's own parameters need no built-in scene.
         assert!(point("occluder_shift", "0.5").check_scene("scene.toml").is_ok());
+    }
+
+    #[test]
+    fn image_folders_are_named_by_the_points_assignments() {
+        let point = vec![("atty.occluder_map_size".to_owned(), "128".to_owned()), ("atty.two_sided".to_owned(), "true".to_owned())];
+        assert_eq!(assignment_label(&point), "occluder_map_size=128;two_sided=true");
+        assert_eq!(path_component(&assignment_label(&point)), "occluder_map_size=128_two_sided=true");
+        assert_eq!(assignment_label(&[]), "defaults");
+        assert_eq!(path_component("a/b:c d"), "a_b_c_d");
     }
 
     #[test]

@@ -20,6 +20,12 @@ fn every_preset_resolves_against_the_registry() {
         assert!(!plan.points.is_empty(), "preset {} has no point", spec.name);
         assert!(spec.x_axis == "time" || plan.varied.contains(&spec.x_axis), "preset {}: x axis {} is not varied", spec.name, spec.x_axis);
         assert!(!spec.scenes.is_empty(), "preset {} names no scene", spec.name);
+        // Scene axes (a built-in scene's own parameters among them) fit every scene it names.
+        for overrides in &plan.scene_overrides {
+            for scene in &spec.scenes {
+                overrides.check_scene(scene).unwrap_or_else(|e| panic!("preset {}: scene {scene}: {e:#}", spec.name));
+            }
+        }
         for scene in &spec.scenes {
             // Built-in names load; manifests are resolved from the repository's root.
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);
@@ -43,4 +49,16 @@ fn trade_takes_every_techniques_quality_knob() {
     }
     let with_knobs = registry.iter().filter(|i| i.trade.is_some()).count();
     assert!(with_knobs >= 5, "only {with_knobs} techniques declare a quality knob");
+}
+
+/// A parameter on two axes would be set twice at every point, the later value silently winning:
+/// refused with its name.
+#[test]
+fn a_parameter_varied_twice_is_refused() {
+    let registry = registry().unwrap();
+    let twice = ["pcss.pcf_kernel=7,15".to_owned(), "pcss.blocker_kernel:pcf_kernel=3:5,7:9".to_owned()];
+    let error = SweepPlan::new(registry, &twice, &[]).unwrap_err();
+    assert!(format!("{error:#}").contains("pcss.pcf_kernel is varied twice"), "{error:#}");
+    let scene_twice = ["scene.light_scale=1,2".to_owned(), "scene.light_scale=3".to_owned(), "pcss".to_owned()];
+    assert!(SweepPlan::new(registry, &scene_twice, &[]).is_err());
 }

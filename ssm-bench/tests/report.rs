@@ -193,6 +193,7 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
             "scene.light_scale",
             "--pixels",
             "receivers",
+            "--images",
             "--set",
             "reference.samples=6",
             "--width",
@@ -218,6 +219,15 @@ fn sweep_varies_the_scene_and_plots_against_a_parameter() {
     assert!(penumbra[1] > penumbra[0], "{penumbra:?}");
     let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
     assert!(svg.contains("scene.light_scale") && !svg.contains("Pareto front"), "parameter axis, no Pareto front");
+    // --images: each scene point's ground truth and each technique point's images.
+    for scale in ["0.5", "2"] {
+        let scene_point = out.join("images").join(format!("light_scale={scale}"));
+        assert!(scene_point.join("reference").join("visibility.png").is_file(), "{}", scene_point.display());
+        let point = scene_point.join(first.name).join(format!("{param}={default}"));
+        for file in ["visibility.png", "visibility.exr", "shaded.png", "heatmap.png"] {
+            assert!(point.join(file).is_file(), "{}/{file}", point.display());
+        }
+    }
     let bad =
         ssm(&["sweep", "--scene", "parallel-square", "--vary", "scene.colour=1", "--vary", &fixed_point, "--out", out.to_str().unwrap()]);
     let message = String::from_utf8_lossy(&bad.stderr);
