@@ -3,6 +3,7 @@
 //! facade), the bench image size, and the rendering of one technique to files.
 
 pub mod report;
+pub mod shard;
 pub mod sweep;
 
 use std::path::Path;

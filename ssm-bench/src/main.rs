@@ -1,12 +1,13 @@
 //! `ssm`: render scenes with any registered soft-shadow technique.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use ssm_bench::shard::Varied;
 use ssm_bench::{
     check_debug_outputs, debug_outputs_for, output_requirements, registry, render_technique, report, support_on, sweep, write_positions,
 };
@@ -32,6 +33,18 @@ enum Command {
     Compare(CompareArgs),
     /// Vary techniques' parameters over a grid; write sweep.csv, sweep.md and the time-against-error plot (PNG, SVG).
     Sweep(SweepArgs),
+    /// Put the shards of a sweep (`ssm sweep --shard K/N` outputs) back together: sweep.csv, sweep.md and the plot.
+    Merge(MergeArgs),
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The shards' output folders (each holds sweep.csv and shard.json), every shard of one sweep once.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Output directory: sweep.csv, sweep.md, sweep.png and sweep.svg, as the unsharded sweep writes them.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -71,6 +84,10 @@ struct SweepArgs {
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
     pixels: Option<report::PixelSet>,
+    /// Run only shard K of N (`2/3`): the K-th of N contiguous blocks of the sweep's runs, in the
+    /// unsharded order; `shard.json` beside `sweep.csv` records them for `ssm merge`.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<ssm_bench::shard::Shard>,
     /// Also write every point's images (visibility, shaded, heat map against the ground truth, and
     /// each scene point's ground truth) under `<out>/images/<scene point>/<technique>/<point>/`.
     #[arg(long)]
@@ -174,6 +191,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render(&args),
         Command::Compare(args) => compare(&args),
         Command::Sweep(args) => sweep_command(&args),
+        Command::Merge(args) => merge_command(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -388,11 +406,14 @@ fn compare(args: &CompareArgs) -> Result<()> {
 }
 
 /// Every varied value of one sweep row, `(qualified parameter, value)`, scene ones first.
-type VariedValues = Vec<(String, String)>;
+/// What a sweep measured: its rows and, per row, its run's number and varied values.
+type SweepRows = (Vec<report::Row>, Vec<(usize, Varied)>);
 
 /// A sweep with every default resolved: the scene, the axes, the pixels and the plan.
 struct ResolvedSweep {
     scene_spec: String,
+    /// Every `--vary` specification, the preset's after the command line's.
+    specs: Vec<String>,
     out: PathBuf,
     plan: sweep::SweepPlan,
     x_axis: String,
@@ -450,18 +471,19 @@ fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&
     }
     let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::MaePenumbra);
     let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(report::PixelSet::All);
-    Ok(ResolvedSweep { scene_spec, out, plan, x_axis, error, pixels })
+    Ok(ResolvedSweep { scene_spec, specs, out, plan, x_axis, error, pixels })
 }
 
-/// Measures every point of the plan, each scene point with its own renderer and ground truth;
-/// returns the rows and, per row, every varied value (scene ones first).
+/// Measures every point of the plan (or of `args.shard`'s runs), each scene point with its own
+/// renderer and ground truth; returns the rows and, per row, its run's number in the unsharded
+/// order and every varied value (scene ones first).
 fn run_sweep(
     gpu: &GpuContext,
     args: &SweepArgs,
     registry: &ssm_core::Registry,
     sweep: &ResolvedSweep,
     settings: &[(&str, &str, &str)],
-) -> Result<(Vec<report::Row>, Vec<VariedValues>)> {
+) -> Result<SweepRows> {
     let base_scene = load_scene(&sweep.scene_spec)?;
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
@@ -471,10 +493,20 @@ fn run_sweep(
         needs = needs.union((info.requirements)(params)?);
     }
     let plan = &sweep.plan;
-    let progress = ProgressBar::new(((plan.points.len() + 1) * plan.scene_points.len()) as u64);
+    // The runs this process measures: all, or its shard's block of them.
+    let total = plan.scene_points.len() * plan.points.len();
+    let runs = args.shard.map_or(0..total, |shard| shard.runs(total));
+    let scene_points_run =
+        plan.scene_points.len().min(runs.clone().map(|r| r / plan.points.len()).collect::<std::collections::BTreeSet<_>>().len());
+    let progress = ProgressBar::new((runs.len() + scene_points_run) as u64);
     progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
     let (mut rows, mut varied) = (Vec::new(), Vec::new());
-    for (scene_point, overrides) in plan.scene_points.iter().zip(&plan.scene_overrides) {
+    for (scene_index, (scene_point, overrides)) in plan.scene_points.iter().zip(&plan.scene_overrides).enumerate() {
+        let first_run = scene_index * plan.points.len();
+        // A scene point none of whose runs are this shard's: no renderer, no ground truth.
+        if !(first_run..first_run + plan.points.len()).any(|run| runs.contains(&run)) {
+            continue;
+        }
         let scene = overrides
             .base_scene(&sweep.scene_spec, &base_scene)
             .and_then(|base| overrides.apply(&base))
@@ -496,7 +528,11 @@ fn run_sweep(
             report::write_images(&dir.join(reference_info.name), &reference, size, &coverage, None)?;
         }
         progress.inc(1);
-        for (info, params, technique_point) in &plan.points {
+        for (point_index, (info, params, technique_point)) in plan.points.iter().enumerate() {
+            let run = first_run + point_index;
+            if !runs.contains(&run) {
+                continue;
+            }
             progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
             let measured = report::measure(&mut renderer, info, params, args.frames, &[])?;
             if let Some(dir) = &images {
@@ -506,7 +542,7 @@ fn run_sweep(
             rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
             let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
             all.extend(technique_point.iter().cloned());
-            varied.push(all);
+            varied.push((run, all));
             progress.inc(1);
         }
     }
@@ -514,15 +550,23 @@ fn run_sweep(
     Ok((rows, varied))
 }
 
+/// What a sweep's outputs are written from, whether measured here or merged from shards.
+struct SweepOutput<'a> {
+    out: &'a Path,
+    /// The preset's name, or `custom`.
+    name: &'a str,
+    /// The adapter's name for `sweep.md`'s header (several, joined, for a merge across machines).
+    adapter: &'a str,
+    size: (u32, u32),
+    frames: u32,
+    scene_spec: &'a str,
+    x_axis: &'a str,
+    error: sweep::ErrorAxis,
+}
+
 /// `sweep.csv`, the plot (PNG and SVG) and the table on stdout.
-fn write_sweep(
-    gpu: &GpuContext,
-    args: &SweepArgs,
-    sweep: &ResolvedSweep,
-    rows: &[report::Row],
-    varied: &[Vec<(String, String)>],
-) -> Result<()> {
-    let (out, x_axis, error) = (&sweep.out, &sweep.x_axis, sweep.error);
+fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(String, String)>]) -> Result<()> {
+    let (out, x_axis, error) = (output.out, output.x_axis, output.error);
     std::fs::write(out.join("sweep.csv"), report::csv(rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
     let table: Vec<sweep::MarkdownRow> = rows
         .iter()
@@ -540,8 +584,7 @@ fn write_sweep(
             }
         })
         .collect();
-    let name = args.preset.as_deref().unwrap_or("custom");
-    let markdown = sweep::markdown(name, &gpu.info.name, (args.width, args.height), args.frames, &table);
+    let markdown = sweep::markdown(output.name, output.adapter, output.size, output.frames, &table);
     std::fs::write(out.join("sweep.md"), markdown).with_context(|| format!("writing {}", out.join("sweep.md").display()))?;
     // One series per technique and combination of the varied values that are not on the x axis.
     let plot_points: Vec<sweep::PlotPoint> = rows
@@ -566,12 +609,12 @@ fn write_sweep(
         })
         .collect();
     let axes = sweep::PlotAxes {
-        x_label: if x_axis == "time" { "time per frame, ms (log)".to_owned() } else { x_axis.clone() },
+        x_label: if x_axis == "time" { "time per frame, ms (log)".to_owned() } else { x_axis.to_owned() },
         y_label: format!("{} (log)", error.label()),
         log_x: x_axis == "time",
         pareto: x_axis == "time" && error != sweep::ErrorAxis::Time,
     };
-    let title = format!("{} at {}x{} on {}", sweep.scene_spec, args.width, args.height, gpu.info.name);
+    let title = format!("{} at {}x{} on {}", output.scene_spec, output.size.0, output.size.1, output.adapter);
     sweep::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
     let front = if axes.pareto { sweep::pareto_front(&plot_points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>()) } else { Vec::new() };
     for (index, (row, values)) in rows.iter().zip(varied).enumerate() {
@@ -608,6 +651,62 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
     let sweep = resolve_sweep(args, registry, &settings)?;
     let gpu = GpuContext::new()?;
     std::fs::create_dir_all(&sweep.out).with_context(|| format!("creating {}", sweep.out.display()))?;
-    let (rows, varied) = run_sweep(&gpu, args, registry, &sweep, &settings)?;
-    write_sweep(&gpu, args, &sweep, &rows, &varied)
+    let (rows, runs) = run_sweep(&gpu, args, registry, &sweep, &settings)?;
+    if let Some(shard) = args.shard {
+        let identity = ssm_bench::shard::SweepIdentity {
+            ssm_version: env!("CARGO_PKG_VERSION").to_owned(),
+            preset: args.preset.clone(),
+            scene: sweep.scene_spec.clone(),
+            varies: sweep.specs.clone(),
+            settings: args.settings.clone(),
+            size: (args.width, args.height),
+            frames: args.frames,
+            pixels: sweep_pixels_name(sweep.pixels),
+            x_axis: sweep.x_axis.clone(),
+            error: sweep_axis_name(sweep.error),
+            runs: sweep.plan.scene_points.len() * sweep.plan.points.len(),
+        };
+        let record = ssm_bench::shard::ShardRecord { identity, shard, adapter: gpu.info.name.clone(), rows: runs.clone() };
+        record.write(&sweep.out)?;
+    }
+    let varied: Vec<Varied> = runs.into_iter().map(|(_, values)| values).collect();
+    let output = SweepOutput {
+        out: &sweep.out,
+        name: args.preset.as_deref().unwrap_or("custom"),
+        adapter: &gpu.info.name,
+        size: (args.width, args.height),
+        frames: args.frames,
+        scene_spec: &sweep.scene_spec,
+        x_axis: &sweep.x_axis,
+        error: sweep.error,
+    };
+    write_sweep(&output, &rows, &varied)
+}
+
+fn merge_command(args: &MergeArgs) -> Result<()> {
+    let merged = ssm_bench::shard::merge(&args.shards)?;
+    let identity = &merged.identity;
+    let error = <sweep::ErrorAxis as clap::ValueEnum>::from_str(&identity.error, true)
+        .map_err(|e| anyhow::anyhow!("the shards' error axis `{}`: {e}", identity.error))?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    if merged.adapters.len() > 1 {
+        say!(
+            "note: the shards ran on {} adapters ({}); compare times within one shard's rows only",
+            merged.adapters.len(),
+            merged.adapters.join("; ")
+        );
+    }
+    let adapter = merged.adapters.join(" + ");
+    let output = SweepOutput {
+        out: &args.out,
+        name: identity.preset.as_deref().unwrap_or("custom"),
+        adapter: &adapter,
+        size: identity.size,
+        frames: identity.frames,
+        scene_spec: &identity.scene,
+        x_axis: &identity.x_axis,
+        error,
+    };
+    say!("merged {} shards of {} runs", args.shards.len(), identity.runs);
+    write_sweep(&output, &merged.rows, &merged.varied)
 }

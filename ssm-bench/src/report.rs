@@ -419,6 +419,125 @@ pub fn csv(rows: &[Row]) -> String {
     out
 }
 
+/// Rows from the text of a `results.csv` or `sweep.csv` that [`csv`] wrote (what `ssm merge`
+/// reads back). The CSV does not hold the image names or the count of compared pixels: they come
+/// back empty. Numbers come back as printed, so that writing the rows again gives the same text.
+///
+/// # Errors
+/// A header other than [`CSV_COLUMNS`], a row with another number of fields, or a field that
+/// does not parse, naming the line and the column.
+pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
+    use anyhow::Context as _;
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default();
+    if header != CSV_COLUMNS.join(",") {
+        anyhow::bail!("the header is not ssm's CSV header ({})", CSV_COLUMNS.join(","));
+    }
+    lines
+        .enumerate()
+        .filter(|(_, line)| !line.is_empty())
+        .map(|(index, line)| {
+            let line_number = index + 2;
+            let fields = split_csv_line(line).with_context(|| format!("line {line_number}"))?;
+            if fields.len() != CSV_COLUMNS.len() {
+                anyhow::bail!("line {line_number}: {} fields, expected {}", fields.len(), CSV_COLUMNS.len());
+            }
+            let field = |name: &str| -> &str {
+                let column = CSV_COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
+                fields[column].as_str()
+            };
+            let float = |name: &str| -> anyhow::Result<f64> {
+                match field(name) {
+                    "" => Ok(f64::NAN),
+                    text => text.parse().with_context(|| format!("line {line_number}, {name}: `{text}` is not a number")),
+                }
+            };
+            let optional =
+                |name: &str| -> anyhow::Result<Option<f64>> { if field(name).is_empty() { Ok(None) } else { float(name).map(Some) } };
+            let whole = |name: &str| -> anyhow::Result<usize> {
+                field(name).parse().with_context(|| format!("line {line_number}, {name}: `{}` is not a whole number", field(name)))
+            };
+            let pairs = |name: &str| -> anyhow::Result<Vec<(String, f64)>> {
+                field(name)
+                    .split(';')
+                    .filter(|p| !p.is_empty())
+                    .map(|pair| {
+                        let (key, value) =
+                            pair.split_once('=').with_context(|| format!("line {line_number}, {name}: `{pair}` is not key=value"))?;
+                        Ok((
+                            key.to_owned(),
+                            value.parse().with_context(|| format!("line {line_number}, {name}: `{value}` is not a number"))?,
+                        ))
+                    })
+                    .collect()
+            };
+            Ok(Row {
+                scene: field("scene").to_owned(),
+                technique: field("technique").to_owned(),
+                light: match field("light") {
+                    "all" => None,
+                    _ => Some(whole("light")?),
+                },
+                params: field("params").to_owned(),
+                width: u32::try_from(whole("width")?).context("width")?,
+                height: u32::try_from(whole("height")?).context("height")?,
+                gpu_ms_median: optional("gpu_ms_median")?,
+                gpu_ms_min: optional("gpu_ms_min")?,
+                cpu_ms: float("cpu_ms")?,
+                metrics: ErrorMetrics {
+                    mae_penumbra: float("mae_penumbra")?,
+                    rmse: float("rmse")?,
+                    max_abs: float("max_abs")?,
+                    psnr: float("psnr")?,
+                    ssim: float("ssim")?,
+                    frac_over_0_05: float("frac_over_0_05")?,
+                    mean_signed: float("mean_signed_error")?,
+                    pixels: 0,
+                    penumbra_pixels: whole("penumbra_pixels")?,
+                    umbra_pixels: whole("umbra_pixels")?,
+                },
+                flip: float("flip_mean")?,
+                adapter: field("adapter").to_owned(),
+                timing_source: match field("timing_source") {
+                    "gpu_timestamps" => TimingSource::GpuTimestamps,
+                    "cpu_wall_only" => TimingSource::CpuWallOnly,
+                    other => anyhow::bail!("line {line_number}, timing_source: `{other}` is neither gpu_timestamps nor cpu_wall_only"),
+                },
+                passes: pairs("passes_ms")?,
+                diagnostics: pairs("diagnostics")?,
+                extra_images: Vec::new(),
+                overlays: Vec::new(),
+            })
+        })
+        .collect()
+}
+
+/// The fields of one CSV line: separated by commas, a field in double quotes may hold commas and
+/// doubled quotes (as [`csv_field`] writes them).
+fn split_csv_line(line: &str) -> anyhow::Result<Vec<String>> {
+    let mut fields = Vec::new();
+    let mut field = String::new();
+    let mut chars = line.chars().peekable();
+    let mut quoted = false;
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', false) if field.is_empty() => quoted = true,
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', true) => quoted = false,
+            (',', false) => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    if quoted {
+        anyhow::bail!("a quoted field is not closed");
+    }
+    fields.push(field);
+    Ok(fields)
+}
+
 /// The columns of the report tables (Markdown and HTML).
 const TABLE_HEADER: [&str; 11] =
     ["technique", "params", "GPU ms (median)", "GPU ms (min)", "MAE penumbra", "RMSE", "max", "PSNR dB", "SSIM", "> 0.05", "FLIP"];
@@ -612,6 +731,47 @@ mod tests {
         assert_eq!(csv_field("q\",x"), "\"q\"\",x\"");
         assert_eq!(number(Some(f64::INFINITY), 2), "inf");
         assert_eq!(number(None, 2), "");
+    }
+
+    #[test]
+    fn rows_read_back_from_their_csv_give_the_same_csv() {
+        let row = |technique: &str, light: Option<usize>, gpu: Option<f64>| Row {
+            scene: "parallel-square[light_scale=0.5]".into(),
+            technique: technique.into(),
+            light,
+            params: "a=1;b=x,y".into(),
+            width: 96,
+            height: 72,
+            gpu_ms_median: gpu,
+            gpu_ms_min: gpu,
+            cpu_ms: 12.5,
+            metrics: ErrorMetrics {
+                mae_penumbra: 0.0123456,
+                rmse: 0.5,
+                max_abs: 1.0,
+                psnr: f64::INFINITY,
+                ssim: 0.987654321,
+                frac_over_0_05: 0.25,
+                mean_signed: -0.001,
+                pixels: 0,
+                penumbra_pixels: 17,
+                umbra_pixels: 3,
+            },
+            flip: 0.1,
+            adapter: "llvmpipe \"x\", y".into(),
+            timing_source: if gpu.is_some() { TimingSource::GpuTimestamps } else { TimingSource::CpuWallOnly },
+            passes: vec![("hard_shadow_map".into(), 1.25), ("hard_filter".into(), 2.0)],
+            diagnostics: vec![("memory_mib".into(), 4.0)],
+            extra_images: Vec::new(),
+            overlays: Vec::new(),
+        };
+        let rows = vec![row("hard", None, Some(3.25)), row("pcss", Some(1), None)];
+        let text = csv(&rows);
+        let back = parse_csv(&text).unwrap();
+        assert_eq!(csv(&back), text);
+        assert_eq!((back[1].light, back[0].metrics.penumbra_pixels, back[0].adapter.as_str()), (Some(1), 17, "llvmpipe \"x\", y"));
+        assert!(parse_csv("scene,technique\n").is_err(), "another header");
+        assert!(parse_csv(&text.replace("96,72", "96")).is_err(), "a field missing");
     }
 
     #[test]

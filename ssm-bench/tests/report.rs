@@ -256,3 +256,83 @@ fn the_memory_a_technique_holds_is_reported() {
     println!("hard: {small} MiB at 512², {large} MiB at 1024²");
     assert!(small > 0.0 && (large / small - 4.0).abs() < 0.1, "{small} MiB, {large} MiB");
 }
+
+/// A sweep split into 3 shards (`--shard K/3`) and merged (`ssm merge`) equals the unsharded
+/// sweep row for row, times aside; the second shard straddles the two scene points. A missing
+/// shard and a shard of another sweep are refused.
+#[test]
+fn three_shards_merged_equal_the_unsharded_sweep() {
+    let cache = scratch("shard-cache");
+    let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_ssm")).env("SSM_CACHE_DIR", &cache).args(args).output().unwrap();
+    let sweep = |out: &Path, frames: &str, extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            "--scene",
+            "parallel-square",
+            "--vary",
+            "scene.light_scale=0.5,2",
+            "--vary",
+            "hard.shadow_map_size=256,512,1024",
+            "--set",
+            "reference.samples=4",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            frames,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let output = run(&args);
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    };
+    let whole = scratch("shard-whole");
+    sweep(&whole, "1", &[]);
+    let shards: Vec<PathBuf> = (1..=3).map(|k| scratch(&format!("shard-{k}"))).collect();
+    for (k, dir) in shards.iter().enumerate() {
+        sweep(dir, "1", &["--shard", &format!("{}/3", k + 1)]);
+        let rows = std::fs::read_to_string(dir.join("sweep.csv")).unwrap().lines().count() - 1;
+        assert_eq!(rows, 2, "6 runs in 3 shards: 2 each");
+    }
+    let merged = scratch("shard-merged");
+    let mut args = vec!["merge", "--out", merged.to_str().unwrap()];
+    // Given in another order: the merge puts the rows back in the unsharded order.
+    args.extend(shards.iter().rev().map(|d| d.to_str().unwrap()));
+    let output = run(&args);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    // Every column but the times.
+    let untimed = |dir: &Path| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+        let header = text.lines().next().unwrap().to_owned();
+        let timed: Vec<usize> = ["gpu_ms_median", "gpu_ms_min", "cpu_ms", "passes_ms"].iter().map(|c| column(&header, c)).collect();
+        text.lines()
+            .map(|line| split_csv(line).into_iter().enumerate().map(|(i, f)| if timed.contains(&i) { String::new() } else { f }).collect())
+            .collect()
+    };
+    let (expected, got) = (untimed(&whole), untimed(&merged));
+    assert_eq!(expected.len(), 7, "a header and 6 rows");
+    assert_eq!(got, expected);
+    for file in ["sweep.md", "sweep.png", "sweep.svg"] {
+        assert!(merged.join(file).is_file(), "{file}");
+    }
+    // Two of three shards, and a shard of another sweep, are refused.
+    let missing = run(&["merge", "--out", merged.to_str().unwrap(), shards[0].to_str().unwrap(), shards[2].to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("shard 2/3 is missing"), "{}", String::from_utf8_lossy(&missing.stderr));
+    let other = scratch("shard-other");
+    sweep(&other, "2", &["--shard", "2/3"]);
+    let mixed = run(&[
+        "merge",
+        "--out",
+        merged.to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+    ]);
+    let message = String::from_utf8_lossy(&mixed.stderr);
+    assert!(message.contains("shards of different sweeps (frames: 1 against 2)"), "{message}");
+    for dir in shards.iter().chain([&whole, &merged, &other, &cache]) {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
