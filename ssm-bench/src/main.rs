@@ -24,9 +24,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// List the registered techniques with their parameters, requirements and whether this adapter runs them.
-    List,
+    List(FormatArgs),
     /// List the built-in scenes and their parameters (`--scene forest:triangles=800000`).
-    Scenes,
+    Scenes(FormatArgs),
     /// Render a scene with one or more techniques and write images and timings.
     Render(RenderArgs),
     /// Render every technique (or those named) and the ground truth; write results.csv, report.md and index.html.
@@ -37,11 +37,30 @@ enum Command {
     Merge(MergeArgs),
 }
 
+/// How a command prints what it found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Format {
+    /// Lines for people.
+    Text,
+    /// One JSON document on stdout, for scripts (progress and notes go to stderr).
+    Json,
+}
+
+#[derive(clap::Args)]
+struct FormatArgs {
+    /// `text` for people, `json` for scripts.
+    #[arg(long, value_enum, default_value = "text")]
+    format: Format,
+}
+
 #[derive(clap::Args)]
 struct MergeArgs {
     /// The shards' output folders (each holds sweep.csv and shard.json), every shard of one sweep once.
     #[arg(required = true)]
     shards: Vec<PathBuf>,
+    /// `text`: a line per point on stdout; `json`: the rows and their varied values as one JSON document.
+    #[arg(long, value_enum, default_value = "text")]
+    format: Format,
     /// Output directory: sweep.csv, sweep.md, sweep.png and sweep.svg, as the unsharded sweep writes them.
     #[arg(long)]
     out: PathBuf,
@@ -84,6 +103,9 @@ struct SweepArgs {
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
     pixels: Option<report::PixelSet>,
+    /// `text`: a line per point on stdout; `json`: the rows and their varied values as one JSON document.
+    #[arg(long, value_enum, default_value = "text")]
+    format: Format,
     /// Run only shard K of N (`2/3`): the K-th of N contiguous blocks of the sweep's runs, in the
     /// unsharded order; `shard.json` beside `sweep.csv` records them for `ssm merge`.
     #[arg(long, value_name = "K/N")]
@@ -124,6 +146,12 @@ struct CompareArgs {
     /// shows what each technique offers; `all`: every one).
     #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
     debug_outputs: Vec<String>,
+    /// `text`: the report's table on stdout; `json`: the rows as one JSON document (for scripts).
+    #[arg(long, value_enum, default_value = "text")]
+    format: Format,
+    /// Open index.html in the default browser when done.
+    #[arg(long)]
+    open: bool,
     /// Output directory: results.csv, report.md, index.html and one folder of images per technique.
     #[arg(long)]
     out: PathBuf,
@@ -186,8 +214,8 @@ fn main() -> ExitCode {
     quiet_window_system_layers();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::List => list(),
-        Command::Scenes => scenes(),
+        Command::List(args) => list(args.format),
+        Command::Scenes(args) => scenes(args.format),
         Command::Render(args) => render(&args),
         Command::Compare(args) => compare(&args),
         Command::Sweep(args) => sweep_command(&args),
@@ -209,9 +237,38 @@ fn main() -> ExitCode {
     }
 }
 
-fn list() -> Result<()> {
+fn list(format: Format) -> Result<()> {
     let registry = registry()?;
     let gpu = GpuContext::new();
+    if format == Format::Json {
+        let techniques = registry
+            .iter()
+            .map(|info| {
+                let requirements = (info.requirements)(&info.default_params())?;
+                Ok(serde_json::json!({
+                    "name": info.name,
+                    "summary": info.summary,
+                    "paper": info.paper,
+                    "kind": format!("{:?}", info.kind).to_lowercase(),
+                    "needs": requirements.describe(),
+                    "runs_here": gpu.as_ref().ok().map(|gpu| support_on(gpu, info)),
+                    "params": info.params.iter().map(|spec| serde_json::json!({
+                        "name": spec.name,
+                        "default": spec.default_value().to_string(),
+                        "range": spec.range_text(),
+                        "doc": spec.doc,
+                    })).collect::<Vec<_>>(),
+                    "debug_outputs": info.debug_outputs.iter().map(|o| serde_json::json!({
+                        "name": o.name, "doc": o.doc, "overlay": o.overlay,
+                    })).collect::<Vec<_>>(),
+                    "presets": info.presets.iter().map(|p| p.name).collect::<Vec<_>>(),
+                }))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let adapter = gpu.as_ref().map_or(serde_json::Value::Null, |gpu| serde_json::Value::String(gpu.describe()));
+        say!("{}", serde_json::to_string_pretty(&serde_json::json!({ "adapter": adapter, "techniques": techniques }))?);
+        return Ok(());
+    }
     match &gpu {
         Ok(gpu) => say!("adapter: {}\n", gpu.describe()),
         Err(e) => say!("adapter: none ({e})\n"),
@@ -235,7 +292,24 @@ fn list() -> Result<()> {
     Ok(())
 }
 
-fn scenes() -> Result<()> {
+fn scenes(format: Format) -> Result<()> {
+    if format == Format::Json {
+        let scenes: Vec<serde_json::Value> = BUILTIN_SCENES
+            .iter()
+            .map(|scene| {
+                serde_json::json!({
+                    "name": scene.name,
+                    "triangles": scene.build().triangle_count(),
+                    "summary": scene.summary,
+                    "params": scene.params.iter().map(|p| serde_json::json!({
+                        "name": p.name, "default": p.default, "min": p.min, "max": p.max, "doc": p.doc,
+                    })).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        say!("{}", serde_json::to_string_pretty(&scenes)?);
+        return Ok(());
+    }
     for scene in BUILTIN_SCENES {
         let built = scene.build();
         say!("{:<16} {:>7} triangles  {}", scene.name, built.triangle_count(), scene.summary);
@@ -244,6 +318,16 @@ fn scenes() -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A progress bar on stderr with the elapsed time and an estimate of the time left.
+fn progress_bar(len: u64) -> ProgressBar {
+    let progress = ProgressBar::new(len);
+    progress.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} ({elapsed}, about {eta} left)")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    progress
 }
 
 /// Splits `technique.param=value`.
@@ -255,7 +339,7 @@ fn parse_setting(text: &str) -> Result<(&str, &str, &str)> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     let registry = registry()?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, Format::Text)?;
     let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
     for (technique, _, _) in &settings {
         if !args.technique.iter().any(|t| t == technique) {
@@ -277,8 +361,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
-    let progress = ProgressBar::new(runs.len() as u64);
-    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let progress = progress_bar(runs.len() as u64);
     for (info, params) in &runs {
         progress.set_message(info.name);
         let dir = args.out.join(info.name);
@@ -304,12 +387,23 @@ fn render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-fn load_scene(spec: &str) -> Result<Scene> {
+/// Loads `spec` and says what it holds: on stdout, or on stderr when stdout carries `Format::Json`.
+fn load_scene(spec: &str, format: Format) -> Result<Scene> {
     let (scene, source) = Scene::load(spec).with_context(|| format!("loading scene `{spec}`"))?;
+    let mut notes = String::new();
     if let SceneSource::StagedModel(manifest) = &source {
-        say!("# staged scene for {spec} (save beside the model and edit):\n{}", manifest.to_toml());
+        notes += &format!("# staged scene for {spec} (save beside the model and edit):\n{}\n", manifest.to_toml());
     }
-    say!("scene: {spec} ({} triangles, {} instances, {} lights)", scene.triangle_count(), scene.instances.len(), scene.lights.len());
+    notes += &format!(
+        "scene: {spec} ({} triangles, {} instances, {} lights)",
+        scene.triangle_count(),
+        scene.instances.len(),
+        scene.lights.len()
+    );
+    match format {
+        Format::Text => say!("{notes}"),
+        Format::Json => eprintln!("{notes}"),
+    }
     Ok(scene)
 }
 
@@ -320,7 +414,7 @@ fn params_for(info: &'static TechniqueInfo, settings: &[(&str, &str, &str)]) -> 
 
 fn compare(args: &CompareArgs) -> Result<()> {
     let registry = registry()?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, args.format)?;
     let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
@@ -360,8 +454,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
-    let progress = ProgressBar::new(runs.len() as u64 + 1);
-    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let progress = progress_bar(runs.len() as u64 + 1);
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
     let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
@@ -400,12 +493,24 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let markdown = report::markdown_report(&context, &rows);
     write("report.md", markdown.clone())?;
     write("index.html", report::html_report(&context, &rows, reference_info.name))?;
-    say!("{markdown}");
-    say!("wrote {}", args.out.join("index.html").display());
+    let index = args.out.join("index.html");
+    match args.format {
+        Format::Text => {
+            say!("{markdown}");
+            say!("wrote results.csv, report.md and the images under {}", args.out.display());
+            say!("report: {} (open it in a browser, or run with --open)", index.display());
+        }
+        Format::Json => say!("{}", serde_json::to_string_pretty(&rows.iter().map(report::row_json).collect::<Vec<_>>())?),
+    }
+    if args.open {
+        // Not a failure when there is no browser: the report is written.
+        if let Err(error) = opener::open(&index) {
+            eprintln!("note: could not open {} in a browser: {error}", index.display());
+        }
+    }
     Ok(())
 }
 
-/// Every varied value of one sweep row, `(qualified parameter, value)`, scene ones first.
 /// What a sweep measured: its rows and, per row, its run's number and varied values.
 type SweepRows = (Vec<report::Row>, Vec<(usize, Varied)>);
 
@@ -484,7 +589,7 @@ fn run_sweep(
     sweep: &ResolvedSweep,
     settings: &[(&str, &str, &str)],
 ) -> Result<SweepRows> {
-    let base_scene = load_scene(&sweep.scene_spec)?;
+    let base_scene = load_scene(&sweep.scene_spec, args.format)?;
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
     let reference_params = params_for(reference_info, settings)?;
@@ -498,8 +603,7 @@ fn run_sweep(
     let runs = args.shard.map_or(0..total, |shard| shard.runs(total));
     let scene_points_run =
         plan.scene_points.len().min(runs.clone().map(|r| r / plan.points.len()).collect::<std::collections::BTreeSet<_>>().len());
-    let progress = ProgressBar::new((runs.len() + scene_points_run) as u64);
-    progress.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let progress = progress_bar((runs.len() + scene_points_run) as u64);
     let (mut rows, mut varied) = (Vec::new(), Vec::new());
     for (scene_index, (scene_point, overrides)) in plan.scene_points.iter().zip(&plan.scene_overrides).enumerate() {
         let first_run = scene_index * plan.points.len();
@@ -562,6 +666,7 @@ struct SweepOutput<'a> {
     scene_spec: &'a str,
     x_axis: &'a str,
     error: sweep::ErrorAxis,
+    format: Format,
 }
 
 /// `sweep.csv`, the plot (PNG and SVG) and the table on stdout.
@@ -617,6 +722,29 @@ fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(St
     let title = format!("{} at {}x{} on {}", output.scene_spec, output.size.0, output.size.1, output.adapter);
     sweep::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
     let front = if axes.pareto { sweep::pareto_front(&plot_points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>()) } else { Vec::new() };
+    if output.format == Format::Json {
+        let json: Vec<serde_json::Value> = rows
+            .iter()
+            .zip(varied)
+            .enumerate()
+            .map(|(index, (row, values))| {
+                let mut value = report::row_json(row);
+                value["varied"] =
+                    values.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>().into();
+                value["pareto"] = front.contains(&index).into();
+                value
+            })
+            .collect();
+        say!("{}", serde_json::to_string_pretty(&json)?);
+        eprintln!(
+            "wrote {}, {}, {} and {}",
+            out.join("sweep.csv").display(),
+            out.join("sweep.md").display(),
+            out.join("sweep.png").display(),
+            out.join("sweep.svg").display()
+        );
+        return Ok(());
+    }
     for (index, (row, values)) in rows.iter().zip(varied).enumerate() {
         let mark = if front.contains(&index) { "*" } else { " " };
         say!(
@@ -679,6 +807,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         scene_spec: &sweep.scene_spec,
         x_axis: &sweep.x_axis,
         error: sweep.error,
+        format: args.format,
     };
     write_sweep(&output, &rows, &varied)
 }
@@ -690,7 +819,7 @@ fn merge_command(args: &MergeArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("the shards' error axis `{}`: {e}", identity.error))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     if merged.adapters.len() > 1 {
-        say!(
+        eprintln!(
             "note: the shards ran on {} adapters ({}); compare times within one shard's rows only",
             merged.adapters.len(),
             merged.adapters.join("; ")
@@ -706,7 +835,8 @@ fn merge_command(args: &MergeArgs) -> Result<()> {
         scene_spec: &identity.scene,
         x_axis: &identity.x_axis,
         error,
+        format: args.format,
     };
-    say!("merged {} shards of {} runs", args.shards.len(), identity.runs);
+    eprintln!("merged {} shards of {} runs", args.shards.len(), identity.runs);
     write_sweep(&output, &merged.rows, &merged.varied)
 }

@@ -419,6 +419,45 @@ pub fn csv(rows: &[Row]) -> String {
     out
 }
 
+/// One row as JSON (`--format json`): the CSV's columns, typed; the errors under `metrics`,
+/// passes and diagnostics as objects; infinite or missing numbers as `null`.
+#[must_use]
+pub fn row_json(row: &Row) -> serde_json::Value {
+    let finite = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
+    let object = |items: &[(String, f64)]| items.iter().map(|(k, v)| (k.clone(), finite(*v))).collect::<serde_json::Map<_, _>>();
+    let m = &row.metrics;
+    serde_json::json!({
+        "scene": row.scene,
+        "technique": row.technique,
+        "light": row.light,
+        "params": row.params,
+        "width": row.width,
+        "height": row.height,
+        "gpu_ms_median": row.gpu_ms_median.map(finite),
+        "gpu_ms_min": row.gpu_ms_min.map(finite),
+        "cpu_ms": finite(row.cpu_ms),
+        "metrics": {
+            "mae_penumbra": finite(m.mae_penumbra),
+            "rmse": finite(m.rmse),
+            "max_abs": finite(m.max_abs),
+            "psnr": finite(m.psnr),
+            "ssim": finite(m.ssim),
+            "frac_over_0_05": finite(m.frac_over_0_05),
+            "mean_signed_error": finite(m.mean_signed),
+            "penumbra_pixels": m.penumbra_pixels,
+            "umbra_pixels": m.umbra_pixels,
+        },
+        "flip_mean": finite(row.flip),
+        "adapter": row.adapter,
+        "timing_source": match row.timing_source {
+            TimingSource::GpuTimestamps => "gpu_timestamps",
+            TimingSource::CpuWallOnly => "cpu_wall_only",
+        },
+        "passes_ms": object(&row.passes),
+        "diagnostics": object(&row.diagnostics),
+    })
+}
+
 /// Rows from the text of a `results.csv` or `sweep.csv` that [`csv`] wrote (what `ssm merge`
 /// reads back). The CSV does not hold the image names or the count of compared pixels: they come
 /// back empty. Numbers come back as printed, so that writing the rows again gives the same text.

@@ -261,3 +261,86 @@ fn debug_outputs_are_written_when_asked_and_only_then() {
     let _ = std::fs::remove_dir_all(&asked);
     let _ = std::fs::remove_dir_all(&unasked);
 }
+
+/// `--format json` gives scripts one JSON document on stdout: every technique with its
+/// parameters and debug outputs, every built-in scene with its parameters, and compare's and
+/// sweep's rows with their metrics (notes such as the scene's summary go to stderr).
+#[test]
+fn json_output_for_scripts() {
+    let json = |args: &[&str]| -> serde_json::Value {
+        let output = ssm(args);
+        assert!(output.status.success(), "{args:?}: {}", String::from_utf8_lossy(&output.stderr));
+        serde_json::from_slice(&output.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: not one JSON document ({e}):\n{}", String::from_utf8_lossy(&output.stdout)))
+    };
+    let list = json(&["list", "--format", "json"]);
+    let techniques = list["techniques"].as_array().unwrap();
+    for info in ssm_bench::registry().unwrap().iter() {
+        let entry = techniques.iter().find(|t| t["name"] == info.name).unwrap_or_else(|| panic!("{} missing", info.name));
+        let params = entry["params"].as_array().unwrap();
+        assert_eq!(params.len(), info.params.len(), "{}", info.name);
+        for (spec, param) in info.params.iter().zip(params) {
+            assert_eq!(
+                (param["name"].as_str(), param["default"].as_str()),
+                (Some(spec.name), Some(spec.default_value().to_string().as_str()))
+            );
+        }
+        assert_eq!(entry["debug_outputs"].as_array().unwrap().len(), info.debug_outputs.len(), "{}", info.name);
+    }
+    let scenes = json(&["scenes", "--format", "json"]);
+    for entry in ssm_scene::BUILTIN_SCENES {
+        let scene = scenes.as_array().unwrap().iter().find(|s| s["name"] == entry.name).unwrap();
+        assert!(scene["triangles"].as_u64().unwrap() > 0);
+        assert_eq!(scene["params"].as_array().unwrap().len(), entry.params.len());
+    }
+    let out = out_dir("json-compare");
+    let (first, _) = two_techniques();
+    let small = ["--width", "48", "--height", "36", "--frames", "1", "--set", "reference.samples=4", "--format", "json"];
+    let mut args = vec!["compare", "--scene", "parallel-square", "--technique", first.name, "--out", out.to_str().unwrap()];
+    args.extend_from_slice(&small);
+    let rows = json(&args);
+    let row = &rows.as_array().unwrap()[0];
+    assert_eq!(row["technique"], first.name);
+    assert!(row["metrics"]["mae_penumbra"].as_f64().is_some_and(|v| (0.0..=1.0).contains(&v)), "{row}");
+    let (vary, _) = common::knob_vary(first, 2);
+    let mut args = vec!["sweep", "--scene", "parallel-square", "--vary", &vary, "--out", out.to_str().unwrap()];
+    args.extend_from_slice(&small);
+    let rows = json(&args);
+    assert!(rows.as_array().unwrap().len() >= 2 && rows[0]["varied"].is_object(), "{rows}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `compare --open` hands index.html to the system's opener (`xdg-open` here, a stand-in
+/// that records what it was given), and a missing opener is a note, not a failure.
+#[test]
+fn compare_opens_its_report_when_asked() {
+    let out = out_dir("open");
+    let bin = out_dir("open-bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let opened = bin.join("opened.txt");
+    let script = bin.join("xdg-open");
+    std::fs::write(&script, format!("#!/bin/sh\necho \"$1\" > '{}'\n", opened.display())).unwrap();
+    let mut permissions = std::fs::metadata(&script).unwrap().permissions();
+    std::os::unix::fs::PermissionsExt::set_mode(&mut permissions, 0o755);
+    std::fs::set_permissions(&script, permissions).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let (first, _) = two_techniques();
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .env("PATH", &path)
+        .args(["compare", "--scene", "parallel-square", "--technique", first.name, "--width", "48", "--height", "36", "--frames", "1"])
+        .args(["--set", "reference.samples=4", "--open", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains(&format!("report: {}", out.join("index.html").display())), "the summary names the report:\n{stdout}");
+    // The opener is spawned, not waited for.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while !opened.is_file() && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let given = std::fs::read_to_string(&opened).unwrap_or_default();
+    assert!(given.trim_end().ends_with("index.html"), "xdg-open was given `{given}`");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&bin);
+}
