@@ -665,6 +665,8 @@ struct SweepOutput<'a> {
     frames: u32,
     scene_spec: &'a str,
     x_axis: &'a str,
+    /// Every `--vary` specification (to find the parameters that vary in step with the x axis).
+    specs: &'a [String],
     error: sweep::ErrorAxis,
     format: Format,
 }
@@ -672,6 +674,9 @@ struct SweepOutput<'a> {
 /// `sweep.csv`, the plot (PNG and SVG) and the table on stdout.
 fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(String, String)>]) -> Result<()> {
     let (out, x_axis, error) = (output.out, output.x_axis, output.error);
+    // Parameters varied in step with the x axis (`scene.segments:rings`) move along it: they are
+    // not what tells one series from another.
+    let along_x = sweep::in_step_with(output.specs, x_axis);
     std::fs::write(out.join("sweep.csv"), report::csv(rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
     let table: Vec<sweep::MarkdownRow> = rows
         .iter()
@@ -697,8 +702,11 @@ fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(St
         .zip(varied)
         .map(|(row, values)| {
             let prefix = format!("{}.", row.technique);
-            let others: Vec<String> =
-                values.iter().filter(|(k, _)| k != x_axis).map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k))).collect();
+            let others: Vec<String> = values
+                .iter()
+                .filter(|(k, _)| k != x_axis && !along_x.contains(k))
+                .map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k)))
+                .collect();
             let x = if x_axis == "time" {
                 sweep::time_of(row)
             } else {
@@ -713,10 +721,16 @@ fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(St
             sweep::PlotPoint { series, x, y: error.of(row), label }
         })
         .collect();
+    // A parameter axis spanning more than a decade is logarithmic too (triangle counts, sizes).
+    let log_x = x_axis == "time" || sweep::spans_decades(&plot_points.iter().map(|p| p.x).collect::<Vec<_>>());
     let axes = sweep::PlotAxes {
-        x_label: if x_axis == "time" { "time per frame, ms (log)".to_owned() } else { x_axis.to_owned() },
+        x_label: match (x_axis == "time", log_x) {
+            (true, _) => "time per frame, ms (log)".to_owned(),
+            (false, true) => format!("{x_axis} (log)"),
+            (false, false) => x_axis.to_owned(),
+        },
         y_label: format!("{} (log)", error.label()),
-        log_x: x_axis == "time",
+        log_x,
         pareto: x_axis == "time" && error != sweep::ErrorAxis::Time,
     };
     let title = format!("{} at {}x{} on {}", output.scene_spec, output.size.0, output.size.1, output.adapter);
@@ -806,6 +820,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         frames: args.frames,
         scene_spec: &sweep.scene_spec,
         x_axis: &sweep.x_axis,
+        specs: &sweep.specs,
         error: sweep.error,
         format: args.format,
     };
@@ -834,6 +849,7 @@ fn merge_command(args: &MergeArgs) -> Result<()> {
         frames: identity.frames,
         scene_spec: &identity.scene,
         x_axis: &identity.x_axis,
+        specs: &identity.varies,
         error,
         format: args.format,
     };

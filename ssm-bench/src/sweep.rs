@@ -501,6 +501,27 @@ pub fn path_component(label: &str) -> String {
     label.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_' | '=') { c } else { '_' }).collect()
 }
 
+/// The other parameters of the `--vary` axis that holds `x_axis` (`scene.rings` for
+/// `scene.segments` in `scene.segments:rings=...`), qualified; empty when it varies alone or is
+/// not a parameter. Specifications that do not parse are skipped (they were checked before).
+#[must_use]
+pub fn in_step_with(specs: &[String], x_axis: &str) -> Vec<String> {
+    specs
+        .iter()
+        .filter_map(|spec| Vary::parse(spec).ok())
+        .find(|vary| vary.params.iter().any(|p| format!("{}.{p}", vary.technique) == x_axis))
+        .map(|vary| vary.params.iter().map(|p| format!("{}.{p}", vary.technique)).filter(|p| p != x_axis).collect())
+        .unwrap_or_default()
+}
+
+/// Whether positive values span more than a decade (so that a logarithmic axis reads better).
+#[must_use]
+pub fn spans_decades(values: &[f64]) -> bool {
+    let positive: Vec<f64> = values.iter().copied().filter(|v| v.is_finite() && *v > 0.0).collect();
+    let (low, high) = positive.iter().fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
+    positive.len() == values.len() && !positive.is_empty() && high > 10.0 * low
+}
+
 /// One point of a plot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlotPoint {
@@ -799,6 +820,16 @@ mod tests {
         }
         // The sweep's own parameters need no built-in scene.
         assert!(point("occluder_shift", "0.5").check_scene("scene.toml").is_ok());
+    }
+
+    #[test]
+    fn parameters_in_step_with_the_x_axis_and_decade_spans() {
+        let specs = ["scene.segments:rings=4:3,16:8".to_owned(), "atty.two_sided=false,true".to_owned()];
+        assert_eq!(in_step_with(&specs, "scene.segments"), vec!["scene.rings".to_owned()]);
+        assert!(in_step_with(&specs, "atty.two_sided").is_empty());
+        assert!(in_step_with(&specs, "time").is_empty());
+        assert!(spans_decades(&[4.0, 16.0, 512.0]) && !spans_decades(&[1.0, 2.0, 4.0]));
+        assert!(!spans_decades(&[-1.0, 0.5, 100.0]), "a non-positive value keeps the axis linear");
     }
 
     #[test]
