@@ -477,6 +477,25 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let adapter = gpu.describe();
     let reference_text = reference_params.to_string();
     let reference_cost = report::reference_cost(&reference.diagnostics);
+    // Where each technique's time goes, passes named without the technique's prefix.
+    let bars: Vec<(String, Vec<(String, f64)>)> = rows
+        .iter()
+        .filter(|r| r.light.is_none())
+        .map(|r| {
+            let prefix = format!("{}_", r.technique.replace('-', "_"));
+            let passes = r.passes.iter().map(|(name, ms)| (name.strip_prefix(&prefix).unwrap_or(name).to_owned(), *ms)).collect();
+            (r.technique.clone(), passes)
+        })
+        .collect();
+    let chart_title = format!("{} at {}x{}: GPU time per pass", args.scene, args.width, args.height);
+    let pass_chart = match sweep::pass_chart(&bars, &chart_title, &args.out.join("passes.png"), &args.out.join("passes.svg")) {
+        Ok(()) => Some("passes.svg"),
+        // Without timestamps there are no passes to chart: the report says nothing of them.
+        Err(error) => {
+            eprintln!("note: no per-pass chart: {error:#}");
+            None
+        }
+    };
     let context = report::ReportContext {
         scene: &args.scene,
         adapter: &adapter,
@@ -485,6 +504,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
         reference_params: &reference_text,
         reference_cost: &reference_cost,
         skipped: &skipped,
+        pass_chart,
     };
     let write = |name: &str, text: String| {
         std::fs::write(args.out.join(name), text).with_context(|| format!("writing {}", args.out.join(name).display()))

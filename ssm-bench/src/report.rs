@@ -632,6 +632,8 @@ pub struct ReportContext<'a> {
     pub reference_cost: &'a str,
     /// Techniques not run, with the reason.
     pub skipped: &'a [(String, String)],
+    /// The per-pass time chart beside the report (`passes.svg`), when one was drawn.
+    pub pass_chart: Option<&'a str>,
 }
 
 /// `report.md`: the context and the table.
@@ -689,6 +691,13 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     out += "</table>\n";
     for (name, why) in context.skipped {
         let _ = writeln!(out, "<p>Not run: <code>{}</code>: {}</p>", escape(name), escape(why));
+    }
+    if let Some(chart) = context.pass_chart {
+        let _ = writeln!(
+            out,
+            "<h2>Where the time goes</h2>\n<p class=\"legend\">Each technique's frame split into its passes (medians), as shares of the frame; the frame's milliseconds beside its name.</p>\n<img src=\"{}\" alt=\"GPU time per pass\" style=\"max-width: 100%\">",
+            escape(chart)
+        );
     }
     out += "<p class=\"legend\">Each row: shaded image, visibility, and the error against the ground truth (red: darker than the reference, over-shadowing; blue: lighter, under-shadowing; full colour at an error of 0.5).</p>\n";
     let _ = writeln!(

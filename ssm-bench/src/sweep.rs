@@ -554,15 +554,100 @@ pub struct PlotAxes {
 /// # Errors
 /// Drawing or file errors, or no finite point.
 pub fn plot(points: &[PlotPoint], axes: &PlotAxes, title: &str, png: &std::path::Path, svg: &std::path::Path) -> Result<()> {
-    // The font for PNG text; SVG text is drawn by whatever opens the file.
-    static FONT: std::sync::Once = std::sync::Once::new();
-    FONT.call_once(|| {
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
-    });
+    register_plot_font();
     draw(&BitMapBackend::new(png, (1000, 700)).into_drawing_area(), points, axes, title)
         .with_context(|| format!("drawing {}", png.display()))?;
     draw(&SVGBackend::new(svg, (1000, 700)).into_drawing_area(), points, axes, title)
         .with_context(|| format!("drawing {}", svg.display()))?;
+    Ok(())
+}
+
+/// The font for PNG text; SVG text is drawn by whatever opens the file.
+fn register_plot_font() {
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    });
+}
+
+/// Where each technique's frame time goes: one bar per technique (`(label, passes)`, each pass
+/// `(name, ms)`), its passes stacked as shares of its frame so that a 10 ms technique and a 10 s
+/// one read alike; the frame's milliseconds are in the bar's label, a pass's name in its
+/// segment when the segment is wide enough. Written to `png` and `svg`.
+///
+/// # Errors
+/// Drawing or file errors, or no bar with a positive time.
+pub fn pass_chart(bars: &[(String, Vec<(String, f64)>)], title: &str, png: &std::path::Path, svg: &std::path::Path) -> Result<()> {
+    let bars: Vec<&(String, Vec<(String, f64)>)> =
+        bars.iter().filter(|(_, passes)| passes.iter().map(|(_, ms)| ms.max(0.0)).sum::<f64>() > 0.0).collect();
+    if bars.is_empty() {
+        bail!("no technique with a timed pass");
+    }
+    register_plot_font();
+    let height = 120 + 48 * bars.len() as u32;
+    draw_pass_chart(&BitMapBackend::new(png, (1000, height)).into_drawing_area(), &bars, title)
+        .with_context(|| format!("drawing {}", png.display()))?;
+    draw_pass_chart(&SVGBackend::new(svg, (1000, height)).into_drawing_area(), &bars, title)
+        .with_context(|| format!("drawing {}", svg.display()))?;
+    Ok(())
+}
+
+fn draw_pass_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    bars: &[&(String, Vec<(String, f64)>)],
+    title: &str,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    area.fill(&WHITE).map_err(chart_error)?;
+    let totals: Vec<f64> = bars.iter().map(|(_, passes)| passes.iter().map(|(_, ms)| ms.max(0.0)).sum()).collect();
+    let names: Vec<String> = bars.iter().zip(&totals).map(|((label, _), total)| format!("{label} ({total:.1} ms)")).collect();
+    let count = bars.len();
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(40)
+        .y_label_area_size(230)
+        .build_cartesian_2d(0.0..100.0, 0.0..count as f64)
+        .map_err(chart_error)?;
+    chart
+        .configure_mesh()
+        .disable_y_mesh()
+        .x_desc("share of the frame's GPU time, %")
+        .label_style(("sans-serif", 15))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_labels(count * 2 + 1)
+        .y_label_formatter(&|y| {
+            // Labels at the bars' middles (k + 0.5), top bar first.
+            let slot = y - y.floor();
+            let index = count.checked_sub(1 + y.floor() as usize);
+            match index {
+                Some(index) if (slot - 0.5).abs() < 1e-6 => names[index].clone(),
+                _ => String::new(),
+            }
+        })
+        .draw()
+        .map_err(chart_error)?;
+    for (index, ((_, passes), total)) in bars.iter().zip(&totals).enumerate() {
+        let top = (count - index) as f64 - 0.15;
+        let bottom = (count - 1 - index) as f64 + 0.15;
+        let mut start = 0.0;
+        for (k, (pass, ms)) in passes.iter().enumerate() {
+            let share = 100.0 * ms.max(0.0) / total;
+            let colour = Palette99::pick(k).to_rgba();
+            chart
+                .draw_series(std::iter::once(Rectangle::new([(start, bottom), (start + share, top)], colour.filled())))
+                .map_err(chart_error)?;
+            // The pass's name inside its segment, when about 7 pixels a character fit (1% ≈ 7.2 pixels here).
+            if share * 7.2 > 7.0 * pass.len() as f64 + 8.0 {
+                let label = Text::new(pass.clone(), (start + 0.5, (top + bottom) / 2.0), ("sans-serif", 13).into_font().color(&BLACK));
+                chart.draw_series(std::iter::once(label)).map_err(chart_error)?;
+            }
+            start += share;
+        }
+    }
+    area.present().map_err(chart_error)?;
     Ok(())
 }
 
@@ -830,6 +915,24 @@ mod tests {
         assert!(in_step_with(&specs, "time").is_empty());
         assert!(spans_decades(&[4.0, 16.0, 512.0]) && !spans_decades(&[1.0, 2.0, 4.0]));
         assert!(!spans_decades(&[-1.0, 0.5, 100.0]), "a non-positive value keeps the axis linear");
+    }
+
+    #[test]
+    fn the_pass_chart_labels_each_bar_with_its_frame_time() {
+        let dir = std::env::temp_dir().join(format!("ssm-pass-chart-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (png, svg) = (dir.join("passes.png"), dir.join("passes.svg"));
+        let bars = vec![
+            ("fast".to_owned(), vec![("shadow_map".to_owned(), 1.0), ("filter".to_owned(), 3.0)]),
+            ("slow".to_owned(), vec![("tiles".to_owned(), 900.0), ("filter".to_owned(), 100.0)]),
+            ("untimed".to_owned(), Vec::new()),
+        ];
+        pass_chart(&bars, "title", &png, &svg).unwrap();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("fast (4.0 ms)") && text.contains("slow (1000.0 ms)") && !text.contains("untimed"), "{text}");
+        assert!(text.lines().any(|line| line.trim() == "tiles"), "a wide segment is named");
+        assert!(pass_chart(&bars[2..], "title", &png, &svg).is_err(), "nothing timed");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -157,6 +157,10 @@ fn compare_reports_every_light_and_the_total() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains(&format!("`{technique}` · light 2")), "{report}");
+    // Where the time goes: the per-pass chart, drawn into the HTML report.
+    let chart = std::fs::read_to_string(out.join("passes.svg")).unwrap();
+    assert!(chart.contains(&format!("{technique} (")) && out.join("passes.png").is_file(), "{chart}");
+    assert!(std::fs::read_to_string(out.join("index.html")).unwrap().contains("<img src=\"passes.svg\""));
 }
 
 #[test]
