@@ -675,12 +675,15 @@ where
     let mut builder = ChartBuilder::on(area);
     builder.caption(title, ("sans-serif", 24)).margin(20).x_label_area_size(50).y_label_area_size(70);
     let (y_low, y_high) = (y_min / 1.5, y_max * 1.5);
-    let y_range = (y_low..y_high).log_scale();
+    // The ticks chosen here: plotters' own log ticks start at the first power of ten inside the
+    // range, so an axis within one decade got that one label, or none.
+    let y_range = (y_low..y_high).log_scale().with_key_points(log_key_points(y_low, y_high));
     let y_fraction = |y: f64| (y / y_low).ln() / (y_high / y_low).ln();
     if axes.log_x {
         let (x_low, x_high) = (x_min / 1.5, x_max * 1.5);
         let legend = emptiest_corner(&usable, |x| (x / x_low).ln() / (x_high / x_low).ln(), y_fraction);
-        let chart = builder.build_cartesian_2d((x_low..x_high).log_scale(), y_range).map_err(chart_error)?;
+        let x_range = (x_low..x_high).log_scale().with_key_points(log_key_points(x_low, x_high));
+        let chart = builder.build_cartesian_2d(x_range, y_range).map_err(chart_error)?;
         draw_series(chart, &usable, axes, legend)
     } else {
         let pad = ((x_max - x_min) * 0.08).max(1e-6);
@@ -689,6 +692,17 @@ where
         let chart = builder.build_cartesian_2d(x_low..x_high, y_range).map_err(chart_error)?;
         draw_series(chart, &usable, axes, legend)
     }
+}
+
+/// Ticks of a log axis from `low` to `high`: 1, 2 and 5 times each power of ten inside, and 3 as
+/// well when the range spans less than two decades (few ticks otherwise).
+fn log_key_points(low: f64, high: f64) -> Vec<f64> {
+    if !(low > 0.0 && high > low && high.is_finite()) {
+        return Vec::new();
+    }
+    let mantissas: &[f64] = if high / low < 100.0 { &[1.0, 2.0, 3.0, 5.0] } else { &[1.0, 2.0, 5.0] };
+    let (first, last) = (low.log10().floor() as i32, high.log10().ceil() as i32);
+    (first..=last).flat_map(|power| mantissas.iter().map(move |m| m * 10f64.powi(power))).filter(|v| *v >= low && *v <= high).collect()
 }
 
 /// A log axis's tick label: only at 1, 2, 3 and 5 times a power of ten, since plotters puts a tick at
@@ -746,7 +760,11 @@ fn emptiest_corner(points: &[&PlotPoint], x_fraction: impl Fn(f64) -> f64, y_fra
 }
 
 fn draw_series<'a, DB, X>(
-    mut chart: ChartContext<'a, DB, Cartesian2d<X, plotters::coord::combinators::LogCoord<f64>>>,
+    mut chart: ChartContext<
+        'a,
+        DB,
+        Cartesian2d<X, plotters::coord::combinators::WithKeyPoints<plotters::coord::combinators::LogCoord<f64>>>,
+    >,
     points: &[&PlotPoint],
     axes: &PlotAxes,
     legend: SeriesLabelPosition,
@@ -933,6 +951,15 @@ mod tests {
         assert!(text.lines().any(|line| line.trim() == "tiles"), "a wide segment is named");
         assert!(pass_chart(&bars[2..], "title", &png, &svg).is_err(), "nothing timed");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn log_axes_get_round_ticks_even_within_a_decade() {
+        assert_eq!(log_key_points(0.017, 0.1), vec![0.02, 0.03, 0.05, 0.1]);
+        let wide = log_key_points(7.0, 5000.0);
+        assert_eq!(wide.first().copied(), Some(10.0));
+        assert!(wide.contains(&200.0) && wide.contains(&5000.0) && !wide.contains(&300.0), "{wide:?}");
+        assert!(log_key_points(0.0, 1.0).is_empty());
     }
 
     #[test]
