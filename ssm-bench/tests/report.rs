@@ -99,8 +99,8 @@ fn compare_writes_a_csv_and_a_report_that_renders_in_a_browser() {
     let page = format!("file://{}", out.join("index.html").display());
     let dom = chromium(&scratch("profile"), &["--dump-dom", &page]);
     let dom = String::from_utf8_lossy(&dom.stdout);
-    // Ground truth (2 images) + 2 techniques × 3 images.
-    assert!(dom.contains("data-images-loaded=\"8/8\""), "not every image loaded:\n{}", &dom[..dom.len().min(2000)]);
+    // Ground truth (2 images) + 2 techniques × 3 images + the per-pass time chart.
+    assert!(dom.contains("data-images-loaded=\"9/9\""), "not every image loaded:\n{}", &dom[..dom.len().min(2000)]);
     let screenshot = out.join("screenshot.png");
     let shot = chromium(&scratch("profile2"), &["--window-size=1200,1600", &format!("--screenshot={}", screenshot.display()), &page]);
     assert!(screenshot.is_file(), "{}", String::from_utf8_lossy(&shot.stderr));
