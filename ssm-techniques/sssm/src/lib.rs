@@ -231,16 +231,14 @@ impl Targets {
         };
         // Per-pixel values a pass writes and the CPU reads back.
         let readable = |label: &str| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::R32Float,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+            render_texture(
+                device,
+                label,
+                width,
+                height,
+                wgpu::TextureFormat::R32Float,
+                wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            )
         };
         let reuse = readable("sssm_reuse_share");
         let penumbra_error = readable("sssm_penumbra_error");
