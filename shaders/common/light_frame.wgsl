@@ -60,6 +60,15 @@ fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
     return light_depth(frame, world) > 0.0;
 }
 
+// True when the whole light lies strictly behind the plane through `world` with normal `normal`
+// (its highest corner above the plane is below it). A light touching the plane, or partly in
+// front of it, is not.
+fn light_behind_surface(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) -> bool {
+    let centre_height = dot(frame.centre.xyz - world, normal);
+    let corner_reach = abs(frame.u_axis.w * dot(frame.u_axis.xyz, normal)) + abs(frame.v_axis.w * dot(frame.v_axis.xyz, normal));
+    return centre_height + corner_reach < 0.0;
+}
+
 // The receiver's tangent plane as seen from the light, prepared once per receiver point so that
 // each tap costs one multiply-add and a division: along the ray from the light's centre through
 // shadow-map coordinates `uv`, the plane's linear depth is numerator / (c.x + c.y u + c.z v)

@@ -4,6 +4,7 @@
 
 // #import common/fullscreen.wgsl
 // #import common/light_frame.wgsl
+// #import common/scene.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
@@ -20,6 +21,8 @@ struct ScreenPoint {
     covered: bool,
     // The surface has the receiver role.
     receives: bool,
+    // The surface belongs to a closed mesh (ssm_scene::Scene::closed_meshes).
+    closed: bool,
 };
 
 fn screen_point(in: FullscreenVertex) -> ScreenPoint {
@@ -30,18 +33,28 @@ fn screen_point(in: FullscreenVertex) -> ScreenPoint {
 fn screen_point_at(texel: vec2<i32>) -> ScreenPoint {
     let position = textureLoad(gbuffer_position, texel, 0);
     let normal = textureLoad(gbuffer_normal, texel, 0);
-    return ScreenPoint(texel, position.xyz, normal.xyz, position.w > 0.5, normal.w > 0.5);
+    let flags = u32(round(max(normal.w, 0.0)));
+    return ScreenPoint(texel, position.xyz, normal.xyz, position.w > 0.5, (flags & GBUFFER_RECEIVES) != 0u, (flags & GBUFFER_CLOSED) != 0u);
 }
 
 // The visibility of pixels no technique needs to compute: 1 where nothing
-// covers the pixel, 0 behind the light's plane (the emitter is one-sided);
-// -1 where the technique must compute it.
+// covers the pixel; 0 behind the light's plane (the emitter is one-sided); 0 on
+// a closed mesh where the whole light is behind the surface's tangent plane
+// (the unlit side of a solid: every ray to the light goes through it, as the
+// ground truth finds); -1 where the technique must compute it.
 fn trivial_visibility(point: ScreenPoint) -> f32 {
     if (!point.covered) {
         return 1.0;
     }
-    if (!in_front_of_light(frame, point.position)) {
+    if (!in_front_of_light(frame, point.position) || hidden_by_own_surface(point)) {
         return 0.0;
     }
     return -1.0;
+}
+
+// True on a closed mesh where the whole light (of `frame`) is behind the surface's tangent plane.
+// An open surface (a leaf card, a floor) is not: the ground truth's rays leave it on the side
+// facing the light.
+fn hidden_by_own_surface(point: ScreenPoint) -> bool {
+    return point.closed && light_behind_surface(frame, point.position, point.normal);
 }

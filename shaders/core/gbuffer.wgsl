@@ -1,5 +1,6 @@
 // The shared G-buffer: world position (w = 1 where geometry covers the pixel)
-// and the shading normal turned towards the camera (w = 1 on receivers).
+// and the shading normal turned towards the camera (w: flags, 1 on receivers,
+// + 2 on closed meshes; decoded by common/screen_pass.wgsl).
 
 // #import common/camera.wgsl
 // #import common/scene.wgsl
@@ -31,12 +32,27 @@ struct GBufferTargets {
 @fragment
 fn gbuffer_fragment(in: GBufferVertex) -> GBufferTargets {
     var normal = normalize(in.normal);
-    // Surfaces are two-sided: shade the side the camera sees.
-    if (dot(normal, camera.position.xyz - in.world) < 0.0) {
+    // Surfaces are two-sided: the normal of the side the camera sees. That side is the facet's
+    // (its plane from the position's screen derivatives, whatever the winding), not the shading
+    // normal's: near a silhouette an interpolated normal can face away from the camera while the
+    // facet faces it, and flipping it there would point a closed mesh's normal inwards.
+    let to_eye = camera.position.xyz - in.world;
+    let across = dpdx(in.world);
+    let down = dpdy(in.world);
+    var facet = cross(across, down);
+    // An edge-on facet has no usable plane: the shading normal decides.
+    if (dot(facet, facet) <= 1e-12 * dot(across, across) * dot(down, down)) {
+        facet = normal;
+    }
+    if (dot(facet, to_eye) < 0.0) {
+        facet = -facet;
+    }
+    if (dot(normal, facet) < 0.0) {
         normal = -normal;
     }
     var out: GBufferTargets;
     out.position = vec4<f32>(in.world, 1.0);
-    out.normal = vec4<f32>(normal, select(0.0, 1.0, (in.role & ROLE_RECEIVES) != 0u));
+    let flags = select(0u, GBUFFER_RECEIVES, (in.role & ROLE_RECEIVES) != 0u) | select(0u, GBUFFER_CLOSED, (in.role & SURFACE_CLOSED) != 0u);
+    out.normal = vec4<f32>(normal, f32(flags));
     return out;
 }

@@ -30,7 +30,9 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let point = screen_point_at(texel);
     var lit = 1.0;
     if (point.covered) {
-        if (!in_front_of_light(frame, point.position)) {
+        // This sample's frame is a point light: behind a closed surface's tangent plane, the
+        // surface itself hides it.
+        if (!in_front_of_light(frame, point.position) || hidden_by_own_surface(point)) {
             lit = 0.0;
         } else {
             let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);

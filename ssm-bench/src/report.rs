@@ -7,7 +7,7 @@ use std::path::Path;
 
 use ssm_core::image_io::{write_exr_gray, write_png_gray16, write_png_rgba8};
 use ssm_core::metrics::{ErrorMetrics, compare, flip_mean, heat_map};
-use ssm_core::{Error, FrameTimings, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
+use ssm_core::{Error, FrameTimings, GBuffer, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
 
 use crate::median;
 
@@ -212,7 +212,11 @@ pub fn pixel_mask(renderer: &Renderer, set: PixelSet) -> Result<Vec<bool>> {
     let positions = renderer.read_positions()?;
     Ok(match set {
         PixelSet::All => positions.iter().map(|p| p[3] > 0.5).collect(),
-        PixelSet::Receivers => positions.iter().zip(renderer.read_normals()?).map(|(p, n)| p[3] > 0.5 && n[3] > 0.5).collect(),
+        PixelSet::Receivers => positions
+            .iter()
+            .zip(renderer.read_normals()?)
+            .map(|(p, n)| p[3] > 0.5 && GBuffer::flags(n[3]) & GBuffer::RECEIVES != 0)
+            .collect(),
     })
 }
 

@@ -14,7 +14,8 @@ pub struct GBuffer {
     pub position: wgpu::Texture,
     /// View of `position`.
     pub position_view: wgpu::TextureView,
-    /// `xyz` unit normal turned towards the camera, `w` 1 on receivers.
+    /// `xyz` unit normal turned towards the camera, `w` the surface's flags as a whole number
+    /// ([`GBuffer::RECEIVES`] | [`GBuffer::CLOSED`]; [`GBuffer::flags`] decodes it).
     pub normal: wgpu::Texture,
     /// View of `normal`.
     pub normal_view: wgpu::TextureView,
@@ -36,6 +37,16 @@ impl GBuffer {
     pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
     /// Format of [`GBuffer::depth`].
     pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+    /// Flag of [`GBuffer::normal`]'s `w`: the surface has the receiver role (`GBUFFER_RECEIVES` in WGSL).
+    pub const RECEIVES: u32 = 1;
+    /// Flag of [`GBuffer::normal`]'s `w`: the surface's mesh is closed (`GBUFFER_CLOSED` in WGSL).
+    pub const CLOSED: u32 = 2;
+
+    /// The flags a normal texel's `w` holds.
+    #[must_use]
+    pub fn flags(normal_w: f32) -> u32 {
+        normal_w.max(0.0).round() as u32
+    }
 
     /// Allocates the targets and builds the pipeline.
     ///

@@ -20,7 +20,7 @@ pub struct SceneVertex {
     pub position: [f32; 3],
     /// World-space unit normal.
     pub normal: [f32; 3],
-    /// Role flags: [`ROLE_CASTS`] | [`ROLE_RECEIVES`].
+    /// Role flags: [`ROLE_CASTS`] | [`ROLE_RECEIVES`] | [`SURFACE_CLOSED`].
     pub role: u32,
 }
 
@@ -28,6 +28,10 @@ pub struct SceneVertex {
 pub const ROLE_CASTS: u32 = 1;
 /// Role flag: the vertex's instance receives shadows.
 pub const ROLE_RECEIVES: u32 = 2;
+/// Flag: the vertex's mesh is closed ([`ssm_scene::Scene::closed_meshes`]), so that where the
+/// whole light is behind its tangent plane the surface itself hides the light (the G-buffer
+/// records it for `trivial_visibility` in `shaders/common/screen_pass.wgsl`).
+pub const SURFACE_CLOSED: u32 = 4;
 
 impl SceneVertex {
     /// Attributes: 0 position, 1 normal, 2 role (as in `shaders/common/scene.wgsl`).
@@ -119,8 +123,11 @@ impl GpuScene {
         let mut vertices = Vec::new();
         // Three index lists, concatenated in role order afterwards.
         let mut by_role: [Vec<u32>; 3] = Default::default();
+        let closed = scene.closed_meshes();
         for triangle in scene.world_triangles() {
-            let flags = (u32::from(triangle.role.casts()) * ROLE_CASTS) | (u32::from(triangle.role.receives()) * ROLE_RECEIVES);
+            let flags = (u32::from(triangle.role.casts()) * ROLE_CASTS)
+                | (u32::from(triangle.role.receives()) * ROLE_RECEIVES)
+                | (u32::from(closed.get(triangle.mesh).copied().unwrap_or(false)) * SURFACE_CLOSED);
             let slot = match triangle.role {
                 _ if !roles => 0,
                 Role::Occluder => 0,

@@ -42,7 +42,7 @@ pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
 pub use error::{BoxedError, Error, Reason, Result};
 pub use frame::{Frame, SharedInputs};
 pub use gbuffer::GBuffer;
-pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SceneVertex};
+pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SURFACE_CLOSED, SceneVertex};
 pub use light_depth::{
     DepthBiasUniform, LightDepthMap, LightDepthMapDesc, NO_SURFACE, ReceiverModel, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ShadowMapBias,
     screen_space_requirements,

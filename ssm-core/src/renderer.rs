@@ -182,7 +182,7 @@ impl Renderer {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// The G-buffer's normals (`w` = receiver flag), row-major from the top-left.
+    /// The G-buffer's normals (`w`: the flags [`GBuffer::flags`] decodes), row-major from the top-left.
     ///
     /// # Errors
     /// [`Error::UndeclaredRequirement`] without a G-buffer, or a readback error.

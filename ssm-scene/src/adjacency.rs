@@ -96,6 +96,15 @@ impl Adjacency {
     pub fn is_closed_manifold(&self) -> bool {
         self.edges.iter().all(|e| e.face_count == 2)
     }
+
+    /// True when every edge has an even number of faces (two, or four where two closed parts
+    /// touch): the triangles bound a volume, so a segment between two points off the surface
+    /// crosses it an odd number of times exactly when one point is inside and the other outside.
+    /// A manifold mesh with a hole, or a single quad, is not closed.
+    #[must_use]
+    pub fn is_closed(&self) -> bool {
+        !self.edges.is_empty() && self.edges.iter().all(|e| e.face_count % 2 == 0)
+    }
 }
 
 #[cfg(test)]
@@ -114,6 +123,7 @@ mod tests {
         assert!(cube.is_closed_manifold());
         let ball = Adjacency::of(&sphere("s", 1.0, 12, 6));
         assert!(ball.is_closed_manifold());
+        assert!(cube.is_closed() && ball.is_closed());
         // Euler: V - E + F = 2 for a sphere.
         assert_eq!(ball.welded_positions.len() as i64 - ball.edges.len() as i64 + ball.triangles.len() as i64, 2);
     }
@@ -123,6 +133,27 @@ mod tests {
         let quad = Adjacency::of(&plane("p", Vec2::ONE));
         assert_eq!(quad.open_edge_count(), 4);
         assert_eq!(quad.edges.iter().filter(|e| e.face_count == 2).count(), 1);
+        assert!(!quad.is_closed());
+    }
+
+    #[test]
+    fn two_closed_parts_touching_at_an_edge_are_closed_a_punctured_one_is_not() {
+        // Two tetrahedra sharing the edge (0, 1): four faces on it, every other edge two.
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(0.5, 1.0, 0.0),
+            Vec3::new(0.5, 0.3, 1.0),
+            Vec3::new(0.5, -1.0, 0.0),
+            Vec3::new(0.5, -0.3, -1.0),
+        ];
+        let mut indices = vec![0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3];
+        indices.extend_from_slice(&[0, 1, 4, 1, 0, 5, 4, 1, 5, 0, 4, 5]);
+        let pair = Adjacency::of(&Mesh::with_generated_normals("pair", positions.clone(), indices.clone()));
+        assert_eq!(pair.non_manifold_edge_count(), 1);
+        assert!(pair.is_closed());
+        indices.truncate(indices.len() - 3);
+        assert!(!Adjacency::of(&Mesh::with_generated_normals("punctured", positions, indices)).is_closed());
     }
 
     #[test]

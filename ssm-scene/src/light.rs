@@ -73,6 +73,15 @@ impl RectLight {
         self.centre + s * self.half_size.x * self.u_axis + t * self.half_size.y * self.v_axis
     }
 
+    /// True when the whole rectangle lies strictly behind the plane through `point` with normal
+    /// `normal` (its highest corner is below the plane). The CPU twin of `light_behind_surface`
+    /// in `shaders/common/light_frame.wgsl`.
+    #[must_use]
+    pub fn is_behind_plane(&self, point: Vec3, normal: Vec3) -> bool {
+        let reach = (self.half_size.x * self.u_axis.dot(normal)).abs() + (self.half_size.y * self.v_axis.dot(normal)).abs();
+        (self.centre - point).dot(normal) + reach < 0.0
+    }
+
     /// Checks the invariants listed on the type.
     ///
     /// # Errors

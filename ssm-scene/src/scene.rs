@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat3, Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
+use crate::adjacency::Adjacency;
 use crate::camera::Camera;
 use crate::error::{Result, SceneError};
 use crate::light::RectLight;
@@ -131,6 +132,8 @@ pub struct WorldTriangle {
     pub normals: [Vec3; 3],
     /// Role of the source instance.
     pub role: Role,
+    /// Index of the source instance's mesh in [`Scene::meshes`].
+    pub mesh: usize,
 }
 
 impl Scene {
@@ -199,9 +202,21 @@ impl Scene {
                     corners: [corner(0), corner(1), corner(2)],
                     normals: [normal(0), normal(1), normal(2)],
                     role: instance.role,
+                    mesh: instance.mesh,
                 }
             })
         })
+    }
+
+    /// Per mesh, whether it is closed ([`Adjacency::is_closed`]): every edge, on welded positions,
+    /// shared by an even number of triangles. A point on a closed mesh whose tangent plane (on
+    /// the side the camera sees) has the whole light behind it sees none of the light, when the
+    /// light is on the camera's side of the mesh (both outside a solid, or both inside a closed
+    /// room): a segment from just behind the surface to the light then crosses the mesh an odd
+    /// number of times.
+    #[must_use]
+    pub fn closed_meshes(&self) -> Vec<bool> {
+        self.meshes.iter().map(|mesh| Adjacency::of(mesh).is_closed()).collect()
     }
 }
 

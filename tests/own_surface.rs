@@ -1,0 +1,69 @@
+//! The unlit side of a closed mesh: where the whole light is behind a closed surface's tangent
+//! plane, every ray from the point to the light goes through the mesh, so the ground truth is 0,
+//! and the framework's shared rule (`trivial_visibility` in `shaders/common/screen_pass.wgsl`)
+//! gives every technique that 0 instead of whatever its shadow map holds there. Open surfaces
+//! (a floor, a leaf card) are left to the techniques: the ground truth's rays leave them on the
+//! side facing the light.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use glam::Vec3;
+use ssm_core::{Error, GBuffer};
+use ssm_integration_tests::registry;
+use ssm_scene::builtin;
+use ssm_testing::{gpu, render};
+
+const SIZE: (u32, u32) = (160, 120);
+
+#[test]
+fn the_unlit_side_of_a_closed_mesh_is_umbra_in_the_ground_truth_and_every_technique() {
+    let gpu = gpu();
+    let mut failures = Vec::new();
+    for name in ["floating-sphere", "sphere-cube", "contact"] {
+        let scene = builtin(name).unwrap().build();
+        let light = scene.lights[0];
+        let reference = render(&gpu, &scene, &ssm_core::reference::INFO, &[("samples", "8"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+        let positions = reference.renderer.read_positions().unwrap();
+        let normals = reference.renderer.read_normals().unwrap();
+        let hidden: Vec<bool> = positions
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| {
+                p[3] > 0.5
+                    && GBuffer::flags(n[3]) & GBuffer::CLOSED != 0
+                    && light.is_behind_plane(Vec3::new(p[0], p[1], p[2]), Vec3::new(n[0], n[1], n[2]))
+            })
+            .collect();
+        let count = hidden.iter().filter(|h| **h).count();
+        let closed = normals.iter().filter(|n| GBuffer::flags(n[3]) & GBuffer::CLOSED != 0).count();
+        println!("{name}: {closed} pixels on closed meshes, {count} with the light wholly behind their tangent plane");
+        assert!(count > 60, "{name}: too few pixels ({count}) on the unlit side of a closed mesh to test anything");
+        let lit_in_truth = hidden.iter().zip(&reference.visibility).filter(|(h, v)| **h && **v > 0.0).count();
+        assert_eq!(lit_in_truth, 0, "{name}: the ground truth sees the light from {lit_in_truth} of {count} such pixels");
+        for info in registry().iter().filter(|info| info.name != "reference") {
+            let rendered = match render(&gpu, &scene, info, &[], SIZE.0, SIZE.1) {
+                Ok(rendered) => rendered,
+                Err(Error::MissingFeatures { .. } | Error::LimitTooLow { .. }) => continue,
+                Err(e) => panic!("{}: {e}", info.name),
+            };
+            let lit = hidden.iter().zip(&rendered.visibility).filter(|(h, v)| **h && **v != 0.0).count();
+            if lit > 0 {
+                failures.push(format!("{name}: {} gives {lit} of {count} pixels on the unlit side of a closed mesh some light", info.name));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn open_surfaces_are_not_marked_closed() {
+    let gpu = gpu();
+    // leaves: a floor and open leaf cards only.
+    let scene = builtin("leaves").unwrap().build();
+    let rendered = render(&gpu, &scene, &ssm_core::reference::INFO, &[("samples", "2"), ("cache", "false")], SIZE.0, SIZE.1).unwrap();
+    let normals = rendered.renderer.read_normals().unwrap();
+    let covered = rendered.renderer.read_positions().unwrap().iter().filter(|p| p[3] > 0.5).count();
+    assert!(covered > 1000);
+    assert!(normals.iter().all(|n| GBuffer::flags(n[3]) & GBuffer::CLOSED == 0), "an open surface was marked closed");
+}
