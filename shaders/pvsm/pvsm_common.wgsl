@@ -54,7 +54,10 @@ struct Kernel {
     // The texel size the prediction asked for along each axis (shadow-map coordinates): tiles finer
     // than that (a neighbour needed more) are integrated at about this resolution.
     texel: vec2<f32>,
-    _pad: vec2<f32>,
+    // The average occluder depth z_o the filter's size came from (the receiver's own depth where no
+    // blocker was seen, with prediction = fixed).
+    blocker_depth: f32,
+    _pad: f32,
 };
 
 // The pixel has a filter to evaluate.

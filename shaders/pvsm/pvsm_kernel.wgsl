@@ -28,6 +28,14 @@ fn plane_change(point: ScreenPoint, uv: vec2<f32>, d: f32, half_texel: vec2<f32>
     return abs(along_u) + abs(along_v);
 }
 
+// The area of texel `texel` (of side 1) inside the rectangle `region` (xy min, zw max, in texels).
+fn texel_area_in(region: vec4<f32>, texel: vec2<i32>) -> f32 {
+    let low = max(region.xy, vec2<f32>(texel));
+    let high = min(region.zw, vec2<f32>(texel) + 1.0);
+    let overlap = max(high - low, vec2<f32>(0.0));
+    return overlap.x * overlap.y;
+}
+
 // kdtree::MIN_TILE_SIZE: the fewest texels a tile's map has (checked by a test of the crate).
 const MIN_TILE_SIZE: f32 = 8.0;
 
@@ -69,9 +77,12 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     //    plane, at the finest level of the map's minimum-depth mip chain where the region spans at
     //    most DETECTION_TEXELS texels a side. A level's texel holds the nearest depth under it, so no
     //    occluder of the conservative map is missed: a pixel with none is fully lit.
-    // 2. The average occluder depth: blocker_kernel² samples of the full-resolution level (the
-    //    minimum of a coarse texel would pull the average towards the light); the coarse blockers
-    //    stand in when the samples fall between occluders too thin to be hit.
+    // 2. The average occluder depth on the full-resolution level (the minimum of a coarse texel
+    //    would pull the average towards the light): where the region spans at most blocker_kernel
+    //    texels a side, every texel of it once, weighted by its area inside the region (the exact
+    //    average of the map over the region, for no more reads than the samples); otherwise
+    //    blocker_kernel² samples. The coarse blockers stand in when the samples fall between
+    //    occluders too thin to be hit.
     let base_size = vec2<f32>(textureDimensions(low_res_map, 0));
     let levels = textureNumLevels(low_res_map);
     // The region is the light seen from the pixel through the nearest occluder's plane: the top of
@@ -101,8 +112,16 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     let low = vec2<i32>(floor((uvd.xy - search) * level_size));
     let high = vec2<i32>(floor((uvd.xy + search) * level_size));
     let limit = vec2<i32>(level_size) - 1;
+    // The region in the full-resolution level's texels, and whether it is small enough to read whole.
+    let region = vec4<f32>((uvd.xy - search) * base_size, (uvd.xy + search) * base_size);
+    let fine_span = vec2<i32>(floor(region.zw)) - vec2<i32>(floor(region.xy)) + 1;
+    let whole = all(fine_span <= vec2<i32>(i32(n)));
     var coarse_sum = 0.0;
     var coarse_count = 0.0;
+    // Area-weighted sums over the full-resolution level: at level 0 the detection reads those very
+    // texels with the same tolerance (the level's texel is the base's), so it gathers them too.
+    var sum = 0.0;
+    var count = 0.0;
     for (var y = max(low.y, 0); y <= min(high.y, limit.y); y++) {
         for (var x = max(low.x, 0); x <= min(high.x, limit.x); x++) {
             let depth = textureLoad(low_res_map, vec2<i32>(x, y), i32(level)).x;
@@ -110,12 +129,29 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             if (depth < tap_plane_depth(receiver, uv) - coarse_tolerance) {
                 coarse_sum += depth;
                 coarse_count += 1.0;
+                if (level == 0u && whole) {
+                    let area = texel_area_in(region, vec2<i32>(x, y));
+                    sum += area * depth;
+                    count += area;
+                }
             }
         }
     }
-    var sum = 0.0;
-    var count = 0.0;
-    if (coarse_count > 0.0) {
+    if (coarse_count > 0.0 && level > 0u && whole) {
+        let fine_low = max(vec2<i32>(floor(region.xy)), vec2<i32>(0));
+        let fine_high = min(vec2<i32>(floor(region.zw)), vec2<i32>(base_size) - 1);
+        for (var y = fine_low.y; y <= fine_high.y; y++) {
+            for (var x = fine_low.x; x <= fine_high.x; x++) {
+                let depth = textureLoad(low_res_map, vec2<i32>(x, y), 0).x;
+                let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / base_size;
+                if (depth < tap_plane_depth(receiver, uv) - fine_tolerance) {
+                    let area = texel_area_in(region, vec2<i32>(x, y));
+                    sum += area * depth;
+                    count += area;
+                }
+            }
+        }
+    } else if (coarse_count > 0.0 && !whole) {
         for (var j = 0u; j < n; j++) {
             for (var i = 0u; i < n; i++) {
                 let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
@@ -126,10 +162,10 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
         }
-        if (count == 0.0) {
-            sum = coarse_sum;
-            count = coarse_count;
-        }
+    }
+    if (count == 0.0) {
+        sum = coarse_sum;
+        count = coarse_count;
     }
     if (count == 0.0 && settings.prediction != 3u) {
         // The conservative map guarantees no occluder was missed: fully lit (Sec. 5.2).
@@ -140,7 +176,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     // With prediction = fixed the pixel is still filtered (the single map decides), with no penumbra
     // where no blocker was seen.
-    let average = select(d, sum / max(count, 1.0), count > 0.0);
+    let average = select(d, sum / max(count, 1e-30), count > 0.0);
     // s_α: the light seen from the receiver through the plane at the average occluder depth.
     let soft_filter = light_half_extent_uv(frame, average, d);
 
@@ -203,6 +239,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     kernel.centre = uvd.xy;
     kernel.depth = d;
     kernel.texel = texel_size;
+    kernel.blocker_depth = average;
     kernel.flags = KERNEL_ACTIVE;
     kernels[index] = kernel;
     atomicAdd(&counters[0], 1u);

@@ -295,8 +295,33 @@ impl LowResMap {
     }
 }
 
-/// Bytes of one `Kernel` of `pvsm_common.wgsl`.
-const KERNEL_BYTES: u64 = 48;
+/// `Kernel` of `shaders/pvsm/pvsm_common.wgsl`: one pixel's filter from step 3, read back for the
+/// debug outputs.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct KernelRecord {
+    centre: [f32; 2],
+    u_axis: [f32; 2],
+    v_height: f32,
+    depth: f32,
+    flags: u32,
+    offset: f32,
+    texel: [f32; 2],
+    blocker_depth: f32,
+    _pad: f32,
+}
+
+impl KernelRecord {
+    /// `KERNEL_ACTIVE` of the WGSL: the pixel has a filter to evaluate.
+    const ACTIVE: u32 = 1;
+
+    fn is_active(&self) -> bool {
+        self.flags & Self::ACTIVE != 0
+    }
+}
+
+/// Bytes of one [`KernelRecord`].
+const KERNEL_BYTES: u64 = std::mem::size_of::<KernelRecord>() as u64;
 
 /// The uniforms of one tile of one light, written when the kd-tree has decided it.
 struct TileSlot {
@@ -959,12 +984,22 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
     }
 
     /// `tiles`: each pixel shaded by the tile its filter's centre falls in (Fig. 10's inset), of the
-    /// last light; `low_res_coverage`: the texels of the conservative low-resolution map that hold a
-    /// surface (1) or none (0).
+    /// last light; `blocker_depth` and `predicted_resolution`: steps 3 and 4 per pixel;
+    /// `low_res_coverage`: the texels of the conservative low-resolution map that hold a surface (1)
+    /// or none (0).
     fn debug_outputs(&mut self, gpu: &GpuContext, requested: &[&str]) -> Result<Vec<ExtraImage>> {
         let mut images = Vec::new();
+        let kernels = if requested.iter().any(|name| KERNEL_OUTPUTS.contains(name)) { self.read_kernels(gpu)? } else { Vec::new() };
         if requested.contains(&"tiles") {
-            images.push(self.tile_image(gpu)?);
+            images.push(self.tile_image(&kernels));
+        }
+        if requested.contains(&"blocker_depth") {
+            images.push(self.kernel_image(&kernels, "blocker_depth", false, |k| k.blocker_depth / k.depth.max(f32::MIN_POSITIVE)));
+        }
+        if requested.contains(&"predicted_resolution") {
+            images.push(self.kernel_image(&kernels, "predicted_resolution", false, |k| {
+                (1.0 / k.texel[0].min(k.texel[1]).max(f32::MIN_POSITIVE)).log2() / PREDICTED_RESOLUTION_SCALE
+            }));
         }
         if requested.contains(&"low_res_coverage") {
             let side = self.settings.low_res_size;
@@ -978,27 +1013,36 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
 }
 
 impl PredictedVirtualShadowMaps {
-    /// The `tiles` debug output.
-    fn tile_image(&self, gpu: &GpuContext) -> Result<ExtraImage> {
+    /// Step 3's per-pixel filters, of the last light rendered.
+    fn read_kernels(&self, gpu: &GpuContext) -> Result<Vec<KernelRecord>> {
         let bytes = ssm_core::readback::read_buffer(gpu, &self.buffers.kernels, self.buffers.kernels.size(), "PVSM kernels")?;
-        let words: Vec<[u32; 12]> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// A debug image of `name` with `value` of each pixel that has a filter, 0 elsewhere.
+    fn kernel_image(&self, kernels: &[KernelRecord], name: &str, overlay: bool, value: impl Fn(&KernelRecord) -> f32) -> ExtraImage {
+        let values = kernels.iter().map(|kernel| if kernel.is_active() { value(kernel) } else { 0.0 }).collect();
+        ExtraImage { name: name.into(), width: self.width, height: self.height, values, overlay }
+    }
+
+    /// The `tiles` debug output.
+    fn tile_image(&self, kernels: &[KernelRecord]) -> ExtraImage {
         let tiles = self.last.tilings.last().map(|t| t.tiles.clone()).unwrap_or_default();
-        let values = words
-            .iter()
-            .map(|kernel| {
-                let centre = Vec2::new(f32::from_bits(kernel[0]), f32::from_bits(kernel[1]));
-                if kernel[6] & 1 == 0 {
-                    return 0.0;
-                }
-                tiles
-                    .iter()
-                    .position(|t| centre.cmpge(t.uv_min).all() && centre.cmplt(t.uv_max).all())
-                    .map_or(0.0, |index| (index + 1) as f32 / tiles.len() as f32)
-            })
-            .collect();
-        Ok(ExtraImage { name: "tiles".into(), width: self.width, height: self.height, values, overlay: true })
+        self.kernel_image(kernels, "tiles", true, |kernel| {
+            let centre = Vec2::from_array(kernel.centre);
+            tiles
+                .iter()
+                .position(|t| centre.cmpge(t.uv_min).all() && centre.cmplt(t.uv_max).all())
+                .map_or(0.0, |index| (index + 1) as f32 / tiles.len() as f32)
+        })
     }
 }
+
+/// The debug outputs read from step 3's kernel buffer.
+const KERNEL_OUTPUTS: [&str; 3] = ["tiles", "blocker_depth", "predicted_resolution"];
+
+/// `predicted_resolution` is log2 of the texels across the light frame ÷ this (1 = 16384²).
+const PREDICTED_RESOLUTION_SCALE: f32 = 14.0;
 
 fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
     Ok(Box::new(PredictedVirtualShadowMaps::new(setup)?))
@@ -1066,6 +1110,16 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             overlay: true,
         },
         DebugOutput {
+            name: "blocker_depth",
+            doc: "step 3's average occluder depth over the receiver's, z_o / z_y (both from the light's plane): 1 at the receiver (a hard shadow), small near the light (a wide penumbra); 0 where no filter is evaluated",
+            overlay: false,
+        },
+        DebugOutput {
+            name: "predicted_resolution",
+            doc: "step 4's prediction (Eq. 5): log2 of the texels across the light frame the pixel asks for along its finer axis, / 14 (1 = 16384); 0 where no filter is evaluated",
+            overlay: false,
+        },
+        DebugOutput {
             name: "low_res_coverage",
             doc: "the conservative low-resolution map's texels: 1 where a surface was drawn, 0 where none (its side, not the frame's)",
             overlay: false,
@@ -1077,6 +1131,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         UniformCheck { wgsl_struct: "PyramidSettings", wgsl_source: PYRAMID_SHADER, imports: &[], rust: PyramidSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_SHADER, imports: LOCAL_SHADERS, rust: TileSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "CullSettings", wgsl_source: CULL_SHADER, imports: &[], rust: CullSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "Kernel", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: KernelRecord::LAYOUT },
     ],
 };
 

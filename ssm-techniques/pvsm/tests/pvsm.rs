@@ -22,7 +22,7 @@ fn run(scene: &Scene, settings: &[(&str, &str)], size: (u32, u32)) -> (Rendered,
     renderer.render(technique.as_mut(), info.name).unwrap();
     let visibility = renderer.read_visibility(0, info.name).unwrap();
     let diagnostics = technique.diagnostics(&renderer.gpu);
-    let extra = technique.debug_outputs(&renderer.gpu, &["tiles", "low_res_coverage"]).unwrap();
+    let extra = technique.debug_outputs(&renderer.gpu, &["tiles", "low_res_coverage", "blocker_depth", "predicted_resolution"]).unwrap();
     (Rendered { renderer, visibility }, diagnostics, extra)
 }
 
@@ -43,6 +43,51 @@ fn parallel_square_is_within_two_hundredths_of_the_exact_visibility() {
     println!("parallel-square: penumbra MAE {:.4}, {} tiles", metrics.mae_penumbra, value(&diagnostics, "pvsm_tiles"));
     assert!(metrics.mae_penumbra <= 0.02, "{}", metrics.mae_penumbra);
     assert!(value(&diagnostics, "pvsm_tiles") >= 1.0 && value(&diagnostics, "pvsm_tile_cap_reached") == 0.0);
+}
+
+fn image<'a>(extra: &'a [ssm_core::ExtraImage], name: &str) -> &'a ssm_core::ExtraImage {
+    extra.iter().find(|image| image.name == name).unwrap_or_else(|| panic!("no debug output {name}"))
+}
+
+/// Step 3's average occluder depth on parallel-square, where every blocker is the square at depth
+/// 2 over a floor at depth 4 (from the light's plane): z_o / z_y = 0.5 on every filtered floor
+/// pixel, for lights from a fiftieth of the scene's (a search region narrower than one texel of the
+/// low-resolution map, averaged over its texels by area) to twice it (sampled).
+#[test]
+fn the_average_occluder_depth_is_the_occluders() {
+    for scale in [0.02f32, 0.1, 1.0, 2.0] {
+        let mut scene = builtin("parallel-square").unwrap().build();
+        scene.lights[0].half_size *= scale;
+        let (rendered, _, extra) = run(&scene, &[], SIZE);
+        let positions = rendered.renderer.read_positions().unwrap();
+        let ratios: Vec<f32> = image(&extra, "blocker_depth")
+            .values
+            .iter()
+            .zip(&positions)
+            .filter(|(ratio, p)| **ratio > 0.0 && p[1].abs() < 1e-4)
+            .map(|(ratio, _)| *ratio)
+            .collect();
+        let worst = ratios.iter().map(|r| (r - 0.5).abs()).fold(0.0f32, f32::max);
+        println!("light scale {scale}: {} floor pixels with a filter, z_o / z_y within {worst:.2e} of 0.5", ratios.len());
+        assert!(ratios.len() > 200, "scale {scale}: only {} floor pixels have a filter", ratios.len());
+        assert!(worst < 1e-3, "scale {scale}: the average occluder depth is off by {worst} (of 0.5)");
+    }
+}
+
+/// Eq. 5 per pixel: a larger light (a wider penumbra on screen) asks for less resolution.
+#[test]
+fn a_larger_light_asks_for_less_resolution() {
+    let median = |scale: f32| {
+        let mut scene = builtin("parallel-square").unwrap().build();
+        scene.lights[0].half_size *= scale;
+        let (_, _, extra) = run(&scene, &[], SIZE);
+        let mut asked: Vec<f32> = image(&extra, "predicted_resolution").values.iter().copied().filter(|v| *v > 0.0).collect();
+        asked.sort_by(f32::total_cmp);
+        2f32.powf(asked[asked.len() / 2] * 14.0)
+    };
+    let (small, large) = (median(0.1), median(2.0));
+    println!("median predicted resolution: {small:.0} texels across the frame for a tenth of the light, {large:.0} for twice it");
+    assert!(large < 0.5 * small, "{large} against {small}");
 }
 
 /// A light of size zero: every filter is the pixel's footprint, and the result is the hard shadow
