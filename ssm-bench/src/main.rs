@@ -114,6 +114,10 @@ struct SweepArgs {
     /// each scene point's ground truth) under `<out>/images/<scene point>/<technique>/<point>/`.
     #[arg(long)]
     images: bool,
+    /// Debug outputs to write beside each point's images, comma-separated (`ssm list` shows what
+    /// each technique offers; `all`: every one); needs `--images`.
+    #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME", requires = "images")]
+    debug_outputs: Vec<String>,
     /// Output directory: sweep.csv, sweep.md (a Markdown table), sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
@@ -658,7 +662,8 @@ fn run_sweep(
                 continue;
             }
             progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
-            let measured = report::measure(&mut renderer, info, params, args.frames, &[])?;
+            let debug = debug_outputs_for(info, &args.debug_outputs, false);
+            let measured = report::measure(&mut renderer, info, params, args.frames, &debug)?;
             if let Some(dir) = &images {
                 let point_dir = dir.join(info.name).join(sweep::path_component(&sweep::assignment_label(technique_point)));
                 report::write_images(&point_dir, &measured, size, &coverage, Some((&reference, &covered)))?;
@@ -811,6 +816,8 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
     let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
     // Every grid point resolved before the GPU is touched: a bad value fails fast.
     let sweep = resolve_sweep(args, registry, &settings)?;
+    let techniques: Vec<&TechniqueInfo> = sweep.plan.points.iter().map(|(info, _, _)| *info).collect();
+    check_debug_outputs(&args.debug_outputs, &techniques)?;
     let gpu = GpuContext::new()?;
     std::fs::create_dir_all(&sweep.out).with_context(|| format!("creating {}", sweep.out.display()))?;
     let (rows, runs) = run_sweep(&gpu, args, registry, &sweep, &settings)?;

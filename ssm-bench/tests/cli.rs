@@ -266,6 +266,50 @@ fn debug_outputs_are_written_when_asked_and_only_then() {
     let _ = std::fs::remove_dir_all(&unasked);
 }
 
+/// `ssm sweep --images --debug-output NAME` writes the debug output beside each point's images;
+/// `--debug-output` without `--images` is refused.
+#[test]
+fn a_sweep_writes_debug_outputs_with_its_images() {
+    let out = out_dir("sweep-debug");
+    let path = out.to_str().unwrap();
+    let sweep = |extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            "--scene",
+            "floating-sphere",
+            "--vary",
+            "pvsm.antialiasing=true",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--frames",
+            "1",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", path]);
+        ssm(&args)
+    };
+    let output = sweep(&["--images", "--debug-output", "blocker_depth"]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let written: Vec<PathBuf> = walk(&out.join("images")).into_iter().filter(|p| p.ends_with("blocker_depth.png")).collect();
+    assert_eq!(written.len(), 1, "{written:?}");
+    let refused = sweep(&["--debug-output", "blocker_depth"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--images"), "{}", String::from_utf8_lossy(&refused.stderr));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Every file under `dir`, recursively.
+fn walk(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let path = entry.path();
+        if path.is_dir() { files.extend(walk(&path)) } else { files.push(path) }
+    }
+    files
+}
+
 /// `--format json` gives scripts one JSON document on stdout: every technique with its
 /// parameters and debug outputs, every built-in scene with its parameters, and compare's and
 /// sweep's rows with their metrics (notes such as the scene's summary go to stderr).
