@@ -1,49 +1,10 @@
-// Percentage-closer soft shadows (Fernando 2005), with the regular n×n blocker
-// search and m×m filter grids that Buades et al. (2015) and Shen et al. (2011)
-// compare against.
-//
-// 1. Blocker search: the region of the shadow map through which the receiver
-//    can see the light at the nearest possible blocker depth (the frame's near
-//    plane) is sampled on an n×n grid; texels nearer the light than the
-//    receiver are blockers, and their depths are averaged.
-// 2. Penumbra estimate: with parallel planes, the light seen from the
-//    receiver through the blocker plane at d_blocker spans
-//    w_light * (d_receiver - d_blocker) / (d_receiver * d_blocker) in the
-//    map's normalised units (Fernando's w_penumbra scaled to the map).
-// 3. PCF over that extent on an m×m grid.
-//
-// With `receiver_plane` on, each tap compares against the depth of the
-// receiver's tangent plane along that tap's ray rather than the receiver's
-// own depth, so that a wide kernel on a surface tilted to the light does not
-// find the surface itself (Isidoro 2006). Off, this is Fernando's sketch.
+// PCSS (pcss_common.wgsl) as a fragment pass: every tap reads the shadow map.
 
-// #import common/screen_pass.wgsl
-// #import common/shadow_map.wgsl
-// #import common/read_counts.wgsl
+// #import pcss/pcss_common.wgsl
 
-struct PcssSettings {
-    // Samples per axis of the blocker search (n).
-    blocker_kernel: u32,
-    // Samples per axis of the filter (m).
-    pcf_kernel: u32,
-    // 1: compare taps with the receiver's tangent plane; 0: with its depth.
-    receiver_plane: u32,
-    // Normal offset of the lookup point, in shadow-map texels.
-    normal_offset: f32,
-    // 1: count the texture reads of each computed pixel into read_counts (profiling; atomics cost time).
-    count_reads: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
-
-@group(2) @binding(0) var shadow_map: texture_2d<f32>;
-@group(2) @binding(1) var<uniform> settings: PcssSettings;
-// Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
-@group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
-
-// Texture reads of this invocation: the G-buffer's two and every shadow-map tap.
-var<private> reads: u32;
+fn tap_depth(uv: vec2<f32>) -> f32 {
+    return shadow_map_depth(shadow_map, uv);
+}
 
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
@@ -53,55 +14,7 @@ fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
         return trivial;
     }
     reads = 2u;
-    let visibility = soft_visibility(point);
-    if (settings.count_reads != 0u) {
-        let word = read_count_word(0u, point.texel);
-        atomicAdd(&read_counts[word], 1u);
-        atomicAdd(&read_counts[word + 1u], reads);
-    }
+    let visibility = soft_visibility(pcss_pixel(point));
+    record_pcss_reads(point.texel);
     return visibility;
-}
-
-// Steps 1 to 3 for a pixel that needs them.
-fn soft_visibility(point: ScreenPoint) -> f32 {
-    let normal = point.normal;
-    let lookup = normal_offset_position(frame, shadow_map, point.position, normal, settings.normal_offset);
-    let uvd = light_uv_depth(frame, lookup);
-    let receiver_depth = uvd.z;
-    // What each tap is compared with (the settings' receiver model; common/shadow_map.wgsl), prepared once.
-    let receiver = receiver_tap_plane(frame, lookup, normal, receiver_depth, settings.receiver_plane != 0u);
-
-    // 1. Blocker search over the light's back-projection through the near plane.
-    let search = light_half_extent_uv(frame, frame.projection.z, receiver_depth);
-    let n = max(settings.blocker_kernel, 1u);
-    var blocker_sum = 0.0;
-    var blocker_count = 0u;
-    for (var j = 0u; j < n; j++) {
-        for (var i = 0u; i < n; i++) {
-            let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
-            let depth = shadow_map_depth(shadow_map, uv);
-            reads += 1u;
-            if (depth < tap_plane_depth(receiver, uv)) {
-                blocker_sum += depth;
-                blocker_count += 1u;
-            }
-        }
-    }
-    if (blocker_count == 0u) {
-        return 1.0;
-    }
-    let blocker_depth = blocker_sum / f32(blocker_count);
-
-    // 2. Penumbra extent, 3. PCF over it.
-    let filter_extent = light_half_extent_uv(frame, blocker_depth, receiver_depth);
-    let m = max(settings.pcf_kernel, 1u);
-    var lit = 0.0;
-    for (var j = 0u; j < m; j++) {
-        for (var i = 0u; i < m; i++) {
-            let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
-            lit += select(0.0, 1.0, tap_plane_depth(receiver, uv) <= shadow_map_depth(shadow_map, uv));
-            reads += 1u;
-        }
-    }
-    return lit / f32(m * m);
 }

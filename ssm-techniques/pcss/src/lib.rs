@@ -10,11 +10,14 @@
 //! separable and predicted variants exist.
 
 use bytemuck::{Pod, Zeroable};
-use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, compute_pipeline, storage_buffer, storage_entry, texture_entry, uniform_buffer, uniform_entry,
+    visibility_storage_entry,
+};
 use ssm_core::read_counts::ReadCounts;
-use ssm_core::shader::create_shader;
+use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE,
+    Choice, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE,
     ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
     VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
@@ -22,8 +25,29 @@ use ssm_core::{
 /// The registered name.
 pub const NAME: &str = "pcss";
 
-/// The blocker search and filter shader.
+/// What both passes share: the settings, the bindings, the blocker search and the filter.
+const COMMON_SHADER: &str = include_str!("../../../shaders/pcss/pcss_common.wgsl");
+/// The fragment pass.
 const SHADER: &str = include_str!("../../../shaders/pcss/pcss.wgsl");
+/// The compute pass whose workgroups share the texels they read.
+const TILED_SHADER: &str = include_str!("../../../shaders/pcss/pcss_tiled.wgsl");
+/// WGSL files the PCSS shaders import besides `common/`.
+const LOCAL_SHADERS: &[(&str, &str)] = &[("pcss/pcss_common.wgsl", COMMON_SHADER)];
+/// The label of the pass (both implementations), and of its read counts.
+const PASS: &str = "pcss_blocker_search_and_filter";
+
+/// Where a tap's depth comes from (the same texels, so the same pixels, either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum TapSource {
+    /// A full-screen fragment pass: every tap reads the shadow map.
+    Texture,
+    /// A compute pass whose 8×8 workgroups load the union of their pixels' search windows into
+    /// workgroup memory once, when it holds at most 4,080 texels (windows a few dozen texels
+    /// wide: a small light, or a coarse map), and read every tap from there; groups with a
+    /// larger union read the shadow map. The implementation, not the algorithm: beside
+    /// `texture`, it tells what PCSS's taps cost from what their number costs.
+    WorkgroupTile,
+}
 
 /// Settings of [`Pcss`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
@@ -40,6 +64,9 @@ pub struct PcssSettings {
     /// Count each pass's texture reads per pixel (diagnostics `pcss_blocker_search_and_filter_reads_per_pixel`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
+    /// Where taps read their depth: texture (a fragment pass reading the shadow map) or workgroup_tile (a compute pass whose workgroups share the texels their pixels read, when they fit; the same pixels).
+    #[param(choice, default = "texture")]
+    pub tap_source: TapSource,
     /// What the taps are compared with.
     #[param(flatten)]
     pub receiver: ReceiverModel,
@@ -77,12 +104,27 @@ impl From<&PcssSettings> for PcssSettingsUniform {
     }
 }
 
+/// The blocker search and filter, as one of [`TapSource`]'s passes.
+enum SearchAndFilter {
+    Fragment(ScreenPass),
+    /// The compute pass, its G-buffer group, per light its output group, and the counts of
+    /// workgroups that used their tile.
+    Tiled {
+        pipeline: wgpu::ComputePipeline,
+        gbuffer_group: wgpu::BindGroup,
+        output_groups: Vec<wgpu::BindGroup>,
+        tile_counts: wgpu::Buffer,
+    },
+}
+
 /// PCSS.
 pub struct Pcss {
     depth_map: LightDepthMap,
-    search_and_filter: ScreenPass,
+    search_and_filter: SearchAndFilter,
     map_bind_group: wgpu::BindGroup,
     read_counts: ReadCounts,
+    width: u32,
+    height: u32,
 }
 
 impl Pcss {
@@ -95,7 +137,7 @@ impl Pcss {
         let device = &setup.gpu.device;
         let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
-        let read_counts = ReadCounts::new(device, "pcss_read_counts", &["pcss_blocker_search_and_filter"], settings.count_reads);
+        let read_counts = ReadCounts::new(device, "pcss_read_counts", &[PASS], settings.count_reads);
         let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
@@ -107,17 +149,52 @@ impl Pcss {
                 read_counts.buffer().as_entire_binding(),
             ],
         );
-        let module = create_shader(setup.gpu, "pcss_filter_shader", SHADER)?;
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
-        let search_and_filter = ScreenPass::new(
-            setup,
-            NAME,
-            "pcss_blocker_search_and_filter",
-            (&module, "pcss_filter"),
-            Some(&map_layout),
-            VISIBILITY_FORMAT.into(),
-        )?;
-        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts })
+        let search_and_filter = match settings.tap_source {
+            TapSource::Texture => {
+                let module = create_shader_with_imports(setup.gpu, "pcss_filter_shader", SHADER, LOCAL_SHADERS)?;
+                SearchAndFilter::Fragment(ScreenPass::new(
+                    setup,
+                    NAME,
+                    PASS,
+                    (&module, "pcss_filter"),
+                    Some(&map_layout),
+                    VISIBILITY_FORMAT.into(),
+                )?)
+            }
+            TapSource::WorkgroupTile => Self::tiled(setup, &map_layout)?,
+        };
+        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, width: setup.scene.width, height: setup.scene.height })
+    }
+
+    /// The compute pass of [`TapSource::WorkgroupTile`].
+    fn tiled(setup: &TechniqueSetup<'_>, map_layout: &wgpu::BindGroupLayout) -> Result<SearchAndFilter> {
+        let device = &setup.gpu.device;
+        let gbuffer = setup.shared.gbuffer(NAME)?;
+        let module = create_shader_with_imports(setup.gpu, "pcss_filter_tiled_shader", TILED_SHADER, LOCAL_SHADERS)?;
+        let output_layout = bind_group_layout(device, "pcss_tiled_output_layout", &[visibility_storage_entry(0), storage_entry(1, false)]);
+        let pipeline = compute_pipeline(
+            device,
+            "pcss_filter_tiled_pipeline",
+            &module,
+            "pcss_filter_tiled",
+            &[&setup.scene.uniform_layout, &gbuffer.layout, map_layout, &output_layout],
+        );
+        let tile_counts = storage_buffer(device, "pcss_tile_counts", 8);
+        let output_groups = setup
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(light, output)| {
+                bind_group(
+                    device,
+                    &format!("pcss_tiled_output_bind_group_{light}"),
+                    &output_layout,
+                    &[wgpu::BindingResource::TextureView(output), tile_counts.as_entire_binding()],
+                )
+            })
+            .collect();
+        Ok(SearchAndFilter::Tiled { pipeline, gbuffer_group: gbuffer.bind_group.clone(), output_groups, tile_counts })
     }
 }
 
@@ -125,13 +202,39 @@ impl ShadowTechnique for Pcss {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
-        self.search_and_filter.encode(frame, light, output, Some(&self.map_bind_group), None);
+        match &self.search_and_filter {
+            SearchAndFilter::Fragment(pass) => pass.encode(frame, light, output, Some(&self.map_bind_group), None),
+            SearchAndFilter::Tiled { pipeline, gbuffer_group, output_groups, tile_counts } => {
+                let output_group = output_groups
+                    .get(light)
+                    .ok_or_else(|| ssm_core::Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
+                frame.clear_buffer("pcss_clear_tile_counts", tile_counts, 0, None);
+                let light_group = &frame.scene.light_bind_groups[light];
+                let mut pass = frame.compute_pass(PASS);
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, light_group, &[]);
+                pass.set_bind_group(1, gbuffer_group, &[]);
+                pass.set_bind_group(2, &self.map_bind_group, &[]);
+                pass.set_bind_group(3, output_group, &[]);
+                pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+            }
+        }
         Ok(())
     }
 
-    /// With `count_reads`: texture reads per computed pixel, and the pixels.
+    /// With `count_reads`: texture reads per computed pixel, and the pixels; with `tap_source =
+    /// workgroup_tile`, `pcss_tiled_share`: the share of the last light's workgroups (with a pixel
+    /// to compute) whose union of windows fitted their tile.
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
-        self.read_counts.diagnostics(gpu)
+        let mut out = self.read_counts.diagnostics(gpu);
+        if let SearchAndFilter::Tiled { tile_counts, .. } = &self.search_and_filter
+            && let Ok(bytes) = ssm_core::readback::read_buffer(gpu, tile_counts, 8, "PCSS tile counts")
+            && let [tiled, groups] = bytemuck::pod_collect_to_vec::<u8, u32>(&bytes)[..]
+            && groups > 0
+        {
+            out.push(("pcss_tiled_share".to_owned(), f64::from(tiled) / f64::from(groups)));
+        }
+        out
     }
 }
 
@@ -150,6 +253,13 @@ const PRESETS: &[ssm_core::Preset] = &[
         summary: "PCSS with the kernel pairs of Buades et al., Table 4 (7/15, 11/21, 29/41)",
         scenes: &["leaves"],
         varies: &["pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41"],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "pcss-taps",
+        summary: "PCSS's taps from the shadow map or from workgroup memory (tap_source; the same pixels) at the kernel pairs of Buades et al., Table 4: what the implementation costs beside what the algorithm does",
+        scenes: &["leaves"],
+        varies: &["pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41", "pcss.tap_source=texture,workgroup_tile"],
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -173,7 +283,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     presets: PRESETS,
     trade: Some("blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41"),
     debug_outputs: &[],
-    uniforms: &[UniformCheck { wgsl_struct: "PcssSettings", wgsl_source: SHADER, imports: &[], rust: PcssSettingsUniform::LAYOUT }],
+    uniforms: &[UniformCheck {
+        wgsl_struct: "PcssSettings",
+        wgsl_source: SHADER,
+        imports: LOCAL_SHADERS,
+        rust: PcssSettingsUniform::LAYOUT,
+    }],
 };
 
 register_technique!(INFO);

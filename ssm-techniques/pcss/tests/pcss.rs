@@ -91,3 +91,53 @@ fn every_builtin_scene_matches_its_reference_image() {
         panic!("{failures}");
     }
 }
+
+/// A case of the test below: its name, scene, settings and the range of the share of tiled workgroups.
+type TileCase = (&'static str, ssm_scene::Scene, &'static [(&'static str, &'static str)], (f64, f64));
+
+/// `tap_source = workgroup_tile` reads every tap's texel from the workgroup's shared tile where
+/// the union of its pixels' windows fits, else from the shadow map: the same texels as the
+/// fragment pass, so the same pixels. Cases where the tiles fit (a small light; a coarse map) and
+/// where they do not (leaves' large windows), at Table 4's smallest and largest kernels.
+#[test]
+fn workgroup_tiles_give_the_fragment_passes_pixels() {
+    use ssm_core::Renderer;
+    let gpu = gpu();
+    let mut small_light = builtin("parallel-square").unwrap().build();
+    small_light.lights[0].half_size *= 0.1;
+    let cases: [TileCase; 4] = [
+        ("small light", small_light, &[], (0.9, 1.0)),
+        (
+            "coarse map, 29/41",
+            builtin("floating-sphere").unwrap().build(),
+            &[("shadow_map_size", "64"), ("blocker_kernel", "29"), ("pcf_kernel", "41")],
+            (0.9, 1.0),
+        ),
+        ("leaves 7/15", builtin("leaves").unwrap().build(), &[], (0.0, 0.5)),
+        ("leaves 29/41", builtin("leaves").unwrap().build(), &[("blocker_kernel", "29"), ("pcf_kernel", "41")], (0.0, 0.5)),
+    ];
+    for (name, scene, settings, (low, high)) in cases {
+        let with = |source: &'static str| {
+            let mut all = settings.to_vec();
+            all.push(("tap_source", source));
+            let info = &ssm_pcss::INFO;
+            let params = info.params_from(all.iter().copied()).unwrap();
+            let needs = (info.requirements)(&params).unwrap();
+            let mut renderer = Renderer::new(&gpu, &scene, WIDTH, HEIGHT, &needs).unwrap();
+            let mut technique = renderer.create_technique(info, &params).unwrap();
+            renderer.render(technique.as_mut(), info.name).unwrap();
+            (renderer.read_visibility(0, info.name).unwrap(), technique.diagnostics(&renderer.gpu))
+        };
+        let ((tiled, diagnostics), (fragment, _)) = (with("workgroup_tile"), with("texture"));
+        let share = diagnostics.iter().find(|(k, _)| k == "pcss_tiled_share").map(|(_, v)| *v).expect("no pcss_tiled_share");
+        let largest = tiled.iter().zip(&fragment).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        let shadowed = fragment.iter().filter(|v| **v < 0.999).count();
+        println!(
+            "{name}: {:.0}% of workgroups tiled, largest difference {largest:e}, {shadowed} pixels in shadow or penumbra",
+            100.0 * share
+        );
+        assert!(shadowed > 100, "{name}: the case has too little shadow");
+        assert!((low..=high).contains(&share), "{name}: {share} of the workgroups tiled, expected {low} to {high}");
+        assert_eq!(largest, 0.0, "{name}: the tiled pass differs from the fragment pass by up to {largest}");
+    }
+}

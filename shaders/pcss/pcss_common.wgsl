@@ -1,0 +1,114 @@
+// Percentage-closer soft shadows (Fernando 2005), with the regular n×n blocker
+// search and m×m filter grids that Buades et al. (2015) and Shen et al. (2011)
+// compare against; shared by the fragment pass (pcss.wgsl) and the compute pass
+// whose workgroups share the shadow-map texels they read (pcss_tiled.wgsl).
+// Each entry file defines `tap_depth(uv)`, where a tap's depth comes from.
+//
+// 1. Blocker search: the region of the shadow map through which the receiver
+//    can see the light at the nearest possible blocker depth (the frame's near
+//    plane) is sampled on an n×n grid; texels nearer the light than the
+//    receiver are blockers, and their depths are averaged.
+// 2. Penumbra estimate: with parallel planes, the light seen from the
+//    receiver through the blocker plane at d_blocker spans
+//    w_light * (d_receiver - d_blocker) / (d_receiver * d_blocker) in the
+//    map's normalised units (Fernando's w_penumbra scaled to the map).
+// 3. PCF over that extent on an m×m grid.
+//
+// With `receiver_plane` on, each tap compares against the depth of the
+// receiver's tangent plane along that tap's ray rather than the receiver's
+// own depth, so that a wide kernel on a surface tilted to the light does not
+// find the surface itself (Isidoro 2006). Off, this is Fernando's sketch.
+
+// #import common/screen_pass.wgsl
+// #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
+
+struct PcssSettings {
+    // Samples per axis of the blocker search (n).
+    blocker_kernel: u32,
+    // Samples per axis of the filter (m).
+    pcf_kernel: u32,
+    // 1: compare taps with the receiver's tangent plane; 0: with its depth.
+    receiver_plane: u32,
+    // Normal offset of the lookup point, in shadow-map texels.
+    normal_offset: f32,
+    // 1: count the texture reads of each computed pixel into read_counts (profiling; atomics cost time).
+    count_reads: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+@group(2) @binding(0) var shadow_map: texture_2d<f32>;
+@group(2) @binding(1) var<uniform> settings: PcssSettings;
+// Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
+@group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texture reads of this invocation: the G-buffer's two and every shadow-map tap.
+var<private> reads: u32;
+
+// A pixel's lookup, prepared before its taps.
+struct PcssPixel {
+    // Shadow-map coordinates and light depth of the lookup point (the normal offset applied).
+    uvd: vec3<f32>,
+    // What each tap is compared with (the settings' receiver model; common/shadow_map.wgsl).
+    receiver: TapPlane,
+    // Half extent of the blocker search, shadow-map coordinates; every tap of both steps lies
+    // inside uvd.xy ± search (the filter's extent is the light through the blockers' plane, which
+    // is no nearer the light than the near plane the search uses).
+    search: vec2<f32>,
+};
+
+fn pcss_pixel(point: ScreenPoint) -> PcssPixel {
+    let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
+    let uvd = light_uv_depth(frame, lookup);
+    let receiver = receiver_tap_plane(frame, lookup, point.normal, uvd.z, settings.receiver_plane != 0u);
+    return PcssPixel(uvd, receiver, light_half_extent_uv(frame, frame.projection.z, uvd.z));
+}
+
+// Steps 1 to 3 for a pixel that needs them.
+fn soft_visibility(pixel: PcssPixel) -> f32 {
+    let uvd = pixel.uvd;
+    let receiver = pixel.receiver;
+    // 1. Blocker search over the light's back-projection through the near plane.
+    let n = max(settings.blocker_kernel, 1u);
+    var blocker_sum = 0.0;
+    var blocker_count = 0u;
+    for (var j = 0u; j < n; j++) {
+        for (var i = 0u; i < n; i++) {
+            let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * pixel.search;
+            let depth = tap_depth(uv);
+            reads += 1u;
+            if (depth < tap_plane_depth(receiver, uv)) {
+                blocker_sum += depth;
+                blocker_count += 1u;
+            }
+        }
+    }
+    if (blocker_count == 0u) {
+        return 1.0;
+    }
+    let blocker_depth = blocker_sum / f32(blocker_count);
+
+    // 2. Penumbra extent, 3. PCF over it.
+    let filter_extent = light_half_extent_uv(frame, blocker_depth, uvd.z);
+    let m = max(settings.pcf_kernel, 1u);
+    var lit = 0.0;
+    for (var j = 0u; j < m; j++) {
+        for (var i = 0u; i < m; i++) {
+            let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
+            lit += select(0.0, 1.0, tap_plane_depth(receiver, uv) <= tap_depth(uv));
+            reads += 1u;
+        }
+    }
+    return lit / f32(m * m);
+}
+
+// Records this invocation's reads (with settings.count_reads).
+fn record_pcss_reads(texel: vec2<i32>) {
+    if (settings.count_reads != 0u) {
+        let word = read_count_word(0u, texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+}
