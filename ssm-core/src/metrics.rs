@@ -54,6 +54,9 @@ pub struct ErrorMetrics {
     pub frac_over_0_05: f64,
     /// Mean signed error over covered pixels: negative when the technique over-shadows.
     pub mean_signed: f64,
+    /// Light bleeding: the technique's mean visibility over the pixels in umbra in the reference
+    /// (0 when every one of them is dark; pre-filtered shadow maps leak light there).
+    pub umbra_leak: f64,
     /// Covered pixels compared.
     pub pixels: usize,
     /// Pixels in penumbra in the reference.
@@ -72,6 +75,7 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
     let classes = classify(reference, covered);
     let (mut count, mut squared, mut max_abs, mut over, mut signed) = (0usize, 0.0f64, 0.0f64, 0usize, 0.0f64);
     let (mut shadow_sum, mut shadow_count) = (0.0f64, 0usize);
+    let (mut umbra_light, mut umbra_count) = (0.0f64, 0usize);
     for ((&r, &v), class) in reference.iter().zip(image).zip(&classes) {
         if *class == ShadowClass::Background {
             continue;
@@ -86,6 +90,10 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
             shadow_sum += error.abs();
             shadow_count += 1;
         }
+        if *class == ShadowClass::Umbra {
+            umbra_light += f64::from(v);
+            umbra_count += 1;
+        }
     }
     let n = count.max(1) as f64;
     let mse = squared / n;
@@ -97,6 +105,7 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
         ssim: ssim(reference, image, covered, width, height),
         frac_over_0_05: over as f64 / n,
         mean_signed: signed / n,
+        umbra_leak: if umbra_count == 0 { 0.0 } else { umbra_light / umbra_count as f64 },
         pixels: count,
         penumbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Penumbra).count(),
         umbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Umbra).count(),
@@ -212,6 +221,8 @@ mod tests {
         let m = compare(&reference, &image, &vec![true; w * h], w, h);
         assert!((m.rmse - 0.1).abs() < 1e-6 && (m.max_abs - 0.1).abs() < 1e-6 && (m.mae_penumbra - 0.1).abs() < 1e-6);
         assert!((m.mean_signed - 0.1).abs() < 1e-6);
+        // A flat 0.5 reference has no umbra: nothing to leak into.
+        assert_eq!((m.umbra_pixels, m.umbra_leak), (0, 0.0));
         assert!((m.psnr - 20.0).abs() < 1e-4, "PSNR of a 0.1 offset is 20 dB, got {}", m.psnr);
         assert_eq!(m.frac_over_0_05, 1.0);
         // Flat images: variances are 0, so SSIM is the luminance term (2·0.5·0.6 + C1)/(0.25 + 0.36 + C1).
@@ -251,6 +262,16 @@ mod tests {
             classify(&reference, &covered),
             vec![ShadowClass::Background, ShadowClass::Lit, ShadowClass::Penumbra, ShadowClass::Umbra]
         );
+    }
+
+    #[test]
+    fn umbra_leak_is_the_mean_visibility_over_the_reference_umbra() {
+        // Two umbra pixels (0.3 and 0.1 of light leaked), a penumbra and a lit one that do not count.
+        let reference = vec![0.0, 0.0, 0.5, 1.0];
+        let image = vec![0.3, 0.1, 0.9, 0.6];
+        let m = compare(&reference, &image, &[true; 4], 4, 1);
+        assert_eq!(m.umbra_pixels, 2);
+        assert!((m.umbra_leak - 0.2).abs() < 1e-6, "{}", m.umbra_leak);
     }
 
     #[test]

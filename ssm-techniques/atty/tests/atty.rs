@@ -119,7 +119,7 @@ fn two_sided_darkens_where_the_back_faces_hide_more_and_is_more_accurate() {
     let gpu = gpu();
     let one = render(&gpu, &sphere, &ssm_atty::INFO, &[], SIZE.0, SIZE.1).unwrap();
     let two = render(&gpu, &sphere, &ssm_atty::INFO, &[("two_sided", "true")], SIZE.0, SIZE.1).unwrap();
-    let receives: Vec<bool> = one.renderer.read_normals().unwrap().iter().map(|n| n[3] > 0.5).collect();
+    let receives = one.receivers();
     let pairs: Vec<(f32, f32)> =
         one.visibility.iter().zip(&two.visibility).zip(&receives).filter(|(_, r)| **r).map(|((a, b), _)| (*a, *b)).collect();
     let lighter = pairs.iter().filter(|(a, b)| b > &(a + 1e-4)).count();
@@ -145,7 +145,7 @@ fn a_point_light_gives_the_hard_shadow() {
     let gpu = gpu();
     let atty = render(&gpu, &scene, &ssm_atty::INFO, &[("occluder_map_size", "512"), ("ssm_size", "1024")], SIZE.0, SIZE.1).unwrap();
     let exact = ssm_testing::reference(&gpu, &scene, 1, SIZE);
-    let receives: Vec<bool> = atty.renderer.read_normals().unwrap().iter().map(|n| n[3] > 0.5).collect();
+    let receives = atty.receivers();
     let compared: Vec<(f32, f32)> =
         atty.visibility.iter().zip(&exact.visibility).zip(&receives).filter(|(_, r)| **r).map(|((a, e), _)| (*a, *e)).collect();
     let penumbra = compared.iter().filter(|(a, _)| *a > 0.02 && *a < 0.98).count() as f32 / compared.len() as f32;

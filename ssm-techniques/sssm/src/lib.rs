@@ -582,12 +582,13 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "sssm-table4",
-        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse; both with the receiver-plane model (on leaves, the plant scene's nearest)",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM with alpha = beta from little to much reuse; both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
             "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
             "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
+            "vssm",
         ],
         ..ssm_core::Preset::DEFAULT
     },

@@ -172,7 +172,7 @@ role = "receiver"
     // The receiver flag tells the ground from the sphere; the silhouette is where it changes.
     let kind = |x: i32, y: i32| {
         let i = (y.clamp(0, height - 1) * width + x.clamp(0, width - 1)) as usize;
-        (positions[i][3] > 0.5, normals[i][3] > 0.5)
+        (positions[i][3] > 0.5, ssm_core::GBuffer::flags(normals[i][3]) & ssm_core::GBuffer::RECEIVES != 0)
     };
     let near_silhouette: Vec<usize> = (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))

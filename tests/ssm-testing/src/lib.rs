@@ -106,7 +106,12 @@ impl Rendered {
     /// If the normals cannot be read back.
     #[must_use]
     pub fn receivers(&self) -> Vec<bool> {
-        self.renderer.read_normals().unwrap_or_else(|e| panic!("{e}")).iter().map(|n| n[3] > 0.5).collect()
+        self.renderer
+            .read_normals()
+            .unwrap_or_else(|e| panic!("{e}"))
+            .iter()
+            .map(|n| ssm_core::GBuffer::flags(n[3]) & ssm_core::GBuffer::RECEIVES != 0)
+            .collect()
     }
 
     /// Light 0's visibility at the pixels that geometry covers (background left out).

@@ -1,0 +1,264 @@
+//! Baseline: variance soft shadow mapping (Yang, Dong, Feng, Seidel and Kautz 2010, *Variance
+//! Soft Shadow Mapping*, Computer Graphics Forum 29(7), Pacific Graphics).
+//!
+//! PCSS's blocker search, penumbra estimate and filter (Fernando 2005), each region answered in
+//! constant time by the shadow map's first two moments (Donnelly and Lauritzen 2006, variance
+//! shadow maps) read from their summed-area table: the average blocker depth from Chebyshev's
+//! one-tailed bound on the fraction of non-blockers, the fraction lit from the same bound; the
+//! kernel subdivided into sub-regions to avoid VSM's incorrectly lit pixels. Passes: the depth
+//! map, the table (rows, then columns, exact 64-bit fixed-point sums), the filter.
+
+use bytemuck::{Pod, Zeroable};
+use ssm_core::passes::{
+    bind_group, bind_group_layout, compute_pipeline, labelled_view, texture_entry, uniform_buffer, uniform_entry,
+    write_storage_texture_entry,
+};
+use ssm_core::shader::create_shader_with_imports;
+use ssm_core::{
+    Frame, LightDepthMap, ParamValues, Preset, Requirements, Result, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo,
+    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
+};
+
+/// The registered name.
+pub const NAME: &str = "vssm";
+
+/// What the table and filter passes share.
+const COMMON_SHADER: &str = include_str!("../../../shaders/vssm/vssm_common.wgsl");
+/// The summed-area table's two passes.
+const SAT_SHADER: &str = include_str!("../../../shaders/vssm/vssm_sat.wgsl");
+/// The blocker search, penumbra estimate and filter.
+const FILTER_SHADER: &str = include_str!("../../../shaders/vssm/vssm.wgsl");
+/// WGSL files the VSSM shaders import besides `common/`.
+const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
+
+/// The table's texel format: the two moments' 64-bit sums as four 32-bit words.
+const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+
+/// Largest shadow map whose table the 64-bit sums hold exactly (4096² texels of moments below
+/// 2^32 sum to below 2^56) and that fits a device's textures.
+const MAX_SIZE: u32 = 4096;
+
+/// Settings of [`VarianceSoftShadowMaps`]: its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Settings)]
+pub struct VssmSettings {
+    /// Side of the square shadow map and of its summed-area table, texels.
+    #[param(default = 1024, min = 16, max = 4096)]
+    pub shadow_map_size: u32,
+    /// Sub-regions per axis of the blocker search's and the filter's regions (1: each region one VSM query; the paper subdivides the kernel against incorrectly lit pixels).
+    #[param(default = 2, min = 1, max = 8)]
+    pub subdivision: u32,
+    /// Smallest variance Chebyshev's bound uses, in units of (depth / far)².
+    #[param(default = 1e-7, min = 0.0, max = 0.01)]
+    pub min_variance: f32,
+    /// Depth bias added to every texel, as a fraction of the scene's bounding-box diagonal (the receiver's depth is compared with its own texels' depth, bias included).
+    #[param(default = 1e-3, min = 0.0, max = 0.1)]
+    pub constant_bias: f32,
+    /// Lookup point moved off the surface along its normal, in shadow-map texels; 0 by default: the bound is continuous in depth, so there is no acne to push away from, and the offset would put the receiver nearer the light than its own texels, where the bound is loose.
+    #[param(default = 0.0, min = 0.0, max = 8.0)]
+    pub normal_offset: f32,
+}
+
+impl VssmSettings {
+    /// The depth map's bias (no slope bias: the bound needs the texels' true depths).
+    fn bias(&self) -> ShadowMapBias {
+        ShadowMapBias { constant_bias: self.constant_bias, slope_bias: 0.0, normal_offset: self.normal_offset }
+    }
+}
+
+/// `VssmSettings` of `shaders/vssm/vssm.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct VssmSettingsUniform {
+    size: f32,
+    subdivision: u32,
+    min_variance: f32,
+    normal_offset: f32,
+    constant_bias: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+impl VssmSettingsUniform {
+    /// The uniform of `settings` in a scene whose bounding box's diagonal is `diagonal`.
+    fn new(settings: &VssmSettings, diagonal: f32) -> Self {
+        Self {
+            size: settings.shadow_map_size as f32,
+            subdivision: settings.subdivision,
+            min_variance: settings.min_variance,
+            normal_offset: settings.normal_offset,
+            constant_bias: settings.constant_bias * diagonal,
+            _pad0: 0.0,
+            _pad1: 0.0,
+            _pad2: 0.0,
+        }
+    }
+}
+
+/// Variance soft shadow mapping.
+pub struct VarianceSoftShadowMaps {
+    depth_map: LightDepthMap,
+    rows: wgpu::ComputePipeline,
+    columns: wgpu::ComputePipeline,
+    rows_group: wgpu::BindGroup,
+    columns_group: wgpu::BindGroup,
+    filter: ScreenPass,
+    filter_group: wgpu::BindGroup,
+    size: u32,
+}
+
+impl VarianceSoftShadowMaps {
+    /// Builds the depth map, the table and the pipelines.
+    ///
+    /// # Errors
+    /// A parameter or GPU error.
+    pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
+        let settings = VssmSettings::from_params(setup.params)?;
+        let gpu = setup.gpu;
+        let device = &gpu.device;
+        let size = settings.shadow_map_size;
+        let depth_map = settings.bias().depth_map(setup, "vssm_shadow_map", size)?;
+        let table_texture = |label: &str| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: TABLE_FORMAT,
+                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let row_sums = labelled_view(&table_texture("vssm_row_sums"), "vssm_row_sums");
+        let table = labelled_view(&table_texture("vssm_moment_table"), "vssm_moment_table");
+        let uint_texture_entry = |binding: u32| wgpu::BindGroupLayoutEntry {
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            ..texture_entry(binding)
+        };
+        let rows_layout =
+            bind_group_layout(device, "vssm_sat_rows_layout", &[texture_entry(0), write_storage_texture_entry(1, TABLE_FORMAT)]);
+        let columns_layout =
+            bind_group_layout(device, "vssm_sat_columns_layout", &[uint_texture_entry(2), write_storage_texture_entry(3, TABLE_FORMAT)]);
+        let sat_module = create_shader_with_imports(gpu, "vssm_sat_shader", SAT_SHADER, LOCAL_SHADERS)?;
+        let frame_layout = &setup.scene.uniform_layout;
+        let rows = compute_pipeline(device, "vssm_sat_rows_pipeline", &sat_module, "vssm_sat_rows", &[frame_layout, &rows_layout]);
+        let columns =
+            compute_pipeline(device, "vssm_sat_columns_pipeline", &sat_module, "vssm_sat_columns", &[frame_layout, &columns_layout]);
+        let rows_group = bind_group(
+            device,
+            "vssm_sat_rows_bind_group",
+            &rows_layout,
+            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), wgpu::BindingResource::TextureView(&row_sums)],
+        );
+        let columns_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vssm_sat_columns_bind_group"),
+            layout: &columns_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&row_sums) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&table) },
+            ],
+        });
+        let filter_layout = bind_group_layout(device, "vssm_filter_layout", &[uint_texture_entry(0), uniform_entry(1), texture_entry(2)]);
+        let filter_group = bind_group(
+            device,
+            "vssm_filter_bind_group",
+            &filter_layout,
+            &[
+                wgpu::BindingResource::TextureView(&table),
+                uniform_buffer(device, "vssm_settings_uniform", &VssmSettingsUniform::new(&settings, setup.scene.bounds.size().length()))
+                    .as_entire_binding(),
+                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+            ],
+        );
+        let filter_module = create_shader_with_imports(gpu, "vssm_filter_shader", FILTER_SHADER, LOCAL_SHADERS)?;
+        let filter =
+            ScreenPass::new(setup, NAME, "vssm_filter", (&filter_module, "vssm_filter"), Some(&filter_layout), VISIBILITY_FORMAT.into())?;
+        Ok(Self { depth_map, rows, columns, rows_group, columns_group, filter, filter_group, size })
+    }
+}
+
+impl ShadowTechnique for VarianceSoftShadowMaps {
+    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
+        self.depth_map.encode(frame, light);
+        let groups = self.size.div_ceil(64);
+        {
+            let light_group = &frame.scene.light_bind_groups[light];
+            let mut pass = frame.compute_pass("vssm_sat_rows");
+            pass.set_pipeline(&self.rows);
+            pass.set_bind_group(0, light_group, &[]);
+            pass.set_bind_group(1, &self.rows_group, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        {
+            let light_group = &frame.scene.light_bind_groups[light];
+            let mut pass = frame.compute_pass("vssm_sat_columns");
+            pass.set_pipeline(&self.columns);
+            pass.set_bind_group(0, light_group, &[]);
+            pass.set_bind_group(1, &self.columns_group, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        self.filter.encode(frame, light, output, Some(&self.filter_group), None);
+        Ok(())
+    }
+}
+
+fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(VarianceSoftShadowMaps::new(setup)?))
+}
+
+fn requirements(params: &ParamValues) -> Result<Requirements> {
+    let settings = VssmSettings::from_params(params)?;
+    Ok(screen_space_requirements(settings.shadow_map_size.min(MAX_SIZE)))
+}
+
+/// Sweeps of the VSSM baseline.
+const PRESETS: &[Preset] = &[Preset {
+    name: "vssm-subdivision",
+    summary: "VSSM's kernel subdivision (1 = plain VSM regions) against the error and the light bleeding (mean_signed_error, umbra_leak), on sphere-cube",
+    scenes: &["sphere-cube"],
+    varies: &["vssm.subdivision=1,2,4,8"],
+    x_axis: "vssm.subdivision",
+    ..Preset::DEFAULT
+}];
+
+/// The registration.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: NAME,
+    summary: "variance soft shadow mapping: PCSS's search and filter from the moments' summed-area table, Chebyshev's blocker estimate, the kernel subdivided (baseline)",
+    paper: "Yang, Dong, Feng, Seidel and Kautz 2010, Variance Soft Shadow Mapping (CGF 29(7), Pacific Graphics)",
+    kind: TechniqueKind::Realtime,
+    params: VssmSettings::PARAMS,
+    requirements,
+    create,
+    presets: PRESETS,
+    trade: Some("subdivision=1,2,4"),
+    debug_outputs: &[],
+    uniforms: &[UniformCheck {
+        wgsl_struct: "VssmSettings",
+        wgsl_source: FILTER_SHADER,
+        imports: LOCAL_SHADERS,
+        rust: VssmSettingsUniform::LAYOUT,
+    }],
+};
+
+register_technique!(INFO);
+
+#[cfg(test)]
+mod tests {
+    /// The filter shader's largest subdivision is the parameter's.
+    #[test]
+    fn the_shaders_largest_subdivision_is_the_parameters() {
+        let Some(ssm_core::ParamSpec { kind: ssm_core::ParamKind::Int { max, .. }, .. }) =
+            <super::VssmSettings as ssm_core::Settings>::PARAMS.iter().find(|p| p.name == "subdivision")
+        else {
+            panic!("no integer parameter `subdivision`");
+        };
+        let line = format!("const MAX_SUBDIVISION: u32 = {max}u;");
+        assert!(super::FILTER_SHADER.contains(&line), "vssm.wgsl lacks `{line}`");
+    }
+}
