@@ -3,7 +3,9 @@
 # machine: a C++ compiler (g++: the meshopt crate builds meshoptimizer's C++
 # decoders), a Vulkan driver (without a GPU, Mesa's software rasteriser
 # lavapipe, package mesa-vulkan-drivers) and, with --for-tests, Chromium for
-# the report test. Prints the exact command when it cannot install (not root
+# the report test and, for the `ssm view` test, a virtual X server (xvfb),
+# xdotool (keys and mouse), ImageMagick (screenshots) and the X libraries
+# winit opens at run time. Prints the exact command when it cannot install (not root
 # and no sudo).
 #
 #   scripts/install-deps.sh              what `ssm` needs to run
@@ -23,8 +25,17 @@ fi
 if ! compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null && ! compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null; then
     packages+=(mesa-vulkan-drivers)
 fi
-if [ "${1:-}" = "--for-tests" ] && ! command -v chromium >/dev/null 2>&1; then
-    packages+=(chromium)
+if [ "${1:-}" = "--for-tests" ]; then
+    command -v chromium >/dev/null 2>&1 || packages+=(chromium)
+    command -v Xvfb >/dev/null 2>&1 || packages+=(xvfb)
+    command -v xdotool >/dev/null 2>&1 || packages+=(xdotool)
+    command -v import >/dev/null 2>&1 || packages+=(imagemagick)
+    # winit loads these with dlopen, so nothing at build time asks for them.
+    if command -v dpkg >/dev/null 2>&1; then
+        for library in libxkbcommon-x11-0 libxcursor1 libxi6 libxrandr2 libx11-xcb1; do
+            dpkg -s "$library" >/dev/null 2>&1 || packages+=("$library")
+        done
+    fi
 fi
 [ ${#packages[@]} -eq 0 ] && exit 0
 

@@ -5,6 +5,7 @@
 pub mod report;
 pub mod shard;
 pub mod sweep;
+pub mod view;
 
 use std::path::Path;
 

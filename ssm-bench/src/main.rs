@@ -33,6 +33,9 @@ enum Command {
     Compare(CompareArgs),
     /// Vary techniques' parameters over a grid; write sweep.csv, sweep.md and the time-against-error plot (PNG, SVG).
     Sweep(SweepArgs),
+    /// A live window: the scene shaded with one technique at a time (number keys switch), a panel of its
+    /// parameters, per-pass GPU times and the error against the cached ground truth; drag to orbit.
+    View(ViewArgs),
     /// Put the shards of a sweep (`ssm sweep --shard K/N` outputs) back together: sweep.csv, sweep.md and the plot.
     Merge(MergeArgs),
 }
@@ -190,6 +193,25 @@ struct RenderArgs {
     out: PathBuf,
 }
 
+#[derive(clap::Args)]
+struct ViewArgs {
+    /// A built-in scene name, a scene manifest (.toml) or a model file.
+    #[arg(long)]
+    scene: String,
+    /// Technique names in key order (key 1 is the first), comma-separated; default: every real-time technique, then `reference`.
+    #[arg(long, value_delimiter = ',')]
+    technique: Vec<String>,
+    /// Rendered image width in pixels (the window adds the panel).
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Rendered image height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Starting parameter `<technique>.<param>=<value>`; repeatable.
+    #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
+    settings: Vec<String>,
+}
+
 /// Writes a line to stdout, failing (rather than panicking like `println!`) when stdout is closed.
 macro_rules! say {
     ($($arg:tt)*) => {
@@ -224,6 +246,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare(&args),
         Command::Sweep(args) => sweep_command(&args),
         Command::Merge(args) => merge_command(&args),
+        Command::View(args) => view(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -391,6 +414,38 @@ fn render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+fn view(args: &ViewArgs) -> Result<()> {
+    let registry = registry()?;
+    let scene = load_scene(&args.scene, Format::Text)?;
+    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
+    let names: Vec<&str> = if args.technique.is_empty() {
+        let mut names: Vec<&str> = registry.iter().filter(|i| i.kind == TechniqueKind::Realtime).map(|i| i.name).collect();
+        names.extend(registry.iter().filter(|i| i.kind == TechniqueKind::GroundTruth).map(|i| i.name));
+        names
+    } else {
+        args.technique.iter().map(String::as_str).collect()
+    };
+    for (technique, _, _) in &settings {
+        if !names.contains(technique) {
+            bail!("--set names technique `{technique}`, which is not among those shown ({})", names.join(","));
+        }
+    }
+    let techniques = names
+        .iter()
+        .map(|name| {
+            let info = registry.get(name)?;
+            Ok((info, params_for(info, &settings)?))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    ssm_bench::view::run(ssm_bench::view::ViewOptions {
+        scene_name: args.scene.clone(),
+        scene,
+        techniques,
+        width: args.width,
+        height: args.height,
+    })
+}
+
 /// Loads `spec` and says what it holds: on stdout, or on stderr when stdout carries `Format::Json`.
 fn load_scene(spec: &str, format: Format) -> Result<Scene> {
     let (scene, source) = Scene::load(spec).with_context(|| format!("loading scene `{spec}`"))?;
@@ -467,6 +522,8 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let covered = report::pixel_mask(&renderer, args.pixels)?;
     progress.inc(1);
     let mut rows = Vec::new();
+    // Every technique's visibility, kept for the interactive viewer's data.
+    let mut visibilities = Vec::new();
     for (info, params) in &runs {
         progress.set_message(info.name);
         // The overlays always: the HTML report draws them over the visibility.
@@ -474,6 +531,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
         let measured = report::measure(&mut renderer, info, params, args.frames, &debug)?;
         report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
         rows.extend(report::rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
+        visibilities.push((info.name, measured.visibility));
         progress.inc(1);
     }
     progress.finish_and_clear();
@@ -516,6 +574,15 @@ fn compare(args: &CompareArgs) -> Result<()> {
     write("results.csv", report::csv(&rows))?;
     let markdown = report::markdown_report(&context, &rows);
     write("report.md", markdown.clone())?;
+    let mut viewer_images =
+        vec![report::ViewerImages { technique: reference_info.name, visibility: &reference.visibility, has_flip: false }];
+    viewer_images.extend(visibilities.iter().map(|(name, visibility)| report::ViewerImages {
+        technique: name,
+        visibility,
+        has_flip: true,
+    }));
+    write("viewer-data.js", report::viewer_data(reference_info.name, size, &coverage, &viewer_images, &rows))?;
+    write("viewer.js", report::VIEWER_SCRIPT.to_owned())?;
     write("index.html", report::html_report(&context, &rows, reference_info.name))?;
     let index = args.out.join("index.html");
     match args.format {

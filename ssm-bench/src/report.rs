@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use ssm_core::image_io::{write_exr_gray, write_png_gray16, write_png_rgba8};
-use ssm_core::metrics::{ErrorMetrics, compare, flip_mean, heat_map};
+use ssm_core::metrics::{ErrorMetrics, compare, flip_map, flip_mean, heat_map};
 use ssm_core::{Error, FrameTimings, GBuffer, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
 
 use crate::median;
@@ -190,6 +190,11 @@ pub fn write_images(
                 image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| Error::write(&file, ssm_core::Reason("buffer size".into())))?;
             picture.save(&file).map_err(|e| Error::write(&file, e))?;
         }
+        let file = dir.join("flip.png");
+        let rgb = flip_map(&reference.shaded, &measured.shaded, width, height);
+        let picture =
+            image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| Error::write(&file, ssm_core::Reason("buffer size".into())))?;
+        picture.save(&file).map_err(|e| Error::write(&file, e))?;
     }
     Ok(())
 }
@@ -659,18 +664,113 @@ pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     out
 }
 
+/// The interactive viewer's script (`ssm-bench/assets/viewer.js`), written beside `index.html` as `viewer.js`.
+pub const VIEWER_SCRIPT: &str = include_str!("../assets/viewer.js");
+
+/// One image set the interactive viewer shows: a technique (or the ground truth) and its visibility per light.
+pub struct ViewerImages<'a> {
+    /// The technique's name (its folder in the report).
+    pub technique: &'a str,
+    /// Visibility per light, row-major, in `[0, 1]`.
+    pub visibility: &'a [Vec<f32>],
+    /// Whether `<technique>/flip.png` was written (every technique but the ground truth).
+    pub has_flip: bool,
+}
+
+/// `viewer-data.js`: what the interactive viewer of `index.html` reads, as
+/// one script that sets `window.SSM_DATA` (a page opened from disk may load
+/// scripts, but not read back the pixels of its own images): the size, the
+/// covered pixels, each technique's visibility per light as 16-bit values
+/// (base64, little-endian), the paths of its shaded and FLIP images, and the
+/// metrics table's rows. `images` starts with the ground truth.
+#[must_use]
+pub fn viewer_data(
+    reference_name: &str,
+    (width, height): (u32, u32),
+    coverage: &[bool],
+    images: &[ViewerImages<'_>],
+    rows: &[Row],
+) -> String {
+    use base64::Engine as _;
+    let encode = |bytes: &[u8]| base64::engine::general_purpose::STANDARD.encode(bytes);
+    let quantised =
+        |values: &[f32]| -> Vec<u8> { values.iter().flat_map(|v| ((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_le_bytes()).collect() };
+    let covered: Vec<u8> = coverage.iter().map(|&c| u8::from(c)).collect();
+    let mut image_sets = serde_json::Map::new();
+    for set in images {
+        image_sets.insert(
+            set.technique.to_owned(),
+            serde_json::json!({
+                "visibility": set.visibility.iter().map(|v| encode(&quantised(v))).collect::<Vec<_>>(),
+                "shaded": format!("{}/shaded.png", set.technique),
+                "flip": set.has_flip.then(|| format!("{}/flip.png", set.technique)),
+            }),
+        );
+    }
+    let finite = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
+    let table: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            let m = &r.metrics;
+            serde_json::json!({
+                "technique": r.technique,
+                "light": r.light.map_or_else(|| "all".to_owned(), |l| l.to_string()),
+                "gpu_ms": r.gpu_ms_median.map_or(serde_json::Value::Null, finite),
+                "mae_penumbra": finite(m.mae_penumbra),
+                "rmse": finite(m.rmse),
+                "ssim": finite(m.ssim),
+                "psnr": finite(m.psnr),
+                "umbra_leak": finite(m.umbra_leak),
+                "frac_over_0_05": finite(m.frac_over_0_05),
+                "flip": finite(r.flip),
+                "passes": r.passes.iter().map(|(name, ms)| format!("{name} {ms:.2}")).collect::<Vec<_>>().join(", "),
+            })
+        })
+        .collect();
+    let lights = images.first().map_or(1, |set| set.visibility.len());
+    let data = serde_json::json!({
+        "width": width,
+        "height": height,
+        "lights": lights,
+        "reference": reference_name,
+        "techniques": images.iter().map(|set| set.technique).collect::<Vec<_>>(),
+        "covered": encode(&covered),
+        "images": image_sets,
+        "rows": table,
+        "columns": [
+            ["technique", "technique"], ["light", "light"], ["gpu_ms", "GPU ms"], ["mae_penumbra", "MAE pen."],
+            ["rmse", "RMSE"], ["ssim", "SSIM"], ["psnr", "PSNR dB"], ["umbra_leak", "umbra leak"],
+            ["frac_over_0_05", "> 0.05"], ["flip", "FLIP"], ["passes", "passes, ms"],
+        ],
+    });
+    format!("// Written by ssm compare: the data of index.html's viewer (viewer.js).\nwindow.SSM_DATA = {data};\n")
+}
+
+/// The interactive viewer's part of `index.html`: controls, canvas, readout and table (filled by `viewer.js`).
+fn viewer_section((width, height): (u32, u32)) -> String {
+    // The readout wraps within the image's width (and its border), so that the table fits beside it.
+    let frame = width + 2;
+    format!(
+        "<section id=\"viewer\">\n<h2>Compare</h2>\n<p class=\"legend\">Keys: <kbd>1</kbd>–<kbd>9</kbd> a technique (or click it), hold <kbd>R</kbd> (or hover its button) for the ground truth; views <kbd>S</kbd> shaded, <kbd>V</kbd> visibility, <kbd>E</kbd> signed error, <kbd>A</kbd> absolute error, <kbd>F</kbd> FLIP; wheel: zoom to the pixel, drag: pan, <kbd>0</kbd>: reset. Click a column to sort, a row to show it.</p>\n<div id=\"viewer-techniques\" class=\"bar\"></div>\n<div id=\"viewer-modes\" class=\"bar\"></div>\n<div class=\"bar\"><label>light <select id=\"viewer-light\"></select></label> <label>exposure (shaded) <input id=\"viewer-exposure\" type=\"range\" min=\"-4\" max=\"4\" step=\"0.1\" value=\"0\"> <span id=\"viewer-exposure-value\">+0.0 EV</span></label></div>\n<div class=\"viewer-row\">\n<div style=\"width: {frame}px\">\n<canvas id=\"viewer-canvas\" width=\"{width}\" height=\"{height}\"></canvas>\n<div id=\"viewer-scale\" class=\"legend\"></div>\n<div id=\"readout\">move the pointer over the image for every technique's value at that pixel</div>\n</div>\n<table id=\"metrics\"></table>\n</div>\n</section>\n"
+    )
+}
+
 fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-/// `index.html`: the table and, per technique, the shaded image, the
-/// visibility and the error heat map side by side; readable offline (images by
-/// relative path, no scripts or styles from elsewhere). A small script records
-/// on `<body data-images-loaded>` how many images loaded, for tests.
+/// `index.html`: the interactive viewer (`viewer.js` over `viewer-data.js`,
+/// both beside it: every technique and the ground truth in one zoomable
+/// frame, switched by keys, with several views, a per-pixel readout and a
+/// sortable metrics table), then the table and, per technique, the shaded
+/// image, the visibility and the error heat map side by side; readable
+/// offline (images and scripts by relative path, nothing from elsewhere). A
+/// small script records on `<body data-images-loaded>` how many images
+/// loaded, for tests.
 #[must_use]
 pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &str) -> String {
     let mut out = String::from(
-        "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>ssm compare</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\ntable { border-collapse: collapse; font-size: 0.9em; }\nth, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }\nth:first-child, th:nth-child(2), td:first-child, td:nth-child(2) { text-align: left; }\nfigure { margin: 1.2em 0; }\nfigure img { width: 32%; image-rendering: pixelated; border: 1px solid #ddd; vertical-align: top; }\n.overlay { position: relative; display: inline-block; width: 32%; vertical-align: top; }\n.overlay img { width: 100%; }\n.overlay img + img { position: absolute; left: 0; top: 0; opacity: 0.5; }\n.legend { font-size: 0.9em; color: #555; }\n</style>\n</head>\n<body data-images-loaded=\"0\">\n",
+        "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>ssm compare</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\ntable { border-collapse: collapse; font-size: 0.9em; }\nth, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: right; }\nth:first-child, th:nth-child(2), td:first-child, td:nth-child(2) { text-align: left; }\nfigure { margin: 1.2em 0; }\nfigure img { width: 32%; image-rendering: pixelated; border: 1px solid #ddd; vertical-align: top; }\n.overlay { position: relative; display: inline-block; width: 32%; vertical-align: top; }\n.overlay img { width: 100%; }\n.overlay img + img { position: absolute; left: 0; top: 0; opacity: 0.5; }\n.legend { font-size: 0.9em; color: #555; }\n.bar { margin: 0.3em 0; }\n.bar button { margin-right: 0.3em; }\nbutton.selected, #metrics tr.selected { background: #1d5fa0; color: white; }\n#viewer-canvas { display: block; image-rendering: pixelated; cursor: crosshair; border: 1px solid #888; }\n#readout { font-family: monospace; margin: 0.4em 0; min-height: 2.6em; }\n#readout .selected { font-weight: bold; }\n#metrics th { cursor: pointer; }\n#metrics th[data-sorted=\"ascending\"]::after { content: \" ▲\"; }\n#metrics th[data-sorted=\"descending\"]::after { content: \" ▼\"; }\n#metrics tbody tr { cursor: pointer; }\n#metrics td:last-child { text-align: left; font-size: 0.85em; }\n.viewer-row { display: flex; gap: 1.5em; align-items: flex-start; flex-wrap: wrap; }\n.viewer-row > div { max-width: 100%; flex: none; }\n.viewer-row > table { flex: 1 1 24em; }\n</style>\n</head>\n<body data-images-loaded=\"0\">\n",
     );
     let _ = writeln!(
         out,
@@ -684,7 +784,8 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
         escape(context.reference_params),
         escape(context.reference_cost)
     );
-    out += "<table>\n<tr>";
+    out += &viewer_section(context.size);
+    out += "<h2>All images</h2>\n<table>\n<tr>";
     for header in TABLE_HEADER {
         let _ = write!(out, "<th>{}</th>", escape(header));
     }
@@ -761,7 +862,7 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
             }
         }
     }
-    out += "<script>\nwindow.addEventListener('load', () => {\n  const images = Array.from(document.images);\n  const loaded = images.filter((i) => i.complete && i.naturalWidth > 0).length;\n  document.body.dataset.imagesLoaded = loaded + '/' + images.length;\n});\n</script>\n</body>\n</html>\n";
+    out += "<script>\nwindow.addEventListener('load', () => {\n  const images = Array.from(document.images);\n  const loaded = images.filter((i) => i.complete && i.naturalWidth > 0).length;\n  document.body.dataset.imagesLoaded = loaded + '/' + images.length;\n});\n</script>\n<script src=\"viewer-data.js\"></script>\n<script src=\"viewer.js\"></script>\n</body>\n</html>\n";
     out
 }
 

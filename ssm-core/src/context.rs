@@ -34,6 +34,13 @@ pub enum ContextError {
         #[source]
         source: wgpu::RequestAdapterError,
     },
+    /// No surface could be made for a window (`ssm view`).
+    #[error("no drawing surface could be made for the window ({source}); is a display (X11 or Wayland) available?")]
+    NoSurface {
+        /// What wgpu said.
+        #[source]
+        source: wgpu::CreateSurfaceError,
+    },
     /// The adapter refused to make a device.
     #[error("the adapter `{adapter}` could not create a device")]
     NoDevice {
@@ -106,7 +113,24 @@ impl GpuContext {
     /// driver; [`ContextError::NoDevice`] if the adapter refuses.
     pub fn new() -> Result<Self, ContextError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None))
+        Self::on_instance(instance, None)
+    }
+
+    /// A context whose adapter can present to `window` (a window handle such
+    /// as winit's `Arc<Window>`), with the surface made for it: what a live
+    /// viewer draws into. Adapter selection is as in [`GpuContext::new`].
+    ///
+    /// # Errors
+    /// [`ContextError::NoSurface`] if no surface can be made for the window, else as [`GpuContext::new`].
+    pub fn for_window<'w>(window: impl Into<wgpu::SurfaceTarget<'w>>) -> Result<(Self, wgpu::Surface<'w>), ContextError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let surface = instance.create_surface(window).map_err(|source| ContextError::NoSurface { source })?;
+        let context = Self::on_instance(instance, Some(&surface))?;
+        Ok((context, surface))
+    }
+
+    fn on_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, ContextError> {
+        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, surface))
             .map_err(|source| ContextError::NoAdapter { source })?;
         let info = adapter.get_info();
         let features = adapter.features() & OPTIONAL_FEATURES;

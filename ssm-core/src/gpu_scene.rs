@@ -168,7 +168,8 @@ impl GpuScene {
         let camera_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene_camera_uniform"),
             contents: bytemuck::bytes_of(&camera),
-            usage: wgpu::BufferUsages::UNIFORM,
+            // COPY_DST: a live viewer moves the camera ([`GpuScene::set_camera`]).
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let uniform_layout = gpu.uniform_layout().clone();
         let uniform_group = |label: &str, buffer: &wgpu::Buffer| {
@@ -261,15 +262,28 @@ impl GpuScene {
     pub fn light_count(&self) -> usize {
         self.light_frames.len()
     }
+
+    /// Points the camera elsewhere: recomputes [`GpuScene::camera`] and
+    /// writes its buffer on `queue` (the light frames do not depend on the
+    /// camera). The G-buffer must be rendered again afterwards
+    /// ([`Renderer::set_camera`](crate::Renderer::set_camera) does both).
+    pub fn set_camera(&mut self, queue: &wgpu::Queue, camera: &ssm_scene::Camera) {
+        self.camera = camera_uniform_of(camera, self.width, self.height);
+        queue.write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&self.camera));
+    }
 }
 
 fn camera_uniform(scene: &Scene, width: u32, height: u32) -> CameraUniform {
+    camera_uniform_of(&scene.camera, width, height)
+}
+
+fn camera_uniform_of(camera: &ssm_scene::Camera, width: u32, height: u32) -> CameraUniform {
     let aspect = width as f32 / height.max(1) as f32;
-    let view_proj: Mat4 = scene.camera.projection(aspect) * scene.camera.view();
+    let view_proj: Mat4 = camera.projection(aspect) * camera.view();
     CameraUniform {
         view_proj: view_proj.to_cols_array_2d(),
         inverse_view_proj: view_proj.inverse().to_cols_array_2d(),
-        position: Vec4::from((scene.camera.position, 1.0)).to_array(),
+        position: Vec4::from((camera.position, 1.0)).to_array(),
         viewport: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
     }
 }

@@ -175,6 +175,20 @@ pub fn flip_mean(reference_rgba: &[u8], image_rgba: &[u8], width: u32, height: u
     f64::from(nv_flip::FlipPool::from_image(&error).mean())
 }
 
+/// Per-pixel FLIP error of `image_rgba` against `reference_rgba` (both RGBA8
+/// sRGB, the viewing condition of [`flip_mean`]) in FLIP's own magma colour
+/// map (black 0, through purple and orange, to pale yellow 1): row-major RGB8.
+///
+/// # Panics
+/// If the slices are not `width * height * 4` bytes.
+#[must_use]
+pub fn flip_map(reference_rgba: &[u8], image_rgba: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let rgb = |rgba: &[u8]| rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<u8>>();
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference_rgba));
+    let image = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(image_rgba));
+    nv_flip::flip(reference, image, nv_flip::DEFAULT_PIXELS_PER_DEGREE).apply_color_lut(&nv_flip::magma_lut()).to_vec()
+}
+
 /// The signed error `image - reference` as an RGB heat map: white where
 /// equal, red where the technique is darker than the reference
 /// (over-shadowing), blue where it is lighter (under-shadowing), saturated at

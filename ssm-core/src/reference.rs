@@ -529,13 +529,10 @@ impl GroundTruth {
         seed: u64,
         cache_dir: &Path,
     ) -> ReferenceImage {
-        let file = cache_dir.join(format!("{:016x}.f32", self.cache_key(light, points, samples_per_axis, seed)));
-        if let Ok(bytes) = std::fs::read(&file)
-            && bytes.len() == points.len() * 4
-        {
-            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-            return ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true };
+        if let Some(image) = self.cached(light, points, samples_per_axis, seed, cache_dir) {
+            return image;
         }
+        let file = self.cache_file(light, points, samples_per_axis, seed, cache_dir);
         let image = self.trace(light, points, samples_per_axis, seed);
         let bytes: Vec<u8> = image.visibility.iter().flat_map(|v| v.to_le_bytes()).collect();
         // Write then rename, so that a concurrent reader never sees half a file.
@@ -544,6 +541,36 @@ impl GroundTruth {
             let _ = std::fs::rename(&partial, &file);
         }
         image
+    }
+
+    /// The image [`GroundTruth::trace_cached`] would return, if `cache_dir`
+    /// holds it; `None` without tracing anything otherwise (a live viewer
+    /// shows the error against the ground truth only where it is cached).
+    #[must_use]
+    pub fn cached(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+        cache_dir: &Path,
+    ) -> Option<ReferenceImage> {
+        let bytes = std::fs::read(self.cache_file(light, points, samples_per_axis, seed, cache_dir)).ok()?;
+        (bytes.len() == points.len() * 4).then(|| {
+            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true }
+        })
+    }
+
+    fn cache_file(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+        cache_dir: &Path,
+    ) -> PathBuf {
+        cache_dir.join(format!("{:016x}.f32", self.cache_key(light, points, samples_per_axis, seed)))
     }
 
     fn cache_key(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> u64 {
@@ -722,6 +749,33 @@ mod tests {
     }
 }
 
+/// The points the ground truth samples, one per pixel (`None` where nothing
+/// was drawn): the G-buffer's positions (`w` = coverage) and normals as read
+/// back, with each pixel's footprint on its tangent plane when
+/// `pixel_footprint` (the `footprint = pixel` parameter). These points are
+/// part of the cache key, so the same view gives the same points.
+#[must_use]
+pub fn surface_points(
+    positions: &[[f32; 4]],
+    normals: &[[f32; 4]],
+    camera: &crate::CameraUniform,
+    pixel_footprint: bool,
+) -> Vec<Option<SurfacePoint>> {
+    let width = (camera.viewport[0] as usize).max(1);
+    positions
+        .iter()
+        .zip(normals)
+        .enumerate()
+        .map(|(index, (p, n))| {
+            (p[3] > 0.5).then(|| SurfacePoint {
+                position: Vec3::new(p[0], p[1], p[2]),
+                normal: Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y),
+                footprint: pixel_footprint.then(|| pixel_rays(camera, (index % width) as f32, (index / width) as f32)),
+            })
+        })
+        .collect()
+}
+
 /// The camera rays through the pixel whose top-left corner is at (`x`, `y`), in pixels.
 fn pixel_rays(camera: &crate::CameraUniform, x: f32, y: f32) -> PixelFootprint {
     let inverse = glam::Mat4::from_cols_array_2d(&camera.inverse_view_proj);
@@ -786,23 +840,7 @@ impl ReferenceTechnique {
             let normals = crate::readback::read_texture(frame.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
             let positions: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&positions);
             let normals: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&normals);
-            let camera = &frame.scene.camera;
-            let width = frame.scene.width.max(1) as usize;
-            let pixel_footprint = self.pixel_footprint;
-            self.points = Some(
-                positions
-                    .iter()
-                    .zip(&normals)
-                    .enumerate()
-                    .map(|(index, (p, n))| {
-                        (p[3] > 0.5).then(|| SurfacePoint {
-                            position: Vec3::new(p[0], p[1], p[2]),
-                            normal: Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y),
-                            footprint: pixel_footprint.then(|| pixel_rays(camera, (index % width) as f32, (index / width) as f32)),
-                        })
-                    })
-                    .collect(),
-            );
+            self.points = Some(surface_points(&positions, &normals, &frame.scene.camera, self.pixel_footprint));
         }
         Ok(self.points.as_deref().unwrap_or_default())
     }

@@ -63,16 +63,7 @@ impl Renderer {
         let mut shared_timings = Vec::new();
         if needs.gbuffer {
             let gbuffer = GBuffer::new(&gpu, &gpu_scene)?;
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer_encoder") });
-            encoder.push_debug_group("gbuffer");
-            gbuffer.encode(&mut encoder, &gpu_scene, &mut timer);
-            encoder.pop_debug_group();
-            timer.resolve(&mut encoder);
-            let start = Instant::now();
-            gpu.queue.submit([encoder.finish()]);
-            gpu.wait_idle().map_err(|e| Error::Gpu { during: "rendering the G-buffer".into(), messages: vec![e] })?;
-            shared_timings = timer.read(&gpu, start.elapsed().as_secs_f64() * 1e3)?.passes;
-            timer.reset();
+            shared_timings = render_gbuffer(&gpu, &gbuffer, &gpu_scene, &mut timer)?;
             shared.gbuffer = Some(gbuffer);
         }
         if needs.adjacency {
@@ -198,6 +189,20 @@ impl Renderer {
     /// # Errors
     /// [`Error::UndeclaredRequirement`] without a G-buffer, or a GPU error.
     pub fn shade(&mut self) -> Result<Vec<u8>> {
+        self.shade_on_gpu()?;
+        let Some(composite) = &self.composite else { unreachable!("built by shade_on_gpu") };
+        let pixels = read_texture(&self.gpu, &composite.target, 4, "shaded image")?;
+        self.check_gpu_errors("composite shading")?;
+        Ok(pixels)
+    }
+
+    /// Shades the current visibility into the composite target and returns
+    /// it ([`Composite::FORMAT`], `COPY_SRC`) without reading it back: what a
+    /// live viewer copies to its window.
+    ///
+    /// # Errors
+    /// [`Error::UndeclaredRequirement`] without a G-buffer, or a GPU error.
+    pub fn shade_on_gpu(&mut self) -> Result<&wgpu::Texture> {
         let gbuffer = self.shared.gbuffer("composite shading")?;
         if self.composite.is_none() {
             self.composite = Some(Composite::new(&self.gpu, &self.scene, &self.visibility_views)?);
@@ -206,9 +211,29 @@ impl Renderer {
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("composite_encoder") });
         composite.encode(&mut encoder, &self.scene, gbuffer);
         self.gpu.queue.submit([encoder.finish()]);
-        let pixels = read_texture(&self.gpu, &composite.target, 4, "shaded image")?;
         self.check_gpu_errors("composite shading")?;
-        Ok(pixels)
+        Ok(&composite.target)
+    }
+
+    /// Moves the camera: updates the uploaded camera and the CPU scene's,
+    /// and renders the G-buffer again (its times replace
+    /// [`Renderer::shared_timings`]). Techniques read the camera from the
+    /// scene's buffer each frame, but one that keeps what it derived from
+    /// the view (the ground truth keeps its traced points) must be created
+    /// again.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for an invalid camera, or a GPU error.
+    pub fn set_camera(&mut self, camera: &ssm_scene::Camera) -> Result<()> {
+        camera.validate(std::path::Path::new("<camera>"))?;
+        std::sync::Arc::make_mut(&mut self.cpu_scene).camera = *camera;
+        self.scene.set_camera(&self.gpu.queue, camera);
+        if let Some(gbuffer) = &self.shared.gbuffer {
+            self.timer.reset();
+            self.shared_timings = render_gbuffer(&self.gpu, gbuffer, &self.scene, &mut self.timer)?;
+            self.timer.reset();
+        }
+        self.check_gpu_errors("moving the camera")
     }
 
     /// Output width.
@@ -222,6 +247,21 @@ impl Renderer {
     pub fn height(&self) -> u32 {
         self.scene.height
     }
+}
+
+/// Renders the G-buffer for the scene's current camera and returns its pass times.
+fn render_gbuffer(gpu: &GpuContext, gbuffer: &GBuffer, scene: &GpuScene, timer: &mut PassTimer) -> Result<Vec<PassTiming>> {
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer_encoder") });
+    encoder.push_debug_group("gbuffer");
+    gbuffer.encode(&mut encoder, scene, timer);
+    encoder.pop_debug_group();
+    timer.resolve(&mut encoder);
+    let start = Instant::now();
+    gpu.queue.submit([encoder.finish()]);
+    gpu.wait_idle().map_err(|e| Error::Gpu { during: "rendering the G-buffer".into(), messages: vec![e] })?;
+    let passes = timer.read(gpu, start.elapsed().as_secs_f64() * 1e3)?.passes;
+    timer.reset();
+    Ok(passes)
 }
 
 /// World-space adjacency of every triangle that casts shadows.
