@@ -584,7 +584,7 @@ pub fn pass_chart(bars: &[(String, Vec<(String, f64)>)], title: &str, png: &std:
         bail!("no technique with a timed pass");
     }
     register_plot_font();
-    let height = 120 + 48 * bars.len() as u32;
+    let height = 120 + 76 * bars.len() as u32;
     draw_pass_chart(&BitMapBackend::new(png, (1000, height)).into_drawing_area(), &bars, title)
         .with_context(|| format!("drawing {}", png.display()))?;
     draw_pass_chart(&SVGBackend::new(svg, (1000, height)).into_drawing_area(), &bars, title)
@@ -630,9 +630,11 @@ where
         .draw()
         .map_err(chart_error)?;
     for (index, ((_, passes), total)) in bars.iter().zip(&totals).enumerate() {
-        let top = (count - index) as f64 - 0.15;
-        let bottom = (count - 1 - index) as f64 + 0.15;
+        let top = (count - index) as f64 - 0.12;
+        let bottom = (count - 1 - index) as f64 + 0.42;
         let mut start = 0.0;
+        // Passes too narrow for their name are named under the bar, each after a swatch of its colour.
+        let (mut key_cursor, mut key_line) = (0.0, 0.0);
         for (k, (pass, ms)) in passes.iter().enumerate() {
             let share = 100.0 * ms.max(0.0) / total;
             let colour = Palette99::pick(k).to_rgba();
@@ -643,6 +645,20 @@ where
             if share * 7.2 > 7.0 * pass.len() as f64 + 8.0 {
                 let label = Text::new(pass.clone(), (start + 0.5, (top + bottom) / 2.0), ("sans-serif", 13).into_font().color(&BLACK));
                 chart.draw_series(std::iter::once(label)).map_err(chart_error)?;
+            } else {
+                let key = format!("{pass} {share:.0}%");
+                // About 6 pixels a character at 12 pixels, 7.2 pixels a percent; a second line when the first is full.
+                let key_width = (6.0 * key.len() as f64 + 26.0) / 7.2;
+                if key_cursor > 0.0 && key_cursor + key_width > 100.0 {
+                    (key_cursor, key_line) = (0.0, key_line + 1.0);
+                }
+                let key_top = bottom - 0.04 - 0.19 * key_line;
+                let key_bottom = key_top - 0.15;
+                let swatch = Rectangle::new([(key_cursor, key_bottom), (key_cursor + 1.4, key_top)], colour.filled());
+                chart.draw_series(std::iter::once(swatch)).map_err(chart_error)?;
+                let text = Text::new(key.clone(), (key_cursor + 1.9, key_top + 0.02), ("sans-serif", 12).into_font().color(&BLACK));
+                chart.draw_series(std::iter::once(text)).map_err(chart_error)?;
+                key_cursor += key_width;
             }
             start += share;
         }
@@ -674,23 +690,25 @@ where
     area.fill(&WHITE).map_err(chart_error)?;
     let mut builder = ChartBuilder::on(area);
     builder.caption(title, ("sans-serif", 24)).margin(20).x_label_area_size(50).y_label_area_size(70);
-    let (y_low, y_high) = (y_min / 1.5, y_max * 1.5);
-    // The ticks chosen here: plotters' own log ticks start at the first power of ten inside the
-    // range, so an axis within one decade got that one label, or none.
-    let y_range = (y_low..y_high).log_scale().with_key_points(log_key_points(y_low, y_high));
-    let y_fraction = |y: f64| (y / y_low).ln() / (y_high / y_low).ln();
+    let y_low = y_min / 1.5;
+    let y_high_for = |x_fraction: &dyn Fn(f64) -> f64| legend_room(&usable, y_low, y_max, x_fraction, axes.pareto);
     if axes.log_x {
         let (x_low, x_high) = (x_min / 1.5, x_max * 1.5);
-        let legend = emptiest_corner(&usable, |x| (x / x_low).ln() / (x_high / x_low).ln(), y_fraction);
+        let (y_high, legend) = y_high_for(&|x: f64| (x / x_low).ln() / (x_high / x_low).ln());
+        // The ticks chosen here: plotters' own log ticks start at the first power of ten inside the
+        // range, so an axis within one decade got that one label, or none.
+        let y_range = (y_low..y_high).log_scale().with_key_points(log_key_points(y_low, y_high));
         let x_range = (x_low..x_high).log_scale().with_key_points(log_key_points(x_low, x_high));
         let chart = builder.build_cartesian_2d(x_range, y_range).map_err(chart_error)?;
-        draw_series(chart, &usable, axes, legend)
+        draw_series(chart, &usable, axes, legend, false)
     } else {
         let pad = ((x_max - x_min) * 0.08).max(1e-6);
         let (x_low, x_high) = (x_min - pad, x_max + pad);
-        let legend = emptiest_corner(&usable, |x| (x - x_low) / (x_high - x_low), y_fraction);
+        let (y_high, legend) = y_high_for(&|x: f64| (x - x_low) / (x_high - x_low));
+        let y_range = (y_low..y_high).log_scale().with_key_points(log_key_points(y_low, y_high));
+        let integers = usable.iter().all(|p| p.x.fract() == 0.0);
         let chart = builder.build_cartesian_2d(x_low..x_high, y_range).map_err(chart_error)?;
-        draw_series(chart, &usable, axes, legend)
+        draw_series(chart, &usable, axes, legend, integers)
     }
 }
 
@@ -737,10 +755,43 @@ fn label_offset(at: (i32, i32), label: &str, placed: &mut Vec<LabelBox>) -> (i32
     chosen
 }
 
+/// The top of a log y axis from `y_low` that leaves the legend room, and where the legend goes: the
+/// emptiest corner when one holds no point (the axis tops at 1.5× the largest value); otherwise the
+/// axis grows upwards until the legend's height at the top right holds no point. A legend must
+/// hide no measurement.
+fn legend_room(points: &[&PlotPoint], y_low: f64, y_max: f64, x_fraction: &dyn Fn(f64) -> f64, pareto: bool) -> (f64, SeriesLabelPosition) {
+    let y_high = y_max * 1.5;
+    let (corner, crowded) = emptiest_corner(points, x_fraction, |y: f64| (y / y_low).ln() / (y_high / y_low).ln());
+    if crowded == 0 {
+        return (y_high, corner);
+    }
+    // The legend's share of the plot's height: a 22-pixel line per series (and the Pareto
+    // front's), in a plot area of about 560 pixels.
+    let mut entries = points.iter().map(|p| p.series.as_str()).collect::<Vec<_>>();
+    entries.sort_unstable();
+    entries.dedup();
+    let share = legend_share(entries.len() + usize::from(pareto));
+    (y_low * (y_max / y_low).powf(1.0 / (1.0 - share - 0.03)), SeriesLabelPosition::UpperRight)
+}
+
+/// The fraction of the plot's height a legend of `entries` lines takes.
+fn legend_share(entries: usize) -> f64 {
+    ((22 * entries + 16) as f64 / 560.0).min(0.45)
+}
+
+/// A linear axis's tick label; on an axis of integers (a light count), none between them.
+fn linear_tick(value: f64, integers: bool) -> String {
+    if integers && value.fract().abs() > 1e-9 { String::new() } else { compact(value) }
+}
+
 /// The corner of the plot whose region (a third of the width, two fifths of the height) holds the
-/// fewest points, for the legend, so that it hides no measurement. `x_fraction` and `y_fraction`
-/// place a value in [0, 1] along the axes as drawn.
-fn emptiest_corner(points: &[&PlotPoint], x_fraction: impl Fn(f64) -> f64, y_fraction: impl Fn(f64) -> f64) -> SeriesLabelPosition {
+/// fewest points, for the legend, so that it hides no measurement, and how many it holds.
+/// `x_fraction` and `y_fraction` place a value in [0, 1] along the axes as drawn.
+fn emptiest_corner(
+    points: &[&PlotPoint],
+    x_fraction: impl Fn(f64) -> f64,
+    y_fraction: impl Fn(f64) -> f64,
+) -> (SeriesLabelPosition, usize) {
     let corners = [
         (SeriesLabelPosition::UpperRight, true, true),
         (SeriesLabelPosition::UpperLeft, false, true),
@@ -756,7 +807,11 @@ fn emptiest_corner(points: &[&PlotPoint], x_fraction: impl Fn(f64) -> f64, y_fra
             })
             .count()
     };
-    corners.into_iter().min_by_key(|(_, right, upper)| crowding(*right, *upper)).map_or(SeriesLabelPosition::UpperRight, |c| c.0)
+    corners
+        .into_iter()
+        .map(|(corner, right, upper)| (corner, crowding(right, upper)))
+        .min_by_key(|(_, count)| *count)
+        .unwrap_or((SeriesLabelPosition::UpperRight, 0))
 }
 
 fn draw_series<'a, DB, X>(
@@ -768,6 +823,7 @@ fn draw_series<'a, DB, X>(
     points: &[&PlotPoint],
     axes: &PlotAxes,
     legend: SeriesLabelPosition,
+    integer_x: bool,
 ) -> Result<()>
 where
     DB: DrawingBackend + 'a,
@@ -779,7 +835,8 @@ where
         .x_desc(axes.x_label.as_str())
         .y_desc(axes.y_label.as_str())
         .label_style(("sans-serif", 15))
-        .x_label_formatter(&|v| if axes.log_x { log_tick(*v) } else { compact(*v) })
+        // An axis of integers (a light count) is labelled at integers only.
+        .x_label_formatter(&|v| if axes.log_x { log_tick(*v) } else { linear_tick(*v, integer_x) })
         .y_label_formatter(&|v| log_tick(*v))
         .draw()
         .map_err(chart_error)?;
@@ -960,6 +1017,36 @@ mod tests {
         assert_eq!(wide.first().copied(), Some(10.0));
         assert!(wide.contains(&200.0) && wide.contains(&5000.0) && !wide.contains(&300.0), "{wide:?}");
         assert!(log_key_points(0.0, 1.0).is_empty());
+    }
+
+    #[test]
+    fn an_axis_of_integers_is_labelled_at_integers_only() {
+        assert_eq!(linear_tick(1.5, true), "");
+        assert_eq!(linear_tick(2.0, true), "2");
+        assert_eq!(linear_tick(1.5, false), "1.5");
+    }
+
+    #[test]
+    fn the_legend_hides_no_point_even_when_every_corner_is_taken() {
+        // Eight series over 1, 2 and 3 lights spread over two decades: every corner holds points.
+        let points: Vec<PlotPoint> = (0..8)
+            .flat_map(|series| {
+                (1..=3).map(move |lights| PlotPoint {
+                    series: format!("s{series}"),
+                    x: f64::from(lights),
+                    y: 10.0 * 1.9f64.powi(series) * f64::from(lights),
+                    label: String::new(),
+                })
+            })
+            .collect();
+        let refs: Vec<&PlotPoint> = points.iter().collect();
+        let (y_low, y_max) = (10.0 / 1.5, refs.iter().map(|p| p.y).fold(0.0, f64::max));
+        let x_fraction = |x: f64| (x - 0.84) / 2.32;
+        assert!(emptiest_corner(&refs, x_fraction, |y| (y / y_low).ln() / (y_max * 1.5 / y_low).ln()).1 > 0, "the case is crowded");
+        let (y_high, corner) = legend_room(&refs, y_low, y_max, &x_fraction, false);
+        assert_eq!(corner, SeriesLabelPosition::UpperRight);
+        let top = 1.0 - legend_share(8);
+        assert!(refs.iter().all(|p| (p.y / y_low).ln() / (y_high / y_low).ln() < top), "a point under the legend");
     }
 
     #[test]

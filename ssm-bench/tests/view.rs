@@ -42,15 +42,18 @@ fn image_origin(line: &str) -> (u32, u32) {
     (x.parse().unwrap_or_else(|_| panic!("bad x in `{line}`")), y.parse().unwrap_or_else(|_| panic!("bad y in `{line}`")))
 }
 
-/// Waits for a stdout line of the viewer containing `needle`.
-fn wait_for(lines: &Receiver<String>, needle: &str, timeout: Duration) -> String {
+/// Waits for a stdout line of the viewer containing `needle`; on failure shows the viewer's stderr (`log`).
+fn wait_for(lines: &Receiver<String>, needle: &str, timeout: Duration, log: &Path) -> String {
     let deadline = Instant::now() + timeout;
     loop {
         let left = deadline.saturating_duration_since(Instant::now());
         match lines.recv_timeout(left) {
             Ok(line) if line.contains(needle) => return line,
             Ok(_) => {}
-            Err(_) => panic!("ssm view did not print `{needle}` within {timeout:?}"),
+            Err(error) => {
+                let stderr = std::fs::read_to_string(log).unwrap_or_default();
+                panic!("ssm view did not print `{needle}` within {timeout:?} ({error}); its stderr:\n{stderr}");
+            }
         }
     }
 }
@@ -122,7 +125,10 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
         .expect("running ssm render");
     assert!(status.success(), "ssm render failed");
 
-    let number = 40 + std::process::id() % 400;
+    // A display no other X server holds (its socket and lock file absent).
+    let number = (40 + std::process::id() % 400..)
+        .find(|n| !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists())
+        .expect("a free display number");
     let display = format!(":{number}");
     let _server = Reaped(
         Command::new("Xvfb")
@@ -146,7 +152,8 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
         .env("DISPLAY", &display)
         .env_remove("WAYLAND_DISPLAY")
         .env("XDG_RUNTIME_DIR", &runtime)
-        .stdout(Stdio::piped());
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(out.join("viewer-stderr.txt")).expect("creating the viewer's log"));
     let mut viewer = Reaped(viewer.spawn().expect("starting ssm view"));
     let stdout = viewer.0.stdout.take().expect("the viewer's stdout");
     let (send, lines) = channel();
@@ -158,13 +165,14 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
         }
     });
 
-    let line = wait_for(&lines, "showing hard", Duration::from_secs(120));
+    let log = out.join("viewer-stderr.txt");
+    let line = wait_for(&lines, "showing hard", Duration::from_secs(120), &log);
     let origin = image_origin(&line);
     let shown_hard = screenshot(&display, &out.join("screen-hard.png"), origin);
     assert_shows(&out, "hard", &shown_hard, &shaded(&rendered, "hard"));
 
     xdotool(&display, &["search", "--sync", "--name", "ssm view", "windowfocus", "--sync", "key", "2"]);
-    let line = wait_for(&lines, "showing pcss", Duration::from_secs(120));
+    let line = wait_for(&lines, "showing pcss", Duration::from_secs(120), &log);
     let shown_pcss = screenshot(&display, &out.join("screen-pcss.png"), image_origin(&line));
     assert_shows(&out, "pcss", &shown_pcss, &shaded(&rendered, "pcss"));
     // Not one picture twice: hard and soft shadows differ visibly.
@@ -179,7 +187,7 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
     }
     drag.extend(["sleep".into(), "0.3".into(), "mouseup".into(), "1".into()]);
     xdotool(&display, &drag.iter().map(String::as_str).collect::<Vec<_>>());
-    let line = wait_for(&lines, "showing pcss", Duration::from_secs(120));
+    let line = wait_for(&lines, "showing pcss", Duration::from_secs(120), &log);
     // Let the frames of the rest of the drag arrive.
     std::thread::sleep(Duration::from_secs(3));
     while lines.try_recv().is_ok() {}
