@@ -56,6 +56,17 @@ struct FormatArgs {
     format: Format,
 }
 
+/// The rendered image's size, as every rendering command takes it.
+#[derive(clap::Args, Clone, Copy)]
+struct ImageSize {
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+}
+
 #[derive(clap::Args)]
 struct MergeArgs {
     /// The shards' output folders (each holds sweep.csv and shard.json), every shard of one sweep once.
@@ -94,12 +105,8 @@ struct SweepArgs {
     /// The x axis: `time`, or a varied parameter as `<technique>.<param>` (`scene.light_scale`); default: the preset's, else time.
     #[arg(long)]
     x: Option<String>,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 480)]
-    height: u32,
+    #[command(flatten)]
+    size: ImageSize,
     /// Frames timed per point after one warm-up.
     #[arg(long, default_value_t = 3)]
     frames: u32,
@@ -134,12 +141,8 @@ struct CompareArgs {
     /// Technique names, comma-separated; default: every registered real-time technique this adapter can run.
     #[arg(long, value_delimiter = ',')]
     technique: Vec<String>,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 480)]
-    height: u32,
+    #[command(flatten)]
+    size: ImageSize,
     /// Parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
@@ -172,12 +175,8 @@ struct RenderArgs {
     /// Technique names, comma-separated (see `ssm list`).
     #[arg(long, value_delimiter = ',', required = true)]
     technique: Vec<String>,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 480)]
-    height: u32,
+    #[command(flatten)]
+    size: ImageSize,
     /// Parameter assignment `<technique>.<param>=<value>`; repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
@@ -201,12 +200,8 @@ struct ViewArgs {
     /// Technique names in key order (key 1 is the first), comma-separated; default: every real-time technique, then `reference`.
     #[arg(long, value_delimiter = ',')]
     technique: Vec<String>,
-    /// Rendered image width in pixels (the window adds the panel).
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    /// Rendered image height in pixels.
-    #[arg(long, default_value_t = 480)]
-    height: u32,
+    #[command(flatten)]
+    size: ImageSize,
     /// Starting parameter `<technique>.<param>=<value>`; repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
@@ -384,7 +379,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     check_debug_outputs(&args.debug_outputs, &runs.iter().map(|(info, _)| *info).collect::<Vec<_>>())?;
     let gpu = GpuContext::new()?;
-    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+    let mut renderer = Renderer::new(&gpu, &scene, args.size.width, args.size.height, &needs)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
@@ -441,8 +436,8 @@ fn view(args: &ViewArgs) -> Result<()> {
         scene_name: args.scene.clone(),
         scene,
         techniques,
-        width: args.width,
-        height: args.height,
+        width: args.size.width,
+        height: args.size.height,
     })
 }
 
@@ -509,7 +504,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     for (info, params) in &runs {
         needs = needs.union((info.requirements)(params)?);
     }
-    let mut renderer = Renderer::new(&gpu, &scene, args.width, args.height, &needs)?;
+    let mut renderer = Renderer::new(&gpu, &scene, args.size.width, args.size.height, &needs)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
@@ -517,7 +512,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
     let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
-    let size = (args.width, args.height);
+    let size = (args.size.width, args.size.height);
     report::write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;
     let covered = report::pixel_mask(&renderer, args.pixels)?;
     progress.inc(1);
@@ -549,7 +544,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
             (r.technique.clone(), passes)
         })
         .collect();
-    let chart_title = format!("{} at {}x{}: GPU time per pass", args.scene, args.width, args.height);
+    let chart_title = format!("{} at {}x{}: GPU time per pass", args.scene, args.size.width, args.size.height);
     let pass_chart = match sweep::pass_chart(&bars, &chart_title, &args.out.join("passes.png"), &args.out.join("passes.svg")) {
         Ok(()) => Some("passes.svg"),
         // Without timestamps there are no passes to chart: the report says nothing of them.
@@ -561,7 +556,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let context = report::ReportContext {
         scene: &args.scene,
         adapter: &adapter,
-        size: (args.width, args.height),
+        size: (args.size.width, args.size.height),
         frames: args.frames,
         reference_params: &reference_text,
         reference_cost: &reference_cost,
@@ -711,11 +706,11 @@ fn run_sweep(
         } else {
             format!("{}[{}]", sweep.scene_spec, scene_point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";"))
         };
-        let mut renderer = Renderer::new(gpu, &scene, args.width, args.height, &needs)?;
+        let mut renderer = Renderer::new(gpu, &scene, args.size.width, args.size.height, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
         let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
         let covered = report::pixel_mask(&renderer, sweep.pixels)?;
-        let size = (args.width, args.height);
+        let size = (args.size.width, args.size.height);
         // Under <out>/images/<scene point>/ when asked: the ground truth, then each technique's points.
         let images = args.images.then(|| sweep.out.join("images").join(sweep::path_component(&sweep::assignment_label(scene_point))));
         let coverage = if images.is_some() { report::pixel_mask(&renderer, report::PixelSet::All)? } else { Vec::new() };
@@ -895,7 +890,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
             scene: sweep.scene_spec.clone(),
             varies: sweep.specs.clone(),
             settings: args.settings.clone(),
-            size: (args.width, args.height),
+            size: (args.size.width, args.size.height),
             frames: args.frames,
             pixels: sweep_pixels_name(sweep.pixels),
             x_axis: sweep.x_axis.clone(),
@@ -910,7 +905,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         out: &sweep.out,
         name: args.preset.as_deref().unwrap_or("custom"),
         adapter: &gpu.info.name,
-        size: (args.width, args.height),
+        size: (args.size.width, args.size.height),
         frames: args.frames,
         scene_spec: &sweep.scene_spec,
         x_axis: &sweep.x_axis,

@@ -25,25 +25,9 @@ fn scratch(test: &str) -> PathBuf {
 
 /// Headless Chromium with the flags that keep it off the network.
 fn chromium(profile: &Path, args: &[&str]) -> std::process::Output {
-    let binary = ["chromium", "chromium-browser", "google-chrome"]
-        .into_iter()
-        .find(|b| Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success()))
-        .unwrap_or_else(|| panic!("no Chromium found: install it with scripts/install-deps.sh --for-tests (Debian package chromium)"));
     let profile_flag = format!("--user-data-dir={}", profile.display());
-    let mut command = Command::new(binary);
-    command.args([
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--allow-file-access-from-files",
-        "--virtual-time-budget=5000",
-        &profile_flag,
-    ]);
+    let mut command = Command::new(common::chromium_binary());
+    command.args(common::OFFLINE_FLAGS).args(["--allow-file-access-from-files", "--virtual-time-budget=5000", &profile_flag]);
     command.args(args).output().expect("chromium runs")
 }
 

@@ -9,6 +9,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
@@ -108,28 +110,11 @@ impl Page {
     }
 }
 
-fn chromium_binary() -> &'static str {
-    ["chromium", "chromium-browser", "google-chrome"]
-        .into_iter()
-        .find(|b| Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success()))
-        .unwrap_or_else(|| panic!("no Chromium found: install it with scripts/install-deps.sh --for-tests (Debian package chromium)"))
-}
-
 /// Starts headless Chromium with DevTools on a free port and opens `page` in a new target.
 fn open(url: &str, profile: &Path) -> (Reaped, Page) {
-    let mut browser = Command::new(chromium_binary())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--remote-debugging-port=0",
-            "--window-size=1400,1000",
-        ])
+    let mut browser = Command::new(common::chromium_binary())
+        .args(common::OFFLINE_FLAGS)
+        .args(["--remote-debugging-port=0", "--window-size=1400,1000"])
         .arg(format!("--user-data-dir={}", profile.display()))
         .arg("about:blank")
         .stderr(Stdio::piped())

@@ -1,8 +1,10 @@
 //! What the CLI tests share: techniques picked from the registry by what
 //! they offer, never by name, so that the tests hold for whatever techniques
-//! are linked.
+//! are linked; and, for the browser tests, Chromium and its offline flags.
 
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
+
+use std::process::Command;
 
 use ssm_core::{GpuContext, ParamKind, TechniqueInfo, TechniqueKind};
 
@@ -67,4 +69,24 @@ pub fn split_csv(line: &str) -> Vec<String> {
 /// The index of `name` in a CSV header line.
 pub fn column(header: &str, name: &str) -> usize {
     header.split(',').position(|c| c == name).unwrap_or_else(|| panic!("no column {name} in {header}"))
+}
+
+/// Flags for a headless Chromium that reaches nothing outside the machine.
+pub const OFFLINE_FLAGS: &[&str] = &[
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+];
+
+/// The Chromium on this machine; the test fails, saying how to install it, when there is none.
+pub fn chromium_binary() -> &'static str {
+    ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|b| Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success()))
+        .unwrap_or_else(|| panic!("no Chromium found: install it with scripts/install-deps.sh --for-tests (Debian package chromium)"))
 }
