@@ -4,15 +4,17 @@
 //! of the selected technique's parameters from its declared
 //! [`ParamSpec`]s, and shows the last frame's per-pass GPU times and, where
 //! the ground truth of this view is in the reference cache, the error
-//! against it. Dragging the image orbits the camera around its target, the
-//! wheel moves it closer or further.
+//! against it. S, V and E switch the image between the shaded frame, one
+//! light's visibility and its signed error against the cached ground truth
+//! (the HTML report's keys). Dragging the image orbits the camera around its
+//! target, the wheel moves it closer or further.
 //!
 //! A frame is rendered only when something changed (technique, parameter,
 //! camera, or the "render continuously" box): on a software rasteriser a
 //! frame of some techniques takes seconds, and the panel must stay usable.
 //!
 //! Each image shown is announced on stdout as one line,
-//! `ssm view: showing <technique> [<params>] frame <n> image <x>,<y> <w>x<h>`,
+//! `ssm view: showing <technique> [<params>] frame <n> view <view> image <x>,<y> <w>x<h>`,
 //! with the image's place in the window in pixels, so that scripts (and the
 //! Xvfb test) know what the window shows and where.
 
@@ -198,6 +200,31 @@ struct Live {
     announce: Option<String>,
     /// Where the image's top-left pixel is in the window, in pixels.
     image_origin: [i64; 2],
+    /// What the image shows.
+    mode: ViewMode,
+    /// The light whose visibility or error is shown (the shaded view has every light).
+    light: usize,
+}
+
+/// What the viewer's image shows (keys S, V, E, as in the HTML report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ViewMode {
+    /// The shaded image, every light.
+    Shaded,
+    /// One light's visibility, grey.
+    Visibility,
+    /// One light's signed error against the cached ground truth.
+    SignedError,
+}
+
+impl ViewMode {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Shaded => "shaded",
+            Self::Visibility => "visibility",
+            Self::SignedError => "signed-error",
+        }
+    }
 }
 
 impl Live {
@@ -280,6 +307,8 @@ impl Live {
             truth,
             announce: None,
             image_origin: [0, 0],
+            mode: ViewMode::Shaded,
+            light: 0,
         };
         live.look_up_truth()?;
         Ok(live)
@@ -436,18 +465,59 @@ impl Live {
         if traced_truth && let Err(error) = self.look_up_truth() {
             self.report.failure = Some(format!("{error}"));
         }
-        self.measure_error(name);
-        let size = wgpu::Extent3d { width: self.renderer.width(), height: self.renderer.height(), depth_or_array_layers: 1 };
-        match self.renderer.shade_on_gpu() {
-            Ok(shaded) => encoder.copy_texture_to_texture(shaded.as_image_copy(), self.display.as_image_copy(), size),
-            Err(error) => self.report.failure = Some(format!("{error}")),
-        }
+        let lights = self.renderer.scene.light_count();
+        let visibility = match (0..lights).map(|light| self.renderer.read_visibility(light, name)).collect::<ssm_core::Result<Vec<_>>>() {
+            Ok(visibility) => visibility,
+            Err(error) => {
+                self.report.failure = Some(format!("{error}"));
+                return;
+            }
+        };
+        self.measure_error(&visibility);
+        self.light = self.light.min(lights.saturating_sub(1));
+        let shown = self.show(encoder, &visibility);
         self.frame += 1;
-        self.announce = Some(format!("ssm view: showing {name} [{params}] frame {}", self.frame));
+        self.announce = Some(format!("ssm view: showing {name} [{params}] frame {} view {}", self.frame, shown.name()));
+    }
+
+    /// Puts the frame just rendered into the display texture as the chosen view; returns the
+    /// view shown (the signed error falls back to the visibility without a cached ground truth).
+    fn show(&mut self, encoder: &mut wgpu::CommandEncoder, visibility: &[Vec<f32>]) -> ViewMode {
+        let (width, height) = (self.renderer.width(), self.renderer.height());
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let image = visibility.get(self.light).map_or(&[][..], Vec::as_slice);
+        let truth = self.truth.images.get(self.light).and_then(Option::as_deref);
+        let (mode, rgba): (ViewMode, Vec<u8>) = match (self.mode, truth) {
+            (ViewMode::Shaded, _) => {
+                match self.renderer.shade_on_gpu() {
+                    Ok(shaded) => encoder.copy_texture_to_texture(shaded.as_image_copy(), self.display.as_image_copy(), size),
+                    Err(error) => self.report.failure = Some(format!("{error}")),
+                }
+                return ViewMode::Shaded;
+            }
+            // The static report's heat map: red where darker than the truth, blue where lighter, full at 0.5.
+            (ViewMode::SignedError, Some(truth)) => (
+                ViewMode::SignedError,
+                metrics::heat_map(truth, image, &self.truth.covered, 0.5).chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect(),
+            ),
+            _ => (
+                ViewMode::Visibility,
+                image.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8).flat_map(|v| [v, v, v, 255]).collect(),
+            ),
+        };
+        if rgba.len() == (width * height * 4) as usize {
+            self.renderer.gpu.queue.write_texture(
+                self.display.as_image_copy(),
+                &rgba,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * width), rows_per_image: Some(height) },
+                size,
+            );
+        }
+        mode
     }
 
     /// The error of the frame just rendered against the cached ground truth, averaged over the lights.
-    fn measure_error(&mut self, name: &str) {
+    fn measure_error(&mut self, visibility: &[Vec<f32>]) {
         let (width, height) = (self.renderer.width() as usize, self.renderer.height() as usize);
         if self.truth.images.iter().any(Option::is_none) {
             let key = self.slots.iter().position(|s| s.info.kind == TechniqueKind::GroundTruth).map(|i| i + 1);
@@ -457,17 +527,13 @@ impl Live {
             });
             return;
         }
-        let mut per_light = Vec::new();
-        for (light, truth) in self.truth.images.iter().enumerate() {
-            let Some(truth) = truth else { continue };
-            match self.renderer.read_visibility(light, name) {
-                Ok(image) => per_light.push(metrics::compare(truth, &image, &self.truth.covered, width, height)),
-                Err(error) => {
-                    self.report.failure = Some(format!("{error}"));
-                    return;
-                }
-            }
-        }
+        let per_light: Vec<ErrorMetrics> = self
+            .truth
+            .images
+            .iter()
+            .zip(visibility)
+            .filter_map(|(truth, image)| truth.as_ref().map(|truth| metrics::compare(truth, image, &self.truth.covered, width, height)))
+            .collect();
         let n = per_light.len().max(1) as f64;
         let mean = |f: fn(&ErrorMetrics) -> f64| per_light.iter().map(f).sum::<f64>() / n;
         if let Some(first) = per_light.first() {
@@ -505,6 +571,11 @@ impl Live {
                 actions.select = Some(index);
             }
         }
+        for (key, mode) in [(egui::Key::S, ViewMode::Shaded), (egui::Key::V, ViewMode::Visibility), (egui::Key::E, ViewMode::SignedError)] {
+            if !typing && ui.input(|i| i.key_pressed(key)) {
+                actions.mode = Some(mode);
+            }
+        }
         egui::Panel::right("view_panel").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.heading(format!("ssm view: {}", self.scene_name));
@@ -516,6 +587,32 @@ impl Live {
                     if ui.selectable_label(index == self.current, label).on_hover_text(slot.info.summary).clicked() {
                         actions.select = Some(index);
                     }
+                }
+                ui.separator();
+                ui.strong("view (S, V, E)");
+                ui.horizontal(|ui| {
+                    for (mode, label) in
+                        [(ViewMode::Shaded, "shaded"), (ViewMode::Visibility, "visibility"), (ViewMode::SignedError, "signed error")]
+                    {
+                        if ui.selectable_label(self.mode == mode, label).clicked() {
+                            actions.mode = Some(mode);
+                        }
+                    }
+                });
+                let lights = self.renderer.scene.light_count();
+                if lights > 1 && self.mode != ViewMode::Shaded {
+                    let mut light = self.light;
+                    ui.add(egui::Slider::new(&mut light, 0..=lights - 1).text("light"));
+                    if light != self.light {
+                        actions.light = Some(light);
+                    }
+                }
+                if self.mode == ViewMode::SignedError {
+                    ui.label(if self.truth.images.get(self.light).is_some_and(Option::is_some) {
+                        "red: darker than the ground truth, blue: lighter; full colour at ±0.5"
+                    } else {
+                        "no cached ground truth for this view: showing the visibility"
+                    });
                 }
                 ui.separator();
                 let slot = &self.slots[self.current];
@@ -612,6 +709,16 @@ impl Live {
             self.current = index;
             self.dirty = true;
         }
+        if let Some(mode) = actions.mode
+            && mode != self.mode
+        {
+            self.mode = mode;
+            self.dirty = true;
+        }
+        if let Some(light) = actions.light {
+            self.light = light;
+            self.dirty = true;
+        }
         let slot = &mut self.slots[self.current];
         let mut params_changed = false;
         if let Some((name, text)) = actions.set {
@@ -655,6 +762,8 @@ struct Actions {
     /// A parameter's new value, as text for [`ParamValues::set`].
     set: Option<(&'static str, String)>,
     defaults: bool,
+    mode: Option<ViewMode>,
+    light: Option<usize>,
     orbit: Option<(f32, f32)>,
     dolly: Option<f32>,
 }

@@ -1,8 +1,8 @@
 //! `ssm view` in a real window: a virtual X server (Xvfb), keys and mouse
 //! from xdotool (XTEST, as a user's), screenshots of the whole screen by
 //! ImageMagick's `import`. The window must show exactly what `ssm render`
-//! shades for the technique selected, switch technique on a number key, and
-//! orbit the camera when the image is dragged.
+//! shades for the technique selected, switch technique on a number key,
+//! show the visibility on V, and orbit the camera when the image is dragged.
 //!
 //! The tools come from `scripts/install-deps.sh --for-tests`; without them
 //! the test fails, saying so, rather than skipping.
@@ -179,6 +179,18 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
     let between = mean_difference(&shown_hard, &shown_pcss);
     assert!(between > 0.5, "hard and pcss look alike in the window ({between:.2} levels)");
 
+    // V shows the visibility: `ssm render`'s 16-bit visibility.png, in 8 bits.
+    xdotool(&display, &["key", "v"]);
+    let line = wait_for(&lines, "view visibility", Duration::from_secs(120), &log);
+    let shown_visibility = screenshot(&display, &out.join("screen-pcss-visibility.png"), image_origin(&line));
+    let written = image::open(rendered.join("pcss").join("visibility.png")).expect("reading visibility.png").to_luma16();
+    let expected = image::RgbImage::from_fn(WIDTH, HEIGHT, |x, y| {
+        let level = (f64::from(written.get_pixel(x, y)[0]) / 65535.0 * 255.0).round() as u8;
+        image::Rgb([level; 3])
+    });
+    assert_shows(&out, "pcss-visibility", &shown_visibility, &expected);
+    let shown_pcss = shown_visibility;
+
     // Drag across the image, a step per frame, as a hand would: the camera orbits.
     let (x, y) = (origin.0 + WIDTH / 2, origin.1 + HEIGHT / 2);
     let mut drag = vec!["mousemove".to_string(), x.to_string(), y.to_string(), "mousedown".into(), "1".into()];
@@ -187,7 +199,7 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
     }
     drag.extend(["sleep".into(), "0.3".into(), "mouseup".into(), "1".into()]);
     xdotool(&display, &drag.iter().map(String::as_str).collect::<Vec<_>>());
-    let line = wait_for(&lines, "showing pcss", Duration::from_secs(120), &log);
+    let line = wait_for(&lines, "view visibility", Duration::from_secs(120), &log);
     // Let the frames of the rest of the drag arrive.
     std::thread::sleep(Duration::from_secs(3));
     while lines.try_recv().is_ok() {}
