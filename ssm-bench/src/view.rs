@@ -150,7 +150,8 @@ impl Orbit {
     /// Scales the eye's distance to the target by `factor`, within the clip range.
     fn dolly(&mut self, factor: f32) {
         let offset = self.camera.position - self.camera.target;
-        let distance = (offset.length() * factor).clamp(self.camera.near * 4.0, self.camera.far * 0.5);
+        // min then max, not clamp: a camera whose far plane is within 8× its near plane has no such range.
+        let distance = (offset.length() * factor).min(self.camera.far * 0.5).max(self.camera.near * 4.0);
         self.camera.position = self.camera.target + offset.normalize_or(Vec3::Z) * distance;
     }
 }
@@ -183,7 +184,7 @@ struct Live {
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
-    /// The shaded image as egui samples it (gamma-encoded `Rgba8Unorm`), copied from the composite target.
+    /// The image as egui samples it (gamma-encoded `Rgba8Unorm`): the composite target copied, or a view written.
     display: wgpu::Texture,
     display_id: egui::TextureId,
     scene_name: String,
