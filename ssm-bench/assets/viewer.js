@@ -9,6 +9,9 @@
 // signed error, absolute error, FLIP), 0 resets the view. Wheel: zoom about
 // the cursor, to single pixels without smoothing; drag: pan.
 //
+// The view is kept in the address's fragment (#technique=pcss&mode=signed&
+// light=0&zoom=4&x=120&y=80), so a link opens the page on the same view.
+//
 // For tests, <body> carries data-viewer-ready, data-technique, data-mode,
 // data-light and data-zoom; #readout carries data-pixel="x,y".
 (function () {
@@ -158,6 +161,7 @@
       context.fillStyle = '#ddd';
       context.fillText(state.mode === 'flip' && shown() === reference ? 'the ground truth has no FLIP map' : 'loading', 10, 20);
     }
+    writeFragment();
     body.dataset.technique = shown();
     body.dataset.mode = state.mode;
     body.dataset.light = String(state.light);
@@ -400,6 +404,49 @@
     fill(rows);
     draw();
   }
+  // The view in the address's fragment: read once at load, rewritten on every change.
+  const MODES = ['shaded', 'visibility', 'signed', 'absolute', 'flip'];
+  function readFragment() {
+    const fields = new URLSearchParams(window.location.hash.slice(1));
+    const technique = fields.get('technique');
+    if (technique && choices.includes(technique)) {
+      state.technique = technique;
+    }
+    if (MODES.includes(fields.get('mode'))) {
+      state.mode = fields.get('mode');
+    }
+    const number = (key, low, high) => {
+      const value = Number(fields.get(key));
+      return fields.has(key) && Number.isFinite(value) ? Math.max(low, Math.min(high, value)) : null;
+    };
+    const light = number('light', 0, data.lights - 1);
+    if (light !== null) {
+      state.light = Math.floor(light);
+      lightChoice.value = String(state.light);
+    }
+    const zoom = number('zoom', 0.25, 64);
+    if (zoom !== null) {
+      state.zoom = zoom;
+    }
+    const x = number('x', -width, 2 * width);
+    const y = number('y', -height, 2 * height);
+    if (x !== null && y !== null) {
+      state.originX = x;
+      state.originY = y;
+    }
+  }
+  function writeFragment() {
+    const fields = new URLSearchParams({
+      technique: state.technique,
+      mode: state.mode,
+      light: String(state.light),
+      zoom: String(Math.round(state.zoom * 1000) / 1000),
+      x: String(Math.round(state.originX * 100) / 100),
+      y: String(Math.round(state.originY * 100) / 100),
+    });
+    history.replaceState(null, '', '#' + fields.toString());
+  }
+  readFragment();
   fill(data.rows);
   draw();
   body.dataset.viewerReady = '1';

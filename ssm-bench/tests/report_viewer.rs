@@ -236,6 +236,14 @@ fn the_comparison_page_switches_flips_reads_out_zooms_and_sorts_in_a_browser() {
     assert_eq!(first.as_f64().unwrap(), order[1], "a second click sorts descending");
     page.eval("document.querySelector('#metrics tbody tr[data-technique=\"hard\"]').click()");
     assert_eq!(page.body("technique"), "hard");
+
+    // The view lives in the address's fragment: a link opens the page on it.
+    let fragment = page.eval("window.location.hash");
+    assert!(fragment.as_str().is_some_and(|f| f.contains("technique=hard") && f.contains("mode=flip")), "fragment {fragment}");
+    page.call("Page.navigate", json!({ "url": format!("{url}#technique=pcss&mode=signed&zoom=4&x=10&y=20") }));
+    page.call("Page.reload", json!({}));
+    page.wait_for("document.readyState === 'complete' && document.body !== null && document.body.dataset.viewerReady === '1'");
+    assert_eq!((page.body("technique"), page.body("mode"), page.body("zoom")), ("pcss".into(), "signed".into(), "4".into()));
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }
