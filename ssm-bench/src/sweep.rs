@@ -609,7 +609,9 @@ where
         .margin(20)
         .x_label_area_size(40)
         .y_label_area_size(230)
-        .build_cartesian_2d(0.0..100.0, 0.0..count as f64)
+        // Shifted by 0.15 so that the labels plotters puts at k + 0.5 sit at the bars' centres, the
+        // bars being in the upper part of their slots to leave room for the names under them.
+        .build_cartesian_2d(0.0..100.0, -0.15..count as f64 - 0.15)
         .map_err(chart_error)?;
     chart
         .configure_mesh()
@@ -630,8 +632,8 @@ where
         .draw()
         .map_err(chart_error)?;
     for (index, ((_, passes), total)) in bars.iter().zip(&totals).enumerate() {
-        let top = (count - index) as f64 - 0.12;
-        let bottom = (count - 1 - index) as f64 + 0.42;
+        let top = (count - index) as f64 - 0.27;
+        let bottom = (count - 1 - index) as f64 + 0.27;
         let mut start = 0.0;
         // Passes too narrow for their name are named under the bar, each after a swatch of its colour.
         let (mut key_cursor, mut key_line) = (0.0, 0.0);
