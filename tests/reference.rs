@@ -12,7 +12,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use glam::{Vec2, Vec3};
-use ssm_core::reference::{GroundTruth, SurfacePoint, parallel_rectangle_visibility};
+use ssm_core::reference::{GroundTruth, ReferenceCache, SurfacePoint, parallel_rectangle_visibility};
 use ssm_scene::builtin;
 use ssm_testing::{gpu, render};
 
@@ -80,6 +80,10 @@ fn cached_results_are_identical_and_keyed_by_their_inputs() {
     assert!(again.cached && again.rays == 0);
     assert_eq!(first.visibility, again.visibility);
     assert_eq!(*first.visibility.last().unwrap(), 1.0, "a pixel without a surface is lit");
+    // The cache alone (no tracer built) finds the same entry, and nothing for other inputs.
+    let cache = ReferenceCache::of(&scene);
+    assert_eq!(cache.cached(light, &points, 8, 1, &dir).map(|image| image.visibility), Some(first.visibility.clone()));
+    assert!(cache.cached(light, &points, 8, 3, &dir).is_none());
     // A different sample count or seed is a different entry.
     assert!(!truth.trace_cached(light, &points, 4, 1, &dir).cached);
     assert!(!truth.trace_cached(light, &points, 8, 2, &dir).cached);

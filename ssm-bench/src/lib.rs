@@ -58,6 +58,19 @@ pub fn output_requirements() -> Requirements {
     Requirements { gbuffer: true, ..Requirements::NONE }
 }
 
+/// What the renderer must build for `techniques` (the union of their requirements) and for the
+/// outputs every command reads ([`output_requirements`]).
+///
+/// # Errors
+/// A technique whose parameters its requirements reject.
+pub fn requirements_of<'a>(techniques: impl IntoIterator<Item = (&'a TechniqueInfo, &'a ParamValues)>) -> ssm_core::Result<Requirements> {
+    let mut needs = output_requirements();
+    for (info, params) in techniques {
+        needs = needs.union((info.requirements)(params)?);
+    }
+    Ok(needs)
+}
+
 /// The debug outputs to ask of `info`: those named in `asked` (`all`: every one it declares),
 /// plus its overlays when `overlays` (the HTML report draws them).
 #[must_use]

@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ssm_bench::shard::Varied;
 use ssm_bench::{
-    check_debug_outputs, debug_outputs_for, output_requirements, registry, render_technique, report, support_on, sweep, write_positions,
+    check_debug_outputs, debug_outputs_for, registry, render_technique, report, requirements_of, support_on, sweep, write_positions,
 };
 use ssm_core::{GpuContext, ParamValues, Renderer, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
@@ -370,13 +370,11 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     // Resolve every technique and its parameters before touching the GPU: a typo fails fast.
     let mut runs = Vec::new();
-    let mut needs = output_requirements();
     for name in &args.technique {
         let info = registry.get(name)?;
-        let params = params_for(info, &settings)?;
-        needs = needs.union((info.requirements)(&params)?);
-        runs.push((info, params));
+        runs.push((info, params_for(info, &settings)?));
     }
+    let needs = requirements_of(runs.iter().map(|(info, params)| (*info, params)))?;
     check_debug_outputs(&args.debug_outputs, &runs.iter().map(|(info, _)| *info).collect::<Vec<_>>())?;
     let gpu = GpuContext::new()?;
     let mut renderer = Renderer::new(&gpu, &scene, args.size.width, args.size.height, &needs)?;
@@ -500,10 +498,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     }
     check_debug_outputs(&args.debug_outputs, &runs.iter().map(|(info, _)| *info).collect::<Vec<_>>())?;
     let reference_params = params_for(reference_info, &settings)?;
-    let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
-    for (info, params) in &runs {
-        needs = needs.union((info.requirements)(params)?);
-    }
+    let needs = requirements_of(runs.iter().map(|(info, params)| (*info, params)).chain([(reference_info, &reference_params)]))?;
     let mut renderer = Renderer::new(&gpu, &scene, args.size.width, args.size.height, &needs)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
@@ -679,10 +674,8 @@ fn run_sweep(
     let reference_info =
         registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).context("no ground-truth technique is registered")?;
     let reference_params = params_for(reference_info, settings)?;
-    let mut needs = output_requirements().union((reference_info.requirements)(&reference_params)?);
-    for (info, params, _) in &sweep.plan.points {
-        needs = needs.union((info.requirements)(params)?);
-    }
+    let needs =
+        requirements_of(sweep.plan.points.iter().map(|(info, params, _)| (*info, params)).chain([(reference_info, &reference_params)]))?;
     let plan = &sweep.plan;
     // The runs this process measures: all, or its shard's block of them.
     let total = plan.scene_points.len() * plan.points.len();

@@ -351,7 +351,9 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
     rows
 }
 
-fn average(all: &[ErrorMetrics]) -> ErrorMetrics {
+/// The errors of several lights as one: means of the per-pixel measures, the largest error, the pixel counts summed (the `all` row).
+#[must_use]
+pub fn average(all: &[ErrorMetrics]) -> ErrorMetrics {
     let n = all.len().max(1) as f64;
     let mean = |f: &dyn Fn(&ErrorMetrics) -> f64| all.iter().map(f).sum::<f64>() / n;
     ErrorMetrics {
@@ -435,7 +437,6 @@ pub fn csv(rows: &[Row]) -> String {
 /// passes and diagnostics as objects; infinite or missing numbers as `null`.
 #[must_use]
 pub fn row_json(row: &Row) -> serde_json::Value {
-    let finite = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
     let object = |items: &[(String, f64)]| items.iter().map(|(k, v)| (k.clone(), finite(*v))).collect::<serde_json::Map<_, _>>();
     let m = &row.metrics;
     serde_json::json!({
@@ -664,6 +665,11 @@ pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     out
 }
 
+/// A number for JSON: `null` when not finite (JSON has no infinity; PSNR of identical images is one).
+fn finite(value: f64) -> serde_json::Value {
+    if value.is_finite() { serde_json::json!(value) } else { serde_json::Value::Null }
+}
+
 /// The interactive viewer's script (`ssm-bench/assets/viewer.js`), written beside `index.html` as `viewer.js`.
 pub const VIEWER_SCRIPT: &str = include_str!("../assets/viewer.js");
 
@@ -707,7 +713,6 @@ pub fn viewer_data(
             }),
         );
     }
-    let finite = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
     let table: Vec<serde_json::Value> = rows
         .iter()
         .map(|r| {

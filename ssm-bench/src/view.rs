@@ -25,10 +25,9 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use ssm_core::metrics::{self, ErrorMetrics};
-use ssm_core::reference::{GroundTruth, surface_points};
+use ssm_core::reference::{ReferenceCache, surface_points};
 use ssm_core::{
-    FrameTimings, GpuContext, ParamKind, ParamSpec, ParamValue, ParamValues, Renderer, Requirements, ShadowTechnique, TechniqueInfo,
-    TechniqueKind,
+    FrameTimings, GpuContext, ParamKind, ParamSpec, ParamValue, ParamValues, Renderer, ShadowTechnique, TechniqueInfo, TechniqueKind,
 };
 use ssm_scene::{Camera, Scene};
 use winit::application::ApplicationHandler;
@@ -169,7 +168,7 @@ struct FrameReport {
 
 /// The ground truth of the current view where the cache holds it.
 struct TruthLookup {
-    truth: GroundTruth,
+    cache: ReferenceCache,
     cache_dir: PathBuf,
     /// Per light, for the current camera: `None` when not cached.
     images: Vec<Option<Vec<f32>>>,
@@ -252,7 +251,7 @@ impl Live {
         surface_config.format = format;
         surface.configure(&gpu.device, &surface_config);
 
-        let needs = requirements_of(&techniques)?;
+        let needs = crate::requirements_of(techniques.iter().map(|(info, params)| (*info, params)))?;
         let renderer = Renderer::new(&gpu, &scene, width, height, &needs).context("uploading the scene")?;
         let display = ssm_core::passes::render_texture(
             &gpu.device,
@@ -278,12 +277,12 @@ impl Live {
         );
         let up = scene.camera.up.normalize_or(Vec3::Y);
         let orbit = Orbit { camera: scene.camera, up };
-        let covered = vec![false; (width * height) as usize];
+        // The cache's key only: building the tracer (its BVH) is left to the `reference` technique, if selected.
         let truth = TruthLookup {
-            truth: GroundTruth::new(&scene),
+            cache: ReferenceCache::of(&scene),
             cache_dir: ssm_core::reference::default_cache_dir(),
             images: Vec::new(),
-            covered,
+            covered: Vec::new(),
         };
         let slots = techniques.into_iter().map(|(info, params)| Slot { info, params, instance: None }).collect();
         let mut live = Self {
@@ -322,17 +321,20 @@ impl Live {
         let positions = self.renderer.read_positions()?;
         let normals = self.renderer.read_normals()?;
         self.truth.covered = positions.iter().map(|p| p[3] > 0.5).collect();
-        let reference = self.slots.iter().find(|s| s.info.kind == TechniqueKind::GroundTruth).map(|s| &s.params);
-        let samples = reference.and_then(|p| p.int("samples").ok()).unwrap_or(16).clamp(1, 256) as u32;
-        let seed = reference.and_then(|p| p.int("seed").ok()).unwrap_or(1).max(0) as u64;
-        let footprint = reference.and_then(|p| p.choice("footprint").ok()) == Some("pixel");
+        // The reference technique's parameters, or its defaults when it is not among those shown.
+        let defaults = ParamValues::defaults(ssm_core::reference::NAME, ssm_core::reference::PARAMS);
+        let reference = self.slots.iter().find(|s| s.info.kind == TechniqueKind::GroundTruth).map_or(&defaults, |s| &s.params);
+        // The parameters' declared ranges make the conversions exact.
+        let samples = u32::try_from(reference.int("samples")?)?;
+        let seed = u64::try_from(reference.int("seed")?)?;
+        let footprint = reference.choice("footprint")? == "pixel";
         let points = surface_points(&positions, &normals, &self.renderer.scene.camera, footprint);
         self.truth.images = self
             .renderer
             .scene
             .light_frames
             .iter()
-            .map(|frame| self.truth.truth.cached(&frame.light, &points, samples, seed, &self.truth.cache_dir).map(|image| image.visibility))
+            .map(|frame| self.truth.cache.cached(&frame.light, &points, samples, seed, &self.truth.cache_dir).map(|image| image.visibility))
             .collect();
         Ok(())
     }
@@ -467,7 +469,12 @@ impl Live {
             self.report.failure = Some(format!("{error}"));
         }
         let lights = self.renderer.scene.light_count();
-        let visibility = match (0..lights).map(|light| self.renderer.read_visibility(light, name)).collect::<ssm_core::Result<Vec<_>>>() {
+        // Read back only what is shown or measured: the shaded view without a cached truth needs nothing.
+        let read = self.mode != ViewMode::Shaded || self.truth.images.iter().all(Option::is_some);
+        let visibility = match (0..if read { lights } else { 0 })
+            .map(|light| self.renderer.read_visibility(light, name))
+            .collect::<ssm_core::Result<Vec<_>>>()
+        {
             Ok(visibility) => visibility,
             Err(error) => {
                 self.report.failure = Some(format!("{error}"));
@@ -535,20 +542,8 @@ impl Live {
             .zip(visibility)
             .filter_map(|(truth, image)| truth.as_ref().map(|truth| metrics::compare(truth, image, &self.truth.covered, width, height)))
             .collect();
-        let n = per_light.len().max(1) as f64;
-        let mean = |f: fn(&ErrorMetrics) -> f64| per_light.iter().map(f).sum::<f64>() / n;
-        if let Some(first) = per_light.first() {
-            self.report.error = Some(ErrorMetrics {
-                mae_penumbra: mean(|m| m.mae_penumbra),
-                rmse: mean(|m| m.rmse),
-                max_abs: per_light.iter().map(|m| m.max_abs).fold(0.0, f64::max),
-                psnr: mean(|m| m.psnr),
-                ssim: mean(|m| m.ssim),
-                frac_over_0_05: mean(|m| m.frac_over_0_05),
-                mean_signed: mean(|m| m.mean_signed),
-                umbra_leak: mean(|m| m.umbra_leak),
-                ..*first
-            });
+        if !per_light.is_empty() {
+            self.report.error = Some(crate::report::average(&per_light));
         }
     }
 
@@ -807,16 +802,4 @@ fn parameter_widget(ui: &mut egui::Ui, spec: &ParamSpec, params: &ParamValues) -
     });
     response.response.on_hover_text(spec.doc);
     response.inner
-}
-
-/// The union of what `techniques` need (and the G-buffer the image is shaded from), for building the renderer once.
-///
-/// # Errors
-/// A technique whose parameters its requirements reject.
-pub fn requirements_of(techniques: &[(&'static TechniqueInfo, ParamValues)]) -> ssm_core::Result<Requirements> {
-    let mut needs = crate::output_requirements();
-    for (info, params) in techniques {
-        needs = needs.union((info.requirements)(params)?);
-    }
-    Ok(needs)
 }

@@ -164,7 +164,7 @@ impl GpuScene {
         });
 
         let bounds = scene.bounds();
-        let camera = camera_uniform(scene, width, height);
+        let camera = camera_uniform(&scene.camera, width, height);
         let camera_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene_camera_uniform"),
             contents: bytemuck::bytes_of(&camera),
@@ -268,16 +268,12 @@ impl GpuScene {
     /// camera). The G-buffer must be rendered again afterwards
     /// ([`Renderer::set_camera`](crate::Renderer::set_camera) does both).
     pub fn set_camera(&mut self, queue: &wgpu::Queue, camera: &ssm_scene::Camera) {
-        self.camera = camera_uniform_of(camera, self.width, self.height);
+        self.camera = camera_uniform(camera, self.width, self.height);
         queue.write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&self.camera));
     }
 }
 
-fn camera_uniform(scene: &Scene, width: u32, height: u32) -> CameraUniform {
-    camera_uniform_of(&scene.camera, width, height)
-}
-
-fn camera_uniform_of(camera: &ssm_scene::Camera, width: u32, height: u32) -> CameraUniform {
+fn camera_uniform(camera: &ssm_scene::Camera, width: u32, height: u32) -> CameraUniform {
     let aspect = width as f32 / height.max(1) as f32;
     let view_proj: Mat4 = camera.projection(aspect) * camera.view();
     CameraUniform {

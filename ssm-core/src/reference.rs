@@ -128,8 +128,90 @@ pub struct GroundTruth {
     bvh: CwBvh,
     /// Offset of ray origins off the surface, world units (scaled to the scene).
     surface_offset: f32,
-    /// Hash of the triangles, for cache keys.
+    /// What the cache is keyed by beyond each image's own inputs: the triangles.
+    cache: ReferenceCache,
+}
+
+/// The ground truth's on-disk cache for one scene: what an image is keyed
+/// by beyond its own inputs (the light, the points, the samples and the
+/// seed) is the hash of the scene's triangles, with [`REFERENCE_VERSION`].
+/// Made without building the BVH, so a viewer can ask whether a view's
+/// ground truth is cached without the cost of a tracer.
+#[derive(Clone, Copy, Debug)]
+pub struct ReferenceCache {
     geometry_hash: u64,
+}
+
+/// The triangles the ground truth traces: every world triangle with a non-zero area.
+fn traced_triangles(scene: &Scene) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    scene
+        .world_triangles()
+        .filter(|t| (t.corners[1] - t.corners[0]).cross(t.corners[2] - t.corners[0]).length_squared() > 0.0)
+        .map(|t| t.corners)
+}
+
+impl ReferenceCache {
+    /// The cache of `scene`'s ground truth.
+    #[must_use]
+    pub fn of(scene: &Scene) -> Self {
+        let mut hasher = Fnv64::new();
+        for corners in traced_triangles(scene) {
+            for corner in corners {
+                hasher.write_f32s(&corner.to_array());
+            }
+        }
+        Self { geometry_hash: hasher.finish() }
+    }
+
+    /// The image [`GroundTruth::trace_cached`] would return, if `cache_dir`
+    /// holds it; `None` without tracing anything otherwise (a live viewer
+    /// shows the error against the ground truth only where it is cached).
+    #[must_use]
+    pub fn cached(
+        &self,
+        light: &RectLight,
+        points: &[Option<SurfacePoint>],
+        samples_per_axis: u32,
+        seed: u64,
+        cache_dir: &Path,
+    ) -> Option<ReferenceImage> {
+        let bytes = std::fs::read(self.file(light, points, samples_per_axis, seed, cache_dir)).ok()?;
+        (bytes.len() == points.len() * 4).then(|| {
+            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true }
+        })
+    }
+
+    fn file(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64, cache_dir: &Path) -> PathBuf {
+        cache_dir.join(format!("{:016x}.f32", self.key(light, points, samples_per_axis, seed)))
+    }
+
+    fn key(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> u64 {
+        let mut hasher = Fnv64::new();
+        hasher.write(&REFERENCE_VERSION.to_le_bytes());
+        hasher.write(&self.geometry_hash.to_le_bytes());
+        hasher.write_f32s(&[light.centre.x, light.centre.y, light.centre.z, light.u_axis.x, light.u_axis.y, light.u_axis.z]);
+        hasher.write_f32s(&[light.v_axis.x, light.v_axis.y, light.v_axis.z, light.half_size.x, light.half_size.y]);
+        hasher.write(&samples_per_axis.to_le_bytes());
+        hasher.write(&seed.to_le_bytes());
+        hasher.write(&(points.len() as u64).to_le_bytes());
+        for point in points {
+            match point {
+                Some(p) => {
+                    hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]);
+                    // Points without a footprint hash as before, so that their cache stays valid.
+                    if let Some(f) = &p.footprint {
+                        hasher.write(&[0xfe]);
+                        for v in [f.eye, f.corner, f.across, f.down] {
+                            hasher.write_f32s(&v.to_array());
+                        }
+                    }
+                }
+                None => hasher.write(&[0xff]),
+            }
+        }
+        hasher.finish()
+    }
 }
 
 /// One pixel's surface point as the G-buffer records it.
@@ -199,20 +281,12 @@ impl GroundTruth {
     /// Builds the BVH over every triangle of `scene` (degenerate ones skipped).
     #[must_use]
     pub fn new(scene: &Scene) -> Self {
-        let mut hasher = Fnv64::new();
-        let triangles: Vec<Triangle> = scene
-            .world_triangles()
-            .filter(|t| (t.corners[1] - t.corners[0]).cross(t.corners[2] - t.corners[0]).length_squared() > 0.0)
-            .map(|t| {
-                for corner in t.corners {
-                    hasher.write_f32s(&corner.to_array());
-                }
-                Triangle { v0: Vec3A::from(t.corners[0]), v1: Vec3A::from(t.corners[1]), v2: Vec3A::from(t.corners[2]) }
-            })
+        let triangles: Vec<Triangle> = traced_triangles(scene)
+            .map(|[v0, v1, v2]| Triangle { v0: Vec3A::from(v0), v1: Vec3A::from(v1), v2: Vec3A::from(v2) })
             .collect();
         let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
         let extent = scene.bounds().size().length().max(1e-6);
-        Self { triangles, bvh, surface_offset: extent * 1e-5, geometry_hash: hasher.finish() }
+        Self { triangles, bvh, surface_offset: extent * 1e-5, cache: ReferenceCache::of(scene) }
     }
 
     /// True when the segment from `origin` to `target` crosses no triangle.
@@ -529,10 +603,10 @@ impl GroundTruth {
         seed: u64,
         cache_dir: &Path,
     ) -> ReferenceImage {
-        if let Some(image) = self.cached(light, points, samples_per_axis, seed, cache_dir) {
+        if let Some(image) = self.cache.cached(light, points, samples_per_axis, seed, cache_dir) {
             return image;
         }
-        let file = self.cache_file(light, points, samples_per_axis, seed, cache_dir);
+        let file = self.cache.file(light, points, samples_per_axis, seed, cache_dir);
         let image = self.trace(light, points, samples_per_axis, seed);
         let bytes: Vec<u8> = image.visibility.iter().flat_map(|v| v.to_le_bytes()).collect();
         // Write then rename, so that a concurrent reader never sees half a file.
@@ -541,63 +615,6 @@ impl GroundTruth {
             let _ = std::fs::rename(&partial, &file);
         }
         image
-    }
-
-    /// The image [`GroundTruth::trace_cached`] would return, if `cache_dir`
-    /// holds it; `None` without tracing anything otherwise (a live viewer
-    /// shows the error against the ground truth only where it is cached).
-    #[must_use]
-    pub fn cached(
-        &self,
-        light: &RectLight,
-        points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
-        seed: u64,
-        cache_dir: &Path,
-    ) -> Option<ReferenceImage> {
-        let bytes = std::fs::read(self.cache_file(light, points, samples_per_axis, seed, cache_dir)).ok()?;
-        (bytes.len() == points.len() * 4).then(|| {
-            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-            ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true }
-        })
-    }
-
-    fn cache_file(
-        &self,
-        light: &RectLight,
-        points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
-        seed: u64,
-        cache_dir: &Path,
-    ) -> PathBuf {
-        cache_dir.join(format!("{:016x}.f32", self.cache_key(light, points, samples_per_axis, seed)))
-    }
-
-    fn cache_key(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> u64 {
-        let mut hasher = Fnv64::new();
-        hasher.write(&REFERENCE_VERSION.to_le_bytes());
-        hasher.write(&self.geometry_hash.to_le_bytes());
-        hasher.write_f32s(&[light.centre.x, light.centre.y, light.centre.z, light.u_axis.x, light.u_axis.y, light.u_axis.z]);
-        hasher.write_f32s(&[light.v_axis.x, light.v_axis.y, light.v_axis.z, light.half_size.x, light.half_size.y]);
-        hasher.write(&samples_per_axis.to_le_bytes());
-        hasher.write(&seed.to_le_bytes());
-        hasher.write(&(points.len() as u64).to_le_bytes());
-        for point in points {
-            match point {
-                Some(p) => {
-                    hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]);
-                    // Points without a footprint hash as before, so that their cache stays valid.
-                    if let Some(f) = &p.footprint {
-                        hasher.write(&[0xfe]);
-                        for v in [f.eye, f.corner, f.across, f.down] {
-                            hasher.write_f32s(&v.to_array());
-                        }
-                    }
-                }
-                None => hasher.write(&[0xff]),
-            }
-        }
-        hasher.finish()
     }
 
     /// Number of triangles in the BVH.

@@ -231,7 +231,6 @@ impl Renderer {
         if let Some(gbuffer) = &self.shared.gbuffer {
             self.timer.reset();
             self.shared_timings = render_gbuffer(&self.gpu, gbuffer, &self.scene, &mut self.timer)?;
-            self.timer.reset();
         }
         self.check_gpu_errors("moving the camera")
     }

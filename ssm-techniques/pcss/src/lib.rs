@@ -75,7 +75,7 @@ pub struct PcssSettings {
     pub bias: ShadowMapBias,
 }
 
-/// The kernel sizes, as `shaders/pcss/pcss.wgsl` reads them (`PcssSettings`).
+/// The kernel sizes, as `shaders/pcss/pcss_common.wgsl` reads them (`PcssSettings`) for both tap sources.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct PcssSettingsUniform {
