@@ -185,3 +185,27 @@ fn the_pyramid_shortcut_gives_what_every_ray_gives() {
         assert_eq!(differing, 0, "{name}");
     }
 }
+
+/// `traversal = per_ray` (every ray through the BVH) traces the same image as the shortcuts,
+/// pixel for pixel, so timing the two against each other compares like with like.
+#[test]
+fn per_ray_traversal_traces_the_shortcuts_image() {
+    use ssm_core::reference::Traversal;
+    let gpu = gpu();
+    let scene = builtin("sphere-cube").unwrap().build();
+    let needs = ssm_core::Requirements { gbuffer: true, ..ssm_core::Requirements::NONE };
+    let renderer = ssm_core::Renderer::new(&gpu, &scene, 64, 48, &needs).unwrap();
+    let points = ssm_core::reference::surface_points(
+        &renderer.read_positions().unwrap(),
+        &renderer.read_normals().unwrap(),
+        &renderer.scene.camera,
+        false,
+    );
+    let light = &scene.lights[0];
+    let shortcuts = GroundTruth::new(&scene).trace(light, &points, 8, 3);
+    let per_ray = GroundTruth::new(&scene).with_traversal(Traversal::PerRay).trace(light, &points, 8, 3);
+    let shadowed = shortcuts.visibility.iter().filter(|v| **v < 1.0).count();
+    assert!(shadowed > 100, "the view must hold shadow to compare: {shadowed} pixels");
+    let differing = shortcuts.visibility.iter().zip(&per_ray.visibility).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{differing} of {} pixels differ between the traversals", points.len());
+}

@@ -130,6 +130,19 @@ pub struct GroundTruth {
     surface_offset: f32,
     /// What the cache is keyed by beyond each image's own inputs: the triangles.
     cache: ReferenceCache,
+    /// How [`GroundTruth::trace`] traces each pixel.
+    traversal: Traversal,
+}
+
+/// How [`GroundTruth::trace`] traces a pixel's rays. Both give the same visibility, ray for ray
+/// (a test compares every pixel), so the cache does not tell them apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Traversal {
+    /// [`GroundTruth::visibility`]: the pyramid from the point to the light (or its quarters)
+    /// gathered from the BVH once, its few triangles tested by each ray.
+    Shortcuts,
+    /// [`GroundTruth::visibility_per_ray`]: every ray through the BVH, the definition.
+    PerRay,
 }
 
 /// The ground truth's on-disk cache for one scene: what an image is keyed
@@ -286,7 +299,13 @@ impl GroundTruth {
             .collect();
         let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
         let extent = scene.bounds().size().length().max(1e-6);
-        Self { triangles, bvh, surface_offset: extent * 1e-5, cache: ReferenceCache::of(scene) }
+        Self { triangles, bvh, surface_offset: extent * 1e-5, cache: ReferenceCache::of(scene), traversal: Traversal::Shortcuts }
+    }
+
+    /// This tracer with `traversal` for [`GroundTruth::trace`] (the same visibility either way).
+    #[must_use]
+    pub fn with_traversal(self, traversal: Traversal) -> Self {
+        Self { traversal, ..self }
     }
 
     /// True when the segment from `origin` to `target` crosses no triangle.
@@ -582,7 +601,13 @@ impl GroundTruth {
             .par_iter()
             .enumerate()
             .map(|(index, point)| match point {
-                Some(point) => self.visibility(light, point, samples_per_axis, &mut SplitMix64::for_pixel(seed, index as u64)),
+                Some(point) => {
+                    let rng = &mut SplitMix64::for_pixel(seed, index as u64);
+                    match self.traversal {
+                        Traversal::Shortcuts => self.visibility(light, point, samples_per_axis, rng),
+                        Traversal::PerRay => self.visibility_per_ray(light, point, samples_per_axis, rng),
+                    }
+                }
                 None => 1.0,
             })
             .collect();
@@ -824,6 +849,11 @@ pub const PARAMS: &[crate::ParamSpec] = &[
         doc: "read and write the on-disk cache (SSM_CACHE_DIR, else ~/.cache/ssm)",
     },
     crate::ParamSpec {
+        name: "traversal",
+        kind: crate::ParamKind::Choice { default: "shortcuts", options: &["shortcuts", "per_ray"] },
+        doc: "how rays are traced, with the same answer ray for ray: shortcuts (each pixel's pyramid to the light gathered from the BVH once, cut into quarters where it holds many triangles) or per_ray (every ray through the BVH, the definition: to time the shortcuts against, with cache = false)",
+    },
+    crate::ParamSpec {
         name: "footprint",
         kind: crate::ParamKind::Choice { default: "centre", options: &["centre", "pixel"] },
         doc: "where each pixel is sampled: at the G-buffer's point (centre), or over the pixel's footprint on the point's tangent plane (pixel: the prefiltered visibility that anti-aliasing aims at)",
@@ -951,7 +981,10 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         crate::VISIBILITY_FORMAT.into(),
     )?;
     Ok(Box::new(ReferenceTechnique {
-        truth: GroundTruth::new(setup.cpu_scene),
+        truth: GroundTruth::new(setup.cpu_scene).with_traversal(match params.choice("traversal")? {
+            "per_ray" => Traversal::PerRay,
+            _ => Traversal::Shortcuts,
+        }),
         samples_per_axis: u32::try_from(params.int("samples")?).unwrap_or(16),
         seed: u64::try_from(params.int("seed")?).unwrap_or(1),
         cache_dir: params.bool("cache")?.then(default_cache_dir),
