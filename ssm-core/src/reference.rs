@@ -136,7 +136,7 @@ pub struct GroundTruth {
 
 /// How [`GroundTruth::trace`] traces a pixel's rays. Both give the same visibility, ray for ray
 /// (a test compares every pixel), so the cache does not tell them apart.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, crate::Choice)]
 pub enum Traversal {
     /// [`GroundTruth::visibility`]: the pyramid from the point to the light (or its quarters)
     /// gathered from the BVH once, its few triangles tested by each ray.
@@ -850,7 +850,7 @@ pub const PARAMS: &[crate::ParamSpec] = &[
     },
     crate::ParamSpec {
         name: "traversal",
-        kind: crate::ParamKind::Choice { default: "shortcuts", options: &["shortcuts", "per_ray"] },
+        kind: crate::ParamKind::Choice { default: "shortcuts", options: <Traversal as crate::Choice>::OPTIONS },
         doc: "how rays are traced, with the same answer ray for ray: shortcuts (each pixel's pyramid to the light gathered from the BVH once, cut into quarters where it holds many triangles) or per_ray (every ray through the BVH, the definition: to time the shortcuts against, with cache = false)",
     },
     crate::ParamSpec {
@@ -981,10 +981,13 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         crate::VISIBILITY_FORMAT.into(),
     )?;
     Ok(Box::new(ReferenceTechnique {
-        truth: GroundTruth::new(setup.cpu_scene).with_traversal(match params.choice("traversal")? {
-            "per_ray" => Traversal::PerRay,
-            _ => Traversal::Shortcuts,
-        }),
+        truth: GroundTruth::new(setup.cpu_scene).with_traversal(
+            <Traversal as crate::Choice>::from_name(params.choice("traversal")?).ok_or(crate::ParamError::WrongType {
+                technique: NAME.into(),
+                name: "traversal".into(),
+                wanted: "Traversal",
+            })?,
+        ),
         samples_per_axis: u32::try_from(params.int("samples")?).unwrap_or(16),
         seed: u64::try_from(params.int("seed")?).unwrap_or(1),
         cache_dir: params.bool("cache")?.then(default_cache_dir),
