@@ -32,11 +32,6 @@ struct PcssSettings {
     receiver_plane: u32,
     // Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
-    // 1: count the texture reads of each computed pixel into read_counts (profiling; atomics cost time).
-    count_reads: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 };
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
@@ -104,9 +99,9 @@ fn soft_visibility(pixel: PcssPixel) -> f32 {
     return lit / f32(m * m);
 }
 
-// Records this invocation's reads (with settings.count_reads).
+// Records this invocation's reads (with COUNT_READS, the settings' count_reads).
 fn record_pcss_reads(texel: vec2<i32>) {
-    if (settings.count_reads != 0u) {
+    if (COUNT_READS) {
         let word = read_count_word(0u, texel);
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);

@@ -5,11 +5,16 @@
 // compute pass whose workgroups share the screen row the blur reads) are in
 // sssm_blocker_blur_fragment.wgsl and sssm_blocker_blur_compute.wgsl; each defines
 // `horizontal_source(texel)`, where a blur tap's pixel comes from, and binds `penumbra_error`, the
-// target of the Table 5 measurement (with settings.penumbra_error: per pixel, (the penumbra width
+// target of the Table 5 measurement (with MEASURE_PENUMBRA_ERROR: per pixel, (the penumbra width
 // from the reused rows − the width from every row read)², shadow-map texels²; -1 where step 2
 // computed no penumbra either way).
 
 // #import sssm/sssm_common.wgsl
+
+// Whether step 2 also searches every blocker row (no reuse) and writes the squared difference of
+// the two penumbra widths to penumbra_error (the settings' penumbra_error, Table 5; costs a full
+// search): a constant of the pipeline, so that without it the measurement is compiled out.
+override MEASURE_PENUMBRA_ERROR: bool = false;
 
 @group(2) @binding(4) var horizontal_blocker: texture_2d<f32>;
 @group(2) @binding(5) var blur_source: texture_2d<f32>;
@@ -18,7 +23,7 @@ var<private> penumbra_error_value: f32 = -1.0;
 
 // Writes the pixel's penumbra error, when measured.
 fn store_penumbra_error(texel: vec2<i32>) {
-    if (settings.penumbra_error != 0u) {
+    if (MEASURE_PENUMBRA_ERROR) {
         textureStore(penumbra_error, texel, vec4<f32>(penumbra_error_value));
     }
 }
@@ -118,7 +123,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
             }
         }
     }
-    if (settings.penumbra_error != 0u) {
+    if (MEASURE_PENUMBRA_ERROR) {
         // Table 5: the error the reuse (α) brings into the penumbra estimate.
         let full = full_blocker_search(uvd, search, receiver, n);
         if (full.y > 0.0 || count > 0.0) {
@@ -156,24 +161,39 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
     let radii = searched.yz;
     let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
+    let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(radii.x, 0.0));
     var blurred = 0.0;
     var total = 0.0;
+    // The taps on the screen are a run of consecutive taps (the tap's x grows with its index).
+    var first_on_screen = m;
+    var last_on_screen = -1;
     for (var j = 0u; j < m; j++) {
-        let tap = centre + vec2<f32>(grid_offset(j, m) * radii.x, 0.0);
-        var value: f32;
-        var weight = tap_weight(j);
+        let offset = grid_offset(j, m);
+        let tap = vec2<f32>(centre.x + offset * radii.x, centre.y);
         if (on_screen(tap)) {
             let source = horizontal_source(vec2<i32>(tap));
-            value = source.value;
+            var weight = tap_weight(j);
             if (settings.bilateral_depth > 0.0) {
-                weight *= bilateral_weight_of(source, tangent_plane_distance(rays, point.position, point.normal, tap), point.normal);
+                weight *= bilateral_weight_of(source, tap_line_distance(line, offset), point.normal);
             }
-        } else {
-            // Past the screen's edge: shadow-test the point of this pixel's tangent plane seen there.
-            let plane = tangent_plane_point(rays, point.position, point.normal, tap);
-            value = select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
+            blurred += weight * source.value;
+            total += weight;
+            first_on_screen = min(first_on_screen, j);
+            last_on_screen = i32(j);
         }
-        blurred += weight * value;
+    }
+    // The taps past the screen's edges (those before the run and after it; none for most pixels):
+    // the shadow test of the point of this pixel's tangent plane seen there. In a loop of their own
+    // so that the loop above does not carry this code for every tap: a SIMD processor (lavapipe's
+    // vectors, a GPU's warps) executes a branch's code for all its lanes when any lane takes it.
+    let before = first_on_screen;
+    let after = select(m - 1u - u32(last_on_screen), 0u, last_on_screen < 0);
+    for (var k = 0u; k < before + after; k++) {
+        let j = select(k, u32(last_on_screen + 1) + (k - before), k >= before);
+        let tap = vec2<f32>(centre.x + grid_offset(j, m) * radii.x, centre.y);
+        let plane = tangent_plane_point(rays, point.position, point.normal, tap);
+        let weight = tap_weight(j);
+        blurred += weight * select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
         total += weight;
     }
     // Every tap on other surfaces (an even m has no centre tap): keep the hard value.

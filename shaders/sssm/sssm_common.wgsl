@@ -11,8 +11,6 @@ struct SssmSettings {
     blur_kernel: u32,
     // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
     receiver_plane: u32,
-    // 1: count each computed pixel's texture reads into read_counts (profiling; atomics cost time).
-    count_reads: u32,
     // Reuse thresholds as fractions of the scene's diagonal (scene_length): light-depth
     // difference (α) and normal-adjusted camera-depth difference (β).
     alpha: f32,
@@ -21,12 +19,7 @@ struct SssmSettings {
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    // 1: step 2 also searches every blocker row (no reuse) and writes the squared difference of the
-    // two penumbra widths, in shadow-map texels², to penumbra_error (Table 5; costs a full search).
-    penumbra_error: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
     // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
     // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
     // exponential per tap.
@@ -43,7 +36,7 @@ struct SssmSettings {
 // Texture reads of this invocation so far (G-buffer, shadow map, the passes' own targets).
 var<private> reads: u32;
 
-// Adds this pixel and its reads to pass `pass_index`'s counts, when counting.
+// Adds this pixel and its reads to pass `pass_index`'s counts, when counting (COUNT_READS).
 fn record_reads(pass_index: u32, texel: vec2<i32>) {
     record_reads_of(pass_index, texel, 1u);
 }
@@ -51,7 +44,7 @@ fn record_reads(pass_index: u32, texel: vec2<i32>) {
 // Adds `pixels` (0 or 1) and this invocation's reads to pass `pass_index`'s counts, when counting:
 // 0 for an invocation that only loaded its share of a workgroup's shared row.
 fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
-    if (settings.count_reads != 0u && (pixels != 0u || reads != 0u)) {
+    if (COUNT_READS && (pixels != 0u || reads != 0u)) {
         let word = read_count_word(pass_index, texel);
         atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
@@ -112,6 +105,36 @@ fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pi
 fn tangent_plane_distance(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
     let hit = tangent_plane_hit(rays, point, normal, pixel);
     return select(-1.0, hit.w * length(hit.xyz), hit.w > 0.0);
+}
+
+// The camera rays of a line of blur taps through pixel position `centre`, tap k at centre +
+// offset_k · `step` (a separable pass's row or column), and where each meets the tangent plane
+// through `point` with normal `normal`. The ray and its dot with the normal are linear in the
+// offset, so a tap costs a few multiply-adds, a division and a square root instead of building its
+// ray and intersecting the plane anew.
+struct TapLine {
+    centre_ray: vec3<f32>,
+    ray_step: vec3<f32>,
+    centre_denominator: f32,
+    denominator_step: f32,
+    // (point - eye) · normal.
+    plane_offset: f32,
+};
+
+fn tap_line(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, centre: vec2<f32>, step: vec2<f32>) -> TapLine {
+    let centre_ray = rays.base + centre.x * rays.per_x + centre.y * rays.per_y;
+    let ray_step = step.x * rays.per_x + step.y * rays.per_y;
+    return TapLine(centre_ray, ray_step, dot(centre_ray, normal), dot(ray_step, normal), dot(point - camera.position.xyz, normal));
+}
+
+// tangent_plane_distance of the tap at `offset` along `line`: the eye's distance to the plane
+// along that tap's ray; -1 where the ray runs along the plane or meets it behind the eye.
+fn tap_line_distance(line: TapLine, offset: f32) -> f32 {
+    let direction = line.centre_ray + offset * line.ray_step;
+    let denominator = line.centre_denominator + offset * line.denominator_step;
+    // Selected rather than branched: a division by a vanishing denominator is discarded.
+    let t = line.plane_offset / denominator;
+    return select(-1.0, t * length(direction), abs(denominator) >= 1e-12 && t > 0.0);
 }
 
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).

@@ -46,12 +46,14 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     var reused = 0.0;
     // Rows failing the β test, recomputed after the reused ones.
     var failed_rows = FailedRows();
+    let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(0.0, radii.y));
     for (var j = 0u; j < m; j++) {
-        let row = centre + vec2<f32>(0.0, grid_offset(j, m) * radii.y);
+        let offset = grid_offset(j, m);
+        let row = centre + vec2<f32>(0.0, offset * radii.y);
         var reuse = false;
         if (on_screen(row)) {
             let source = vertical_source(vec2<i32>(row));
-            let expected = tangent_plane_distance(rays, point.position, point.normal, row);
+            let expected = tap_line_distance(line, offset);
             if (within_beta(source, expected)) {
                 let weight = tap_weight(j) * bilateral_weight_of(source, expected, point.normal);
                 blurred += weight * source.value;

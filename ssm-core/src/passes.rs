@@ -67,6 +67,22 @@ pub fn fullscreen_pipeline(
     bind_group_layouts: &[&wgpu::BindGroupLayout],
     target: wgpu::ColorTargetState,
 ) -> wgpu::RenderPipeline {
+    fullscreen_pipeline_specialised(device, label, module, fragment, bind_group_layouts, target, &[])
+}
+
+/// [`fullscreen_pipeline`] with values for the fragment stage's pipeline-overridable constants
+/// (WGSL `override`, by name): code a setting switches off is then compiled out of the pipeline
+/// instead of skipped at run time, which a SIMD rasteriser (lavapipe) pays for anyway.
+#[must_use]
+pub fn fullscreen_pipeline_specialised(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fragment: &str,
+    bind_group_layouts: &[&wgpu::BindGroupLayout],
+    target: wgpu::ColorTargetState,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = bind_group_layouts.iter().copied().map(Some).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(&format!("{label}_layout")),
@@ -83,7 +99,7 @@ pub fn fullscreen_pipeline(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(fragment),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             targets: &[Some(target)],
         }),
         multiview_mask: None,
@@ -111,6 +127,20 @@ pub fn compute_pipeline(
     entry: &str,
     bind_group_layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_specialised(device, label, module, entry, bind_group_layouts, &[])
+}
+
+/// [`compute_pipeline`] with values for its pipeline-overridable constants (WGSL `override`, by
+/// name; see [`fullscreen_pipeline_specialised`]).
+#[must_use]
+pub fn compute_pipeline_specialised(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    bind_group_layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = bind_group_layouts.iter().copied().map(Some).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(&format!("{label}_layout")),
@@ -122,7 +152,7 @@ pub fn compute_pipeline(
         layout: Some(&layout),
         module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
         cache: None,
     })
 }

@@ -6,8 +6,10 @@
 //! profiles; each invocation that does the pass's work adds 1 to its pass's
 //! pixel count and the number of textures it read to its read count
 //! (`atomicAdd`, which costs time: techniques count only when their
-//! `count_reads` parameter asks). Each pass's counts are spread over
-//! [`READ_COUNT_BUCKETS`] pairs, chosen by pixel, so that a 32-bit read count
+//! `count_reads` parameter asks, and build their pipelines with
+//! [`ReadCounts::pipeline_constants`], so that otherwise the counting code is
+//! compiled out). Each pass's counts are spread over [`READ_COUNT_BUCKETS`]
+//! pairs, chosen by pixel, so that a 32-bit read count
 //! holds a 4K frame's 2,522 reads per pixel and the atomics contend less.
 //! Cleared at the first light of each frame, so the figures cover one
 //! frame's lights.
@@ -37,6 +39,13 @@ impl ReadCounts {
     pub fn new(device: &wgpu::Device, label: &str, passes: &'static [&'static str], enabled: bool) -> Self {
         let buffer = crate::passes::storage_buffer(device, label, (passes.len().max(1) * READ_COUNT_BUCKETS * 8) as u64);
         Self { buffer, passes, enabled }
+    }
+
+    /// The pipeline-overridable constant that switches the shaders' counting on or off
+    /// (`COUNT_READS` of `common/read_counts.wgsl`): off, the counting code is compiled out.
+    #[must_use]
+    pub fn pipeline_constants(&self) -> [(&'static str, f64); 1] {
+        [("COUNT_READS", f64::from(u8::from(self.enabled)))]
     }
 
     /// The buffer, to bind as `array<atomic<u32>>`.

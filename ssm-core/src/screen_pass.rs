@@ -4,7 +4,7 @@
 
 use crate::error::Result;
 use crate::frame::Frame;
-use crate::passes::{color_attachment, fullscreen_pipeline};
+use crate::passes::{color_attachment, fullscreen_pipeline_specialised};
 use crate::technique::TechniqueSetup;
 
 /// A full-screen pass with the binding convention of
@@ -34,10 +34,28 @@ impl ScreenPass {
         own_layout: Option<&wgpu::BindGroupLayout>,
         target: wgpu::ColorTargetState,
     ) -> Result<Self> {
+        Self::specialised(setup, technique, label, (module, fragment), own_layout, target, &[])
+    }
+
+    /// As [`ScreenPass::new`], with values for the fragment stage's pipeline-overridable
+    /// constants (WGSL `override`, by name; [`fullscreen_pipeline_specialised`]).
+    ///
+    /// # Errors
+    /// As [`ScreenPass::new`].
+    pub fn specialised(
+        setup: &TechniqueSetup<'_>,
+        technique: &str,
+        label: &str,
+        (module, fragment): (&wgpu::ShaderModule, &str),
+        own_layout: Option<&wgpu::BindGroupLayout>,
+        target: wgpu::ColorTargetState,
+        constants: &[(&str, f64)],
+    ) -> Result<Self> {
         let gbuffer = setup.shared.gbuffer(technique)?;
         let mut layouts = vec![&setup.scene.uniform_layout, &gbuffer.layout];
         layouts.extend(own_layout);
-        let pipeline = fullscreen_pipeline(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target);
+        let pipeline =
+            fullscreen_pipeline_specialised(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target, constants);
         Ok(Self { label: label.to_owned(), pipeline, gbuffer_bind_group: gbuffer.bind_group.clone() })
     }
 

@@ -11,8 +11,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, compute_pipeline, storage_buffer, storage_entry, texture_entry, uniform_buffer, uniform_entry,
-    visibility_storage_entry,
+    bind_group, bind_group_layout, compute_pipeline_specialised, storage_buffer, storage_entry, texture_entry, uniform_buffer,
+    uniform_entry, visibility_storage_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
@@ -83,10 +83,6 @@ pub struct PcssSettingsUniform {
     pcf_kernel: u32,
     receiver_plane: u32,
     normal_offset: f32,
-    count_reads: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 impl From<&PcssSettings> for PcssSettingsUniform {
@@ -96,10 +92,6 @@ impl From<&PcssSettings> for PcssSettingsUniform {
             pcf_kernel: settings.pcf_kernel,
             receiver_plane: u32::from(settings.receiver.receiver_plane),
             normal_offset: settings.bias.normal_offset,
-            count_reads: u32::from(settings.count_reads),
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
         }
     }
 }
@@ -153,32 +145,34 @@ impl Pcss {
         let search_and_filter = match settings.tap_source {
             TapSource::Texture => {
                 let module = create_shader_with_imports(setup.gpu, "pcss_filter_shader", SHADER, LOCAL_SHADERS)?;
-                SearchAndFilter::Fragment(ScreenPass::new(
+                SearchAndFilter::Fragment(ScreenPass::specialised(
                     setup,
                     NAME,
                     PASS,
                     (&module, "pcss_filter"),
                     Some(&map_layout),
                     VISIBILITY_FORMAT.into(),
+                    &read_counts.pipeline_constants(),
                 )?)
             }
-            TapSource::WorkgroupTile => Self::tiled(setup, &map_layout)?,
+            TapSource::WorkgroupTile => Self::tiled(setup, &map_layout, &read_counts)?,
         };
         Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, width: setup.scene.width, height: setup.scene.height })
     }
 
     /// The compute pass of [`TapSource::WorkgroupTile`].
-    fn tiled(setup: &TechniqueSetup<'_>, map_layout: &wgpu::BindGroupLayout) -> Result<SearchAndFilter> {
+    fn tiled(setup: &TechniqueSetup<'_>, map_layout: &wgpu::BindGroupLayout, read_counts: &ReadCounts) -> Result<SearchAndFilter> {
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let module = create_shader_with_imports(setup.gpu, "pcss_filter_tiled_shader", TILED_SHADER, LOCAL_SHADERS)?;
         let output_layout = bind_group_layout(device, "pcss_tiled_output_layout", &[visibility_storage_entry(0), storage_entry(1, false)]);
-        let pipeline = compute_pipeline(
+        let pipeline = compute_pipeline_specialised(
             device,
             "pcss_filter_tiled_pipeline",
             &module,
             "pcss_filter_tiled",
             &[&setup.scene.uniform_layout, &gbuffer.layout, map_layout, &output_layout],
+            &read_counts.pipeline_constants(),
         );
         let tile_counts = storage_buffer(device, "pcss_tile_counts", 8);
         let output_groups = setup

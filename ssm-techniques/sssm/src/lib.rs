@@ -12,8 +12,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
-    write_storage_texture_entry,
+    bind_group, bind_group_layout, compute_pipeline_specialised, labelled_view, render_texture, texture_entry, uniform_buffer,
+    uniform_entry, write_storage_texture_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
@@ -120,15 +120,11 @@ pub struct SssmSettingsUniform {
     blocker_kernel: u32,
     blur_kernel: u32,
     receiver_plane: u32,
-    count_reads: u32,
     alpha: f32,
     beta: f32,
     normal_offset: f32,
     bilateral_depth: f32,
-    penumbra_error: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
     blur_weights: [[f32; 4]; 32],
 }
 
@@ -157,15 +153,11 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             blocker_kernel: settings.blocker_kernel,
             blur_kernel: settings.blur_kernel,
             receiver_plane: u32::from(settings.receiver.receiver_plane),
-            count_reads: u32::from(settings.count_reads),
             alpha: settings.alpha,
             beta: settings.beta,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
-            penumbra_error: u32::from(settings.penumbra_error),
             _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
             blur_weights: blur_weights(settings),
         }
     }
@@ -268,8 +260,14 @@ impl SeparableSoftShadowMaps {
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
         let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES, settings.count_reads);
-        let shared =
-            Shared { setup, settings: &settings_buffer, depth_map: &depth_map, read_counts: read_counts.buffer(), targets: &targets };
+        let shared = Shared {
+            setup,
+            settings: &settings_buffer,
+            depth_map: &depth_map,
+            read_counts: &read_counts,
+            measure_penumbra_error: settings.penumbra_error,
+            targets: &targets,
+        };
         let horizontal_blocker_layout =
             shared.layout("sssm_horizontal_blocker_layout", &[write_storage_texture_entry(4, wgpu::TextureFormat::Rgba32Float)]);
         let horizontal_blocker_group = shared.group(
@@ -277,13 +275,14 @@ impl SeparableSoftShadowMaps {
             &horizontal_blocker_layout,
             &[wgpu::BindingResource::TextureView(&targets.blur_source)],
         );
-        let horizontal_blocker = ScreenPass::new(
+        let horizontal_blocker = ScreenPass::specialised(
             setup,
             NAME,
             "sssm_horizontal_blocker",
             (&shared.module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
             Some(&horizontal_blocker_layout),
             wgpu::TextureFormat::Rgba32Float.into(),
+            &read_counts.pipeline_constants(),
         )?;
         let blur_steps = match settings.blur_passes {
             BlurPasses::Fragment => shared.fragment_steps()?,
@@ -317,18 +316,26 @@ impl SeparableSoftShadowMaps {
 }
 
 /// What the three passes' bind groups share (binding 0 camera, 1 settings, 2 depth map, 3 read
-/// counts), and the builders of steps 2 and 3.
+/// counts) and their pipelines' constants, and the builders of steps 2 and 3.
 struct Shared<'a> {
     setup: &'a TechniqueSetup<'a>,
     settings: &'a wgpu::Buffer,
     depth_map: &'a LightDepthMap,
-    read_counts: &'a wgpu::Buffer,
+    read_counts: &'a ReadCounts,
+    /// The settings' `penumbra_error` (step 2's `MEASURE_PENUMBRA_ERROR`).
+    measure_penumbra_error: bool,
     targets: &'a Targets,
 }
 
 impl Shared<'_> {
     fn module(&self, label: &str, source: &str) -> Result<wgpu::ShaderModule> {
         create_shader_with_imports(self.setup.gpu, label, source, LOCAL_SHADERS)
+    }
+
+    /// Step 2's pipeline constants: whether it counts reads and measures the penumbra error.
+    fn blocker_blur_constants(&self) -> [(&'static str, f64); 2] {
+        let [count_reads] = self.read_counts.pipeline_constants();
+        [count_reads, ("MEASURE_PENUMBRA_ERROR", f64::from(u8::from(self.measure_penumbra_error)))]
     }
 
     /// A layout of the shared entries and `extra`.
@@ -344,7 +351,7 @@ impl Shared<'_> {
             self.setup.scene.camera_buffer.as_entire_binding(),
             self.settings.as_entire_binding(),
             wgpu::BindingResource::TextureView(&self.depth_map.linear_depth_view),
-            self.read_counts.as_entire_binding(),
+            self.read_counts.buffer().as_entire_binding(),
         ];
         resources.extend_from_slice(extra);
         bind_group(&self.setup.gpu.device, label, layout, &resources)
@@ -390,21 +397,23 @@ impl Shared<'_> {
             ),
             self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
         ];
-        let blocker_blur = ScreenPass::new(
+        let blocker_blur = ScreenPass::specialised(
             self.setup,
             NAME,
             "sssm_blocker_and_horizontal_blur",
             (&self.module("sssm_blocker_blur_fragment_shader", BLOCKER_BLUR_FRAGMENT_SHADER)?, "sssm_blocker_blur"),
             Some(&blocker_blur_layout),
             wgpu::TextureFormat::Rgba32Float.into(),
+            &self.blocker_blur_constants(),
         )?;
-        let vertical_blur = ScreenPass::new(
+        let vertical_blur = ScreenPass::specialised(
             self.setup,
             NAME,
             "sssm_vertical_blur",
             (&self.module("sssm_vertical_blur_fragment_shader", VERTICAL_BLUR_FRAGMENT_SHADER)?, "sssm_vertical_blur"),
             Some(&vertical_blur_layout),
             VISIBILITY_FORMAT.into(),
+            &self.read_counts.pipeline_constants(),
         )?;
         Ok(BlurSteps::Fragment { blocker_blur, vertical_blur, groups })
     }
@@ -447,19 +456,21 @@ impl Shared<'_> {
                 self.group(&format!("sssm_vertical_blur_columns_bind_group_{light}"), &vertical_blur_layout, &resources)
             })
             .collect();
-        let blocker_blur = compute_pipeline(
+        let blocker_blur = compute_pipeline_specialised(
             device,
             "sssm_blocker_blur_rows_pipeline",
             &self.module("sssm_blocker_blur_compute_shader", BLOCKER_BLUR_COMPUTE_SHADER)?,
             "sssm_blocker_blur_rows",
             &[&setup.scene.uniform_layout, &gbuffer.layout, &blocker_blur_layout],
+            &self.blocker_blur_constants(),
         );
-        let vertical_blur = compute_pipeline(
+        let vertical_blur = compute_pipeline_specialised(
             device,
             "sssm_vertical_blur_columns_pipeline",
             &self.module("sssm_vertical_blur_compute_shader", VERTICAL_BLUR_COMPUTE_SHADER)?,
             "sssm_vertical_blur_columns",
             &[&setup.scene.uniform_layout, &gbuffer.layout, &vertical_blur_layout],
+            &self.read_counts.pipeline_constants(),
         );
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {

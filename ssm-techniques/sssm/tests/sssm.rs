@@ -358,3 +358,41 @@ fn the_penumbra_error_reuse_brings_in_is_zero_without_reuse_and_grows_with_alpha
     // Off by default: no diagnostic, no full search.
     assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| k != "sssm_penumbra_mse_texels2"));
 }
+
+/// The screen-space blurs see past the screen's edges: with the vertical field of view fixed, an
+/// image is the central columns of one twice as wide, and SSSM's must be too, where its blurs
+/// reach beyond the narrow image's left and right edges. There, the narrow image's taps are
+/// shadow tests of the pixel's tangent plane (the horizontal pass's fallback), the wide image's
+/// the hard values of the same ground's pixels: they agree up to where in its pixel a tap lands.
+/// Top-down parallel-square, cut so that the occluder lies inside the narrow image and its
+/// penumbra crosses both edges; dropping the taps past an edge, or keeping the pixel's own value
+/// there, leaves the edge columns far from the wide image's.
+#[test]
+fn the_blur_past_the_screen_edges_gives_the_pixels_of_a_wider_screen() {
+    let scene = top_down_parallel_square();
+    let gpu = gpu();
+    let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05")];
+    let (width, height) = (32u32, 64u32);
+    let narrow = render(&gpu, &scene, &ssm_sssm::INFO, &settings, width, height).unwrap();
+    let wide = render(&gpu, &scene, &ssm_sssm::INFO, &settings, 2 * width, height).unwrap();
+    let cropped: Vec<f32> = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (y, x)))
+        .map(|(y, x)| wide.visibility[(y * 2 * width + x + width / 2) as usize])
+        .collect();
+    // The four columns at each edge, over the rows the penumbra crosses.
+    let edge: Vec<bool> = (0..height * width)
+        .map(|i| {
+            let x = i % width;
+            (x < 4 || x >= width - 4) && cropped[i as usize] > 0.02 && cropped[i as usize] < 0.98
+        })
+        .collect();
+    let count = edge.iter().filter(|e| **e).count();
+    let edge_difference = mean_abs_difference(&narrow.visibility, &cropped, &edge);
+    let everywhere = mean_abs_difference(&narrow.visibility, &cropped, &vec![true; (width * height) as usize]);
+    println!(
+        "narrow against the wide image's centre: mean |difference| {edge_difference:.4} over {count} penumbra pixels at the edges, {everywhere:.4} over all"
+    );
+    assert!(count > 100, "the penumbra must cross the narrow image's edges: {count} pixels");
+    assert!(edge_difference < 0.02, "{edge_difference}");
+    assert!(everywhere < 0.01, "{everywhere}");
+}
