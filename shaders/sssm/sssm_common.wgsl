@@ -168,23 +168,30 @@ fn tap_weight(i: u32) -> f32 {
 // every row any of them failed, which with a tenth of the rows failing and 32 lanes would be nearly
 // all of them.
 struct FailedRows {
-    words: array<u32, 4>,
+    words: vec4<u32>,
 };
 
+// The four words' indices, to pick one by comparison: selects instead of a dynamically indexed
+// array or a loop over the words, whose every iteration a SIMD rasteriser runs for all its lanes.
+const WORD_INDICES: vec4<u32> = vec4<u32>(0u, 1u, 2u, 3u);
+
 fn mark_failed_row(failed: ptr<function, FailedRows>, row: u32) {
-    (*failed).words[row / 32u] |= 1u << (row % 32u);
+    (*failed).words |= select(vec4<u32>(0u), vec4<u32>(1u << (row % 32u)), WORD_INDICES == vec4<u32>(row / 32u));
 }
 
 // Removes and returns the lowest marked row; -1 when none is left.
 fn pop_failed_row(failed: ptr<function, FailedRows>) -> i32 {
-    for (var word = 0u; word < 4u; word++) {
-        let bits = (*failed).words[word];
-        if (bits != 0u) {
-            (*failed).words[word] = bits & (bits - 1u);
-            return i32(word * 32u + firstTrailingBit(bits));
-        }
-    }
-    return -1;
+    let words = (*failed).words;
+    // The first word with a bit left (4: none).
+    var word = 4u;
+    word = select(word, 3u, words.w != 0u);
+    word = select(word, 2u, words.z != 0u);
+    word = select(word, 1u, words.y != 0u);
+    word = select(word, 0u, words.x != 0u);
+    let picked = WORD_INDICES == vec4<u32>(word);
+    let bits = dot(select(vec4<u32>(0u), words, picked), vec4<u32>(1u));
+    (*failed).words = select(words, vec4<u32>(bits & (bits - 1u)), picked);
+    return select(-1, i32(word * 32u + firstTrailingBit(bits)), word < 4u);
 }
 
 // Whether a pixel position lies on the screen.
