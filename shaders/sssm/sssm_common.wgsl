@@ -19,7 +19,8 @@ struct SssmSettings {
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    _pad0: u32,
+    // The sum of the blur_kernel tap weights below.
+    blur_weight_total: f32,
     // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
     // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
     // exponential per tap.

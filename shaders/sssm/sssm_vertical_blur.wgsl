@@ -108,26 +108,26 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
     // The plane point's own light depth times den (the one-sided emitter's test, without the offset).
     let first_front = eye_light.z * first_den + plane_offset * first_ray_light.z;
     let front_step = eye_light.z * den_step + plane_offset * ray_step_light.z;
+    let half_inverse_projection = 0.5 / frame.projection.xy;
     var row_sum = 0.0;
-    var row_total = 0.0;
+    // Selects rather than branches, and products rather than quotients where a sign decides: a
+    // tap costs one division (its light depth's reciprocal) and the same few instructions in
+    // every lane.
     for (var i = 0u; i < m; i++) {
         let index = f32(i);
         let den = first_den + index * den_step;
-        var visible = own_hard;
         // The ray meets the plane in front of the eye (tangent_plane_point's w).
-        if (abs(den) >= 1e-12 && plane_offset * den > 0.0) {
-            visible = 0.0;
-            // In front of the light's plane (tap_visibility's first test).
-            if ((first_front + index * front_step) * den > 0.0) {
-                let h = first_h + index * h_step;
-                let uv = 0.5 + 0.5 * h.xy / (h.z * frame.projection.xy);
-                reads += 1u;
-                visible = select(0.0, 1.0, h.z / den <= shadow_map_depth(shadow_map, uv));
-            }
-        }
-        let weight = tap_weight(i);
-        row_sum += weight * visible;
-        row_total += weight;
+        let meets_plane = abs(den) >= 1e-12 && plane_offset * den > 0.0;
+        // In front of the light's plane (tap_visibility's first test).
+        let in_front = (first_front + index * front_step) * den > 0.0;
+        let h = first_h + index * h_step;
+        let uv = 0.5 + h.xy * (half_inverse_projection / h.z);
+        reads += 1u;
+        // h.z / den <= the map's depth, with den's sign.
+        let map_depth = shadow_map_depth(shadow_map, uv) * den;
+        let lit = select(h.z >= map_depth, h.z <= map_depth, den > 0.0);
+        let visible = select(own_hard, select(0.0, select(0.0, 1.0, lit), in_front), meets_plane);
+        row_sum += tap_weight(i) * visible;
     }
-    return row_sum / row_total;
+    return row_sum / settings.blur_weight_total;
 }

@@ -124,7 +124,7 @@ pub struct SssmSettingsUniform {
     beta: f32,
     normal_offset: f32,
     bilateral_depth: f32,
-    _pad0: u32,
+    blur_weight_total: f32,
     blur_weights: [[f32; 4]; 32],
 }
 
@@ -157,7 +157,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             beta: settings.beta,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
-            _pad0: 0,
+            blur_weight_total: blur_weights(settings).iter().flatten().sum(),
             blur_weights: blur_weights(settings),
         }
     }
