@@ -177,7 +177,13 @@ struct FailedRows {
 const WORD_INDICES: vec4<u32> = vec4<u32>(0u, 1u, 2u, 3u);
 
 fn mark_failed_row(failed: ptr<function, FailedRows>, row: u32) {
-    (*failed).words |= select(vec4<u32>(0u), vec4<u32>(1u << (row % 32u)), WORD_INDICES == vec4<u32>(row / 32u));
+    mark_failed_row_if(failed, row, true);
+}
+
+// mark_failed_row where `failed_test` holds, without a branch.
+fn mark_failed_row_if(failed: ptr<function, FailedRows>, row: u32, failed_test: bool) {
+    let bit = select(0u, 1u << (row % 32u), failed_test);
+    (*failed).words |= select(vec4<u32>(0u), vec4<u32>(bit), WORD_INDICES == vec4<u32>(row / 32u));
 }
 
 // Removes and returns the lowest marked row; -1 when none is left.
@@ -302,19 +308,15 @@ fn unpack_blur_source(value: f32, packed: vec4<f32>) -> BlurSource {
 // test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
 // not leak over edges.
 fn bilateral_weight_of(source: BlurSource, expected_distance: f32, normal: vec3<f32>) -> f32 {
-    if (settings.bilateral_depth <= 0.0) {
-        return 1.0;
-    }
-    if (source.eye_distance < 0.0 || expected_distance < 0.0) {
-        return 0.0;
-    }
     let gap = (source.eye_distance - expected_distance) / scene_length(frame, settings.bilateral_depth);
     let turn = max(dot(normal, source.normal), 0.0);
     // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
     // falls to 1/2 at about 23°.
     let turn_2 = turn * turn;
     let turn_4 = turn_2 * turn_2;
-    return exp(-gap * gap) * turn_4 * turn_4;
+    let weight = select(exp(-gap * gap) * turn_4 * turn_4, 0.0, source.eye_distance < 0.0 || expected_distance < 0.0);
+    // Selected rather than branched (a division by a zero tolerance is discarded).
+    return select(weight, 1.0, settings.bilateral_depth <= 0.0);
 }
 
 // Whether the tap pixel seen as `source` lies within β of this pixel's tangent plane along its ray

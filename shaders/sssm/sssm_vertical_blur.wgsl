@@ -47,24 +47,20 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // Rows failing the β test, recomputed after the reused ones.
     var failed_rows = FailedRows();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(0.0, radii.y));
+    // Selects rather than branches: every lane of a SIMD vector runs every tap anyway. A row off
+    // the screen reads the nearest on-screen texel, whose value it does not use.
+    let last_texel = vec2<i32>(camera.viewport.xy) - 1;
     for (var j = 0u; j < m; j++) {
         let offset = grid_offset(j, m);
         let row = centre + vec2<f32>(0.0, offset * radii.y);
-        var reuse = false;
-        if (on_screen(row)) {
-            let source = vertical_source(vec2<i32>(row));
-            let expected = tap_line_distance(line, offset);
-            if (within_beta(source, expected)) {
-                let weight = tap_weight(j) * bilateral_weight_of(source, expected, point.normal);
-                blurred += weight * source.value;
-                total += weight;
-                reused += 1.0;
-                reuse = true;
-            }
-        }
-        if (!reuse) {
-            mark_failed_row(&failed_rows, j);
-        }
+        let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), last_texel));
+        let expected = tap_line_distance(line, offset);
+        let reuse = on_screen(row) && within_beta(source, expected);
+        let weight = select(0.0, tap_weight(j) * bilateral_weight_of(source, expected, point.normal), reuse);
+        blurred += weight * source.value;
+        total += weight;
+        reused += select(0.0, 1.0, reuse);
+        mark_failed_row_if(&failed_rows, j, !reuse);
     }
     loop {
         let failed = pop_failed_row(&failed_rows);

@@ -361,40 +361,56 @@ fn the_penumbra_error_reuse_brings_in_is_zero_without_reuse_and_grows_with_alpha
     assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| k != "sssm_penumbra_mse_texels2"));
 }
 
-/// The screen-space blurs see past the screen's edges: with the vertical field of view fixed, an
-/// image is the central columns of one twice as wide, and SSSM's must be too, where its blurs
-/// reach beyond the narrow image's left and right edges. There, the narrow image's taps are
-/// shadow tests of the pixel's tangent plane (the horizontal pass's fallback), the wide image's
-/// the hard values of the same ground's pixels: they agree up to where in its pixel a tap lands.
-/// Top-down parallel-square, cut so that the occluder lies inside the narrow image and its
-/// penumbra crosses both edges; dropping the taps past an edge, or keeping the pixel's own value
-/// there, leaves the edge columns far from the wide image's.
-#[test]
-fn the_blur_past_the_screen_edges_gives_the_pixels_of_a_wider_screen() {
-    let scene = top_down_parallel_square();
+/// Mean |SSSM's `small` image − the same pixels of `large`| over the penumbra pixels within four
+/// pixels of `small`'s edges along the axis it is cut (`along_x`: left and right; else top and
+/// bottom), `large` being `small` widened on both sides of that axis by half `small`'s size,
+/// with the same pixel size; and the number of those pixels.
+fn edge_difference(small: (&Scene, u32, u32), large: &Scene, along_x: bool) -> (f32, usize) {
     let gpu = gpu();
     let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05")];
-    let (width, height) = (32u32, 64u32);
-    let narrow = render(&gpu, &scene, &ssm_sssm::INFO, &settings, width, height).unwrap();
-    let wide = render(&gpu, &scene, &ssm_sssm::INFO, &settings, 2 * width, height).unwrap();
+    let (scene, width, height) = small;
+    let (large_width, large_height) = if along_x { (2 * width, height) } else { (width, 2 * height) };
+    let narrow = render(&gpu, scene, &ssm_sssm::INFO, &settings, width, height).unwrap();
+    let wide = render(&gpu, large, &ssm_sssm::INFO, &settings, large_width, large_height).unwrap();
+    let (dx, dy) = if along_x { (width / 2, 0) } else { (0, height / 2) };
     let cropped: Vec<f32> = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (y, x)))
-        .map(|(y, x)| wide.visibility[(y * 2 * width + x + width / 2) as usize])
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| wide.visibility[((y + dy) * large_width + x + dx) as usize])
         .collect();
-    // The four columns at each edge, over the rows the penumbra crosses.
     let edge: Vec<bool> = (0..height * width)
         .map(|i| {
-            let x = i % width;
-            (x < 4 || x >= width - 4) && cropped[i as usize] > 0.02 && cropped[i as usize] < 0.98
+            let (x, y) = (i % width, i / width);
+            let near_edge = if along_x { x < 4 || x >= width - 4 } else { y < 4 || y >= height - 4 };
+            near_edge && cropped[i as usize] > 0.02 && cropped[i as usize] < 0.98
         })
         .collect();
-    let count = edge.iter().filter(|e| **e).count();
-    let edge_difference = mean_abs_difference(&narrow.visibility, &cropped, &edge);
-    let everywhere = mean_abs_difference(&narrow.visibility, &cropped, &vec![true; (width * height) as usize]);
+    (mean_abs_difference(&narrow.visibility, &cropped, &edge), edge.iter().filter(|e| **e).count())
+}
+
+/// The screen-space blurs see past the screen's edges: an image is the middle of one that shows
+/// more of the scene at the same pixel size (twice as wide with the same vertical field of view,
+/// or twice as tall with the field of view whose tangent is twice as large), and SSSM's must be
+/// too where its blurs reach past the smaller image's edges. There, the smaller image's taps are
+/// shadow tests of the pixel's tangent plane (the horizontal pass's fallback, the vertical pass's
+/// recomputed rows), the larger image's the results of the same ground's pixels: they agree up to
+/// where in its pixel a tap lands. Top-down parallel-square, cut so that the occluder lies inside
+/// the smaller image and its penumbra crosses both edges. Dropping the taps past the right edge,
+/// keeping the pixel's own value there, or reusing the nearest row on the screen for the rows
+/// past the top and bottom, leaves the edge pixels far from the larger image's.
+#[test]
+fn the_blur_past_the_screen_edges_gives_the_pixels_of_a_larger_screen() {
+    let scene = top_down_parallel_square();
+    let (across, across_pixels) = edge_difference((&scene, 32, 64), &scene, true);
+    // A landscape image a third of the ground high, and the one twice as tall.
+    let mut short = scene.clone();
+    short.camera.fov_y = 2.0 * (1.1f32 / 6.0).atan();
+    let mut tall = short.clone();
+    tall.camera.fov_y = 2.0 * (2.0 * (short.camera.fov_y * 0.5).tan()).atan();
+    let (down, down_pixels) = edge_difference((&short, 64, 32), &tall, false);
     println!(
-        "narrow against the wide image's centre: mean |difference| {edge_difference:.4} over {count} penumbra pixels at the edges, {everywhere:.4} over all"
+        "smaller against the larger image's middle: mean |difference| {across:.4} over {across_pixels} penumbra pixels at the left and right edges, {down:.4} over {down_pixels} at the top and bottom"
     );
-    assert!(count > 100, "the penumbra must cross the narrow image's edges: {count} pixels");
-    assert!(edge_difference < 0.02, "{edge_difference}");
-    assert!(everywhere < 0.01, "{everywhere}");
+    assert!(across_pixels > 100 && down_pixels > 100, "the penumbra must cross the edges: {across_pixels}, {down_pixels} pixels");
+    assert!(across < 0.02, "left and right: {across}");
+    assert!(down < 0.02, "top and bottom: {down}");
 }
