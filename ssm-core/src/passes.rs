@@ -57,24 +57,12 @@ pub fn labelled_view(texture: &wgpu::Texture, label: &str) -> wgpu::TextureView 
 
 /// A full-screen pass pipeline: the shared full-screen triangle vertex stage
 /// (`common/fullscreen.wgsl`, imported by `module`) and the fragment entry
-/// point `fragment` writing one `target`.
+/// point `fragment` writing one `target`, with values for the fragment stage's
+/// pipeline-overridable constants (WGSL `override`, by name; `&[]` for none): code a
+/// setting switches off is then compiled out of the pipeline instead of skipped at run
+/// time, which a SIMD rasteriser (lavapipe) pays for anyway.
 #[must_use]
 pub fn fullscreen_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    fragment: &str,
-    bind_group_layouts: &[&wgpu::BindGroupLayout],
-    target: wgpu::ColorTargetState,
-) -> wgpu::RenderPipeline {
-    fullscreen_pipeline_specialised(device, label, module, fragment, bind_group_layouts, target, &[])
-}
-
-/// [`fullscreen_pipeline`] with values for the fragment stage's pipeline-overridable constants
-/// (WGSL `override`, by name): code a setting switches off is then compiled out of the pipeline
-/// instead of skipped at run time, which a SIMD rasteriser (lavapipe) pays for anyway.
-#[must_use]
-pub fn fullscreen_pipeline_specialised(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
@@ -118,22 +106,11 @@ pub fn color_attachment(view: &wgpu::TextureView, clear: Option<wgpu::Color>) ->
     })
 }
 
-/// A compute pipeline of entry point `entry` in `module` over `bind_group_layouts`.
+/// A compute pipeline of entry point `entry` in `module` over `bind_group_layouts`, with
+/// values for its pipeline-overridable constants (WGSL `override`, by name; `&[]` for none;
+/// see [`fullscreen_pipeline`]).
 #[must_use]
 pub fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    bind_group_layouts: &[&wgpu::BindGroupLayout],
-) -> wgpu::ComputePipeline {
-    compute_pipeline_specialised(device, label, module, entry, bind_group_layouts, &[])
-}
-
-/// [`compute_pipeline`] with values for its pipeline-overridable constants (WGSL `override`, by
-/// name; see [`fullscreen_pipeline_specialised`]).
-#[must_use]
-pub fn compute_pipeline_specialised(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,

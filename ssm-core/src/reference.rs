@@ -979,6 +979,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         (&module, "reference_upload"),
         Some(layout),
         crate::VISIBILITY_FORMAT.into(),
+        &[],
     )?;
     Ok(Box::new(ReferenceTechnique {
         truth: GroundTruth::new(setup.cpu_scene).with_traversal(

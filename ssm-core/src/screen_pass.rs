@@ -4,7 +4,7 @@
 
 use crate::error::Result;
 use crate::frame::Frame;
-use crate::passes::{color_attachment, fullscreen_pipeline_specialised};
+use crate::passes::{color_attachment, fullscreen_pipeline};
 use crate::technique::TechniqueSetup;
 
 /// A full-screen pass with the binding convention of
@@ -20,8 +20,10 @@ pub struct ScreenPass {
 
 impl ScreenPass {
     /// Builds the pipeline of fragment entry point `fragment` in `module`,
-    /// writing one `target`. `technique` names the caller in errors; `label`
-    /// names the pass and prefixes its GPU objects.
+    /// writing one `target`, with values for its pipeline-overridable constants
+    /// (WGSL `override`, by name; `&[]` for none; [`fullscreen_pipeline`]).
+    /// `technique` names the caller in errors; `label` names the pass and
+    /// prefixes its GPU objects.
     ///
     /// # Errors
     /// [`Error::UndeclaredRequirement`](crate::Error::UndeclaredRequirement) if
@@ -33,29 +35,12 @@ impl ScreenPass {
         (module, fragment): (&wgpu::ShaderModule, &str),
         own_layout: Option<&wgpu::BindGroupLayout>,
         target: wgpu::ColorTargetState,
-    ) -> Result<Self> {
-        Self::specialised(setup, technique, label, (module, fragment), own_layout, target, &[])
-    }
-
-    /// As [`ScreenPass::new`], with values for the fragment stage's pipeline-overridable
-    /// constants (WGSL `override`, by name; [`fullscreen_pipeline_specialised`]).
-    ///
-    /// # Errors
-    /// As [`ScreenPass::new`].
-    pub fn specialised(
-        setup: &TechniqueSetup<'_>,
-        technique: &str,
-        label: &str,
-        (module, fragment): (&wgpu::ShaderModule, &str),
-        own_layout: Option<&wgpu::BindGroupLayout>,
-        target: wgpu::ColorTargetState,
         constants: &[(&str, f64)],
     ) -> Result<Self> {
         let gbuffer = setup.shared.gbuffer(technique)?;
         let mut layouts = vec![&setup.scene.uniform_layout, &gbuffer.layout];
         layouts.extend(own_layout);
-        let pipeline =
-            fullscreen_pipeline_specialised(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target, constants);
+        let pipeline = fullscreen_pipeline(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target, constants);
         Ok(Self { label: label.to_owned(), pipeline, gbuffer_bind_group: gbuffer.bind_group.clone() })
     }
 

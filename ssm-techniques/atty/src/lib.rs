@@ -239,8 +239,8 @@ impl DepthPyramid {
             })
             .collect();
         let module = create_shader_with_imports(setup.gpu, &format!("{}_shader", kind.label), kind.shader, LOCAL_SHADERS)?;
-        let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout]);
-        let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout]);
+        let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout], &[]);
+        let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout], &[]);
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
             return Err(Error::Gpu { during: format!("building Atty's {label}"), messages });
@@ -438,6 +438,7 @@ impl SoftShadowMaps {
             &module,
             "atty_patches",
             &[setup.gpu.uniform_layout(), &Self::patches_layout(device)],
+            &[],
         );
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
@@ -516,7 +517,8 @@ impl SoftShadowMaps {
             ],
         );
         let module = create_shader_with_imports(setup.gpu, "atty_project_shader", PROJECT_SHADER, LOCAL_SHADERS)?;
-        let project = ScreenPass::new(setup, NAME, "atty_project", (&module, "atty_project"), Some(&layout), VISIBILITY_FORMAT.into())?;
+        let project =
+            ScreenPass::new(setup, NAME, "atty_project", (&module, "atty_project"), Some(&layout), VISIBILITY_FORMAT.into(), &[])?;
         Ok((project, group))
     }
 }

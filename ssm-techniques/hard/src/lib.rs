@@ -73,7 +73,8 @@ impl HardShadowMapping {
             &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), settings_buffer.as_entire_binding()],
         );
         let module = create_shader(setup.gpu, "hard_lookup_shader", SHADER)?;
-        let lookup = ScreenPass::new(setup, NAME, "hard_lookup", (&module, "hard_lookup"), Some(&map_layout), VISIBILITY_FORMAT.into())?;
+        let lookup =
+            ScreenPass::new(setup, NAME, "hard_lookup", (&module, "hard_lookup"), Some(&map_layout), VISIBILITY_FORMAT.into(), &[])?;
         Ok(Self { depth_map, lookup, map_bind_group })
     }
 }

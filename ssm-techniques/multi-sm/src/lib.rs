@@ -118,6 +118,7 @@ impl MultiShadowMaps {
             &module,
             "multi_sm_accumulate",
             &[setup.gpu.uniform_layout(), &gbuffer.layout, &own_layout],
+            &[],
         );
         Ok(Self {
             depth_map,

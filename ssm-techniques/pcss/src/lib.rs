@@ -11,8 +11,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, compute_pipeline_specialised, storage_buffer, storage_entry, texture_entry, uniform_buffer,
-    uniform_entry, visibility_storage_entry,
+    bind_group, bind_group_layout, compute_pipeline, storage_buffer, storage_entry, texture_entry, uniform_buffer, uniform_entry,
+    visibility_storage_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
@@ -145,7 +145,7 @@ impl Pcss {
         let search_and_filter = match settings.tap_source {
             TapSource::Texture => {
                 let module = create_shader_with_imports(setup.gpu, "pcss_filter_shader", SHADER, LOCAL_SHADERS)?;
-                SearchAndFilter::Fragment(ScreenPass::specialised(
+                SearchAndFilter::Fragment(ScreenPass::new(
                     setup,
                     NAME,
                     PASS,
@@ -166,7 +166,7 @@ impl Pcss {
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let module = create_shader_with_imports(setup.gpu, "pcss_filter_tiled_shader", TILED_SHADER, LOCAL_SHADERS)?;
         let output_layout = bind_group_layout(device, "pcss_tiled_output_layout", &[visibility_storage_entry(0), storage_entry(1, false)]);
-        let pipeline = compute_pipeline_specialised(
+        let pipeline = compute_pipeline(
             device,
             "pcss_filter_tiled_pipeline",
             &module,

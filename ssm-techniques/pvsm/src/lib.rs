@@ -839,21 +839,23 @@ impl Pipelines {
         let cull_module = module("pvsm_cull_shader", CULL_SHADER)?;
         Ok(Self {
             low_res,
-            mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip]),
+            mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip], &[]),
             kernel: compute_pipeline(
                 device,
                 "pvsm_kernel_pipeline",
                 &kernel_module,
                 "pvsm_kernel",
                 &[screen[0], screen[1], &layouts.kernel],
+                &[],
             ),
-            pyramid: compute_pipeline(device, "pvsm_pyramid_pipeline", &pyramid_module, "pvsm_pyramid", &[&layouts.pyramid]),
+            pyramid: compute_pipeline(device, "pvsm_pyramid_pipeline", &pyramid_module, "pvsm_pyramid", &[&layouts.pyramid], &[]),
             filter: compute_pipeline(
                 device,
                 "pvsm_tile_filter_pipeline",
                 &filter_module,
                 "pvsm_tile_filter",
                 &[screen[0], screen[1], &layouts.common, &layouts.tile],
+                &[],
             ),
             resolve: compute_pipeline(
                 device,
@@ -861,6 +863,7 @@ impl Pipelines {
                 &filter_module,
                 "pvsm_resolve",
                 &[screen[0], screen[1], &layouts.common, &layouts.resolve],
+                &[],
             ),
             cull: compute_pipeline(
                 device,
@@ -868,6 +871,7 @@ impl Pipelines {
                 &cull_module,
                 "pvsm_tile_cull",
                 &[gpu.uniform_layout(), &layouts.cull],
+                &[],
             ),
         })
     }

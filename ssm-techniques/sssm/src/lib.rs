@@ -12,8 +12,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, compute_pipeline_specialised, labelled_view, render_texture, texture_entry, uniform_buffer,
-    uniform_entry, write_storage_texture_entry,
+    bind_group, bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+    write_storage_texture_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::readback::read_texture;
@@ -275,7 +275,7 @@ impl SeparableSoftShadowMaps {
             &horizontal_blocker_layout,
             &[wgpu::BindingResource::TextureView(&targets.blur_source)],
         );
-        let horizontal_blocker = ScreenPass::specialised(
+        let horizontal_blocker = ScreenPass::new(
             setup,
             NAME,
             "sssm_horizontal_blocker",
@@ -397,7 +397,7 @@ impl Shared<'_> {
             ),
             self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
         ];
-        let blocker_blur = ScreenPass::specialised(
+        let blocker_blur = ScreenPass::new(
             self.setup,
             NAME,
             "sssm_blocker_and_horizontal_blur",
@@ -406,7 +406,7 @@ impl Shared<'_> {
             wgpu::TextureFormat::Rgba32Float.into(),
             &self.blocker_blur_constants(),
         )?;
-        let vertical_blur = ScreenPass::specialised(
+        let vertical_blur = ScreenPass::new(
             self.setup,
             NAME,
             "sssm_vertical_blur",
@@ -456,7 +456,7 @@ impl Shared<'_> {
                 self.group(&format!("sssm_vertical_blur_columns_bind_group_{light}"), &vertical_blur_layout, &resources)
             })
             .collect();
-        let blocker_blur = compute_pipeline_specialised(
+        let blocker_blur = compute_pipeline(
             device,
             "sssm_blocker_blur_rows_pipeline",
             &self.module("sssm_blocker_blur_compute_shader", BLOCKER_BLUR_COMPUTE_SHADER)?,
@@ -464,7 +464,7 @@ impl Shared<'_> {
             &[&setup.scene.uniform_layout, &gbuffer.layout, &blocker_blur_layout],
             &self.blocker_blur_constants(),
         );
-        let vertical_blur = compute_pipeline_specialised(
+        let vertical_blur = compute_pipeline(
             device,
             "sssm_vertical_blur_columns_pipeline",
             &self.module("sssm_vertical_blur_compute_shader", VERTICAL_BLUR_COMPUTE_SHADER)?,

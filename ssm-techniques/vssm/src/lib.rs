@@ -146,9 +146,9 @@ impl VarianceSoftShadowMaps {
             bind_group_layout(device, "vssm_sat_columns_layout", &[uint_texture_entry(2), write_storage_texture_entry(3, TABLE_FORMAT)]);
         let sat_module = create_shader_with_imports(gpu, "vssm_sat_shader", SAT_SHADER, LOCAL_SHADERS)?;
         let frame_layout = &setup.scene.uniform_layout;
-        let rows = compute_pipeline(device, "vssm_sat_rows_pipeline", &sat_module, "vssm_sat_rows", &[frame_layout, &rows_layout]);
+        let rows = compute_pipeline(device, "vssm_sat_rows_pipeline", &sat_module, "vssm_sat_rows", &[frame_layout, &rows_layout], &[]);
         let columns =
-            compute_pipeline(device, "vssm_sat_columns_pipeline", &sat_module, "vssm_sat_columns", &[frame_layout, &columns_layout]);
+            compute_pipeline(device, "vssm_sat_columns_pipeline", &sat_module, "vssm_sat_columns", &[frame_layout, &columns_layout], &[]);
         let rows_group = bind_group(
             device,
             "vssm_sat_rows_bind_group",
@@ -176,8 +176,15 @@ impl VarianceSoftShadowMaps {
             ],
         );
         let filter_module = create_shader_with_imports(gpu, "vssm_filter_shader", FILTER_SHADER, LOCAL_SHADERS)?;
-        let filter =
-            ScreenPass::new(setup, NAME, "vssm_filter", (&filter_module, "vssm_filter"), Some(&filter_layout), VISIBILITY_FORMAT.into())?;
+        let filter = ScreenPass::new(
+            setup,
+            NAME,
+            "vssm_filter",
+            (&filter_module, "vssm_filter"),
+            Some(&filter_layout),
+            VISIBILITY_FORMAT.into(),
+            &[],
+        )?;
         Ok(Self { depth_map, rows, columns, rows_group, columns_group, filter, filter_group, size })
     }
 }

@@ -326,6 +326,7 @@ impl PenumbraWedges {
             &blend_module,
             "wedges_blend",
             &[gpu.uniform_layout(), gpu.gbuffer_layout(), &blend_layout],
+            &[],
         );
         let umbra_mask_pipeline = umbra_mask_pipeline(gpu, &blend_module);
         let resolve = ScreenPass::new(
@@ -335,6 +336,7 @@ impl PenumbraWedges {
             (&blend_module, "wedges_resolve"),
             Some(&blend_layout),
             VISIBILITY_FORMAT.into(),
+            &[],
         )?;
 
         let adjacency = setup.shared.adjacency(NAME)?;
@@ -579,7 +581,7 @@ impl MeshPasses {
         let plain = [light, &mesh_layout];
         let writes_arguments = [light, &mesh_layout, &indirect_layout];
         let pipeline = |entry: &str, layouts: &[&wgpu::BindGroupLayout]| {
-            compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts)
+            compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts, &[])
         };
         let silhouettes = SilhouettePasses {
             reset: pipeline("wedges_reset", &writes_arguments),

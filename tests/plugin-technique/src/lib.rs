@@ -86,7 +86,8 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
         entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) }],
     });
     let module = create_shader(setup.gpu, "plugin_hard_shader", SHADER)?;
-    let lookup = ScreenPass::new(setup, NAME, "plugin_hard_lookup", (&module, "plugin_hard"), Some(&layout), VISIBILITY_FORMAT.into())?;
+    let lookup =
+        ScreenPass::new(setup, NAME, "plugin_hard_lookup", (&module, "plugin_hard"), Some(&layout), VISIBILITY_FORMAT.into(), &[])?;
     Ok(Box::new(PluginHard { depth_map, lookup, depth_map_group }))
 }
 
