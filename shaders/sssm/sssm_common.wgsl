@@ -102,12 +102,6 @@ fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pi
     return vec4<f32>(camera.position.xyz + hit.xyz * max(hit.w, 0.0), select(0.0, 1.0, hit.w > 0.0));
 }
 
-// Distance from the eye to that point, |t|·|ray|; -1 where there is none.
-fn tangent_plane_distance(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
-    let hit = tangent_plane_hit(rays, point, normal, pixel);
-    return select(-1.0, hit.w * length(hit.xyz), hit.w > 0.0);
-}
-
 // The camera rays of a line of blur taps through pixel position `centre`, tap k at centre +
 // offset_k · `step` (a separable pass's row or column), and where each meets the tangent plane
 // through `point` with normal `normal`. The ray and its dot with the normal are linear in the
@@ -128,8 +122,9 @@ fn tap_line(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, centre: vec2<
     return TapLine(centre_ray, ray_step, dot(centre_ray, normal), dot(ray_step, normal), dot(point - camera.position.xyz, normal));
 }
 
-// tangent_plane_distance of the tap at `offset` along `line`: the eye's distance to the plane
-// along that tap's ray; -1 where the ray runs along the plane or meets it behind the eye.
+// The eye's distance to the plane along the ray of the tap at `offset` along `line`
+// (tangent_plane_hit's t times the ray's length); -1 where the ray runs along the plane or meets
+// it behind the eye.
 fn tap_line_distance(line: TapLine, offset: f32) -> f32 {
     let direction = line.centre_ray + offset * line.ray_step;
     let denominator = line.centre_denominator + offset * line.denominator_step;
@@ -303,7 +298,7 @@ fn unpack_blur_source(value: f32, packed: vec4<f32>) -> BlurSource {
 
 // Bilateral weight of a blur tap landing on `source`, for the pixel seen with normal `normal`,
 // where `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
-// pixel's ray (tangent_plane_distance): how much the surface seen there looks like this pixel's
+// pixel's ray (tap_line_distance): how much the surface seen there looks like this pixel's
 // tangent plane, by the difference of camera distances (the distance of the vertical pass's β
 // test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
 // not leak over edges.

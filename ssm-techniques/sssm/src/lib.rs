@@ -149,6 +149,7 @@ fn blur_weights(settings: &SssmSettings) -> [[f32; 4]; 32] {
 
 impl From<&SssmSettings> for SssmSettingsUniform {
     fn from(settings: &SssmSettings) -> Self {
+        let blur_weights = blur_weights(settings);
         Self {
             blocker_kernel: settings.blocker_kernel,
             blur_kernel: settings.blur_kernel,
@@ -157,8 +158,8 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             beta: settings.beta,
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
-            blur_weight_total: blur_weights(settings).iter().flatten().sum(),
-            blur_weights: blur_weights(settings),
+            blur_weight_total: blur_weights.iter().flatten().sum(),
+            blur_weights,
         }
     }
 }
