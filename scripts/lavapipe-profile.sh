@@ -22,7 +22,8 @@ ssm=target/release/ssm
 [ -x "$ssm" ] || { echo "lavapipe-profile: build it first: cargo build --release -p ssm-bench --bin ssm" >&2; exit 1; }
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 work=$(mktemp -d)
-trap 'kill "$pid" 2>/dev/null || true; rm -rf "$work"' EXIT
+pid=
+trap '[ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$work"' EXIT
 # Enough frames to outlast the start-up and the sampling window.
 "$ssm" render --frames "${PROFILE_FRAMES:-150}" --width 640 --height 480 "$@" --out "$work/out" >/dev/null 2>&1 &
 pid=$!
