@@ -146,7 +146,8 @@ fn a_pixel_footprint_averages_the_visibility_over_the_pixel() {
 /// The pyramid shortcut (lit with no ray cast when no triangle is in the pyramid from the point
 /// to the light, dark when one triangle covers it, else each ray against the few triangles in it)
 /// gives what casting every ray through the BVH gives, with the same jitter: on scenes with
-/// contact, thin occluders, self-shadowing curved surfaces and a point light.
+/// contact, thin occluders, self-shadowing curved surfaces and a point light, with 8² rays and
+/// with 13² and 20² (quarters of odd and uneven sizes, every eighth or so pixel).
 #[test]
 fn the_pyramid_shortcut_gives_what_every_ray_gives() {
     use ssm_core::reference::SplitMix64;
@@ -167,22 +168,24 @@ fn the_pyramid_shortcut_gives_what_every_ray_gives() {
         let normals = renderer.read_normals().unwrap();
         let truth = GroundTruth::new(&scene);
         let light = &scene.lights[0];
-        let (mut differing, mut covered) = (0, 0);
-        for (index, (p, n)) in positions.iter().zip(&normals).enumerate() {
-            if p[3] < 0.5 {
-                continue;
+        for (samples, stride) in [(8, 1), (13, 3), (20, 5)] {
+            let (mut differing, mut covered) = (0, 0);
+            for (index, (p, n)) in positions.iter().zip(&normals).enumerate().step_by(stride) {
+                if p[3] < 0.5 {
+                    continue;
+                }
+                covered += 1;
+                let point = SurfacePoint { position: Vec3::new(p[0], p[1], p[2]), normal: Vec3::new(n[0], n[1], n[2]), footprint: None };
+                let fast = truth.visibility(light, &point, samples, &mut SplitMix64::for_pixel(7, index as u64));
+                let every_ray = truth.visibility_per_ray(light, &point, samples, &mut SplitMix64::for_pixel(7, index as u64));
+                if fast != every_ray {
+                    differing += 1;
+                    println!("{name}, {samples}² rays: pixel {index}: {fast} with the shortcut, {every_ray} ray by ray");
+                }
             }
-            covered += 1;
-            let point = SurfacePoint { position: Vec3::new(p[0], p[1], p[2]), normal: Vec3::new(n[0], n[1], n[2]), footprint: None };
-            let fast = truth.visibility(light, &point, 8, &mut SplitMix64::for_pixel(7, index as u64));
-            let every_ray = truth.visibility_per_ray(light, &point, 8, &mut SplitMix64::for_pixel(7, index as u64));
-            if fast != every_ray {
-                differing += 1;
-                println!("{name}: pixel {index}: {fast} with the shortcut, {every_ray} ray by ray");
-            }
+            println!("{name}, {samples}² rays: {differing} of {covered} pixels differ");
+            assert_eq!(differing, 0, "{name}, {samples}² rays");
         }
-        println!("{name}: {differing} of {covered} pixels differ");
-        assert_eq!(differing, 0, "{name}");
     }
 }
 
