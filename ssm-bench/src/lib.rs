@@ -118,8 +118,20 @@ pub fn render_technique(
     dir: &Path,
 ) -> ssm_core::Result<report::Measured> {
     let measured = report::measure(renderer, info, params, frames, debug)?;
+    write_run(renderer, &measured, dir)?;
+    Ok(measured)
+}
+
+/// Writes what [`render_technique`] writes for a technique measured with `renderer` (by
+/// [`report::measure`] or [`report::measure_all`]), under `dir`.
+///
+/// # Errors
+/// GPU or file errors.
+pub fn write_run(renderer: &Renderer, measured: &report::Measured, dir: &Path) -> ssm_core::Result<()> {
+    let info = measured.info;
+    let params = &measured.params;
     let coverage = report::pixel_mask(renderer, report::PixelSet::All)?;
-    report::write_images(dir, &measured, (renderer.width(), renderer.height()), &coverage, None)?;
+    report::write_images(dir, measured, (renderer.width(), renderer.height()), &coverage, None)?;
     let report = json!({
         "technique": info.name,
         "params": params.to_string(),
@@ -137,8 +149,7 @@ pub fn render_technique(
     });
     let file = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::write(&file, e))?;
-    std::fs::write(&file, text).map_err(|e| ssm_core::Error::write(&file, e))?;
-    Ok(measured)
+    std::fs::write(&file, text).map_err(|e| ssm_core::Error::write(&file, e))
 }
 
 /// Writes the G-buffer's world positions to `position.exr`: `R`, `G`, `B` the

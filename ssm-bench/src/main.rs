@@ -8,9 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use ssm_bench::shard::Varied;
-use ssm_bench::{
-    check_debug_outputs, debug_outputs_for, registry, render_technique, report, requirements_of, support_on, sweep, write_positions,
-};
+use ssm_bench::{check_debug_outputs, debug_outputs_for, registry, report, requirements_of, support_on, sweep, write_positions, write_run};
 use ssm_core::{GpuContext, ParamValues, Renderer, TechniqueInfo, TechniqueKind};
 use ssm_scene::{BUILTIN_SCENES, Scene, SceneSource};
 
@@ -67,6 +65,22 @@ struct ImageSize {
     height: u32,
 }
 
+/// How the timed frames of several techniques (or sweep points) are ordered.
+#[derive(clap::Args, Clone, Copy)]
+struct FrameOrderArgs {
+    /// Time each technique's frames in one block, one technique in memory at a time, instead of
+    /// in turns (every technique's first frame, then every second, ...), which keeps a slow spell
+    /// of the machine from landing on one technique: for sets too large to hold together.
+    #[arg(long)]
+    sequential: bool,
+}
+
+impl FrameOrderArgs {
+    fn order(self) -> report::FrameOrder {
+        if self.sequential { report::FrameOrder::Sequential } else { report::FrameOrder::Interleaved }
+    }
+}
+
 #[derive(clap::Args)]
 struct MergeArgs {
     /// The shards' output folders (each holds sweep.csv and shard.json), every shard of one sweep once.
@@ -107,6 +121,8 @@ struct SweepArgs {
     x: Option<String>,
     #[command(flatten)]
     size: ImageSize,
+    #[command(flatten)]
+    frame_order: FrameOrderArgs,
     /// Frames timed per point after one warm-up.
     #[arg(long, default_value_t = 3)]
     frames: u32,
@@ -143,6 +159,8 @@ struct CompareArgs {
     technique: Vec<String>,
     #[command(flatten)]
     size: ImageSize,
+    #[command(flatten)]
+    frame_order: FrameOrderArgs,
     /// Parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
@@ -177,6 +195,8 @@ struct RenderArgs {
     technique: Vec<String>,
     #[command(flatten)]
     size: ImageSize,
+    #[command(flatten)]
+    frame_order: FrameOrderArgs,
     /// Parameter assignment `<technique>.<param>=<value>`; repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
@@ -382,27 +402,27 @@ fn render(args: &RenderArgs) -> Result<()> {
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
     let progress = progress_bar(runs.len() as u64);
-    for (info, params) in &runs {
-        progress.set_message(info.name);
+    progress.set_message(args.technique.join(","));
+    let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, false)).collect();
+    let jobs: Vec<report::MeasureJob<'_>> =
+        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
+    // Technique errors name the technique already.
+    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+    progress.finish_and_clear();
+    for run in &measured {
+        let info = run.info;
         let dir = args.out.join(info.name);
-        // Technique errors name the technique already.
-        let debug = debug_outputs_for(info, &args.debug_outputs, false);
-        let run = render_technique(&mut renderer, info, params, args.frames, &debug, &dir)?;
+        write_run(&renderer, run, &dir)?;
         let time = match run.gpu_ms_median() {
             Some(ms) => format!("{ms:.3} ms GPU"),
             None => format!("{:.3} ms CPU wall (no timestamps)", run.cpu_ms_median()),
         };
-        progress.suspend(|| -> Result<()> {
-            say!("{:<8} {time}  [{}]  -> {}", info.name, params, dir.display());
-            if !run.diagnostics.is_empty() {
-                let text: Vec<String> = run.diagnostics.iter().map(|(k, v)| format!("{k}={v:.4}")).collect();
-                say!("{:<8} {}", "", text.join("  "));
-            }
-            Ok(())
-        })?;
-        progress.inc(1);
+        say!("{:<8} {time}  [{}]  -> {}", info.name, run.params, dir.display());
+        if !run.diagnostics.is_empty() {
+            let text: Vec<String> = run.diagnostics.iter().map(|(k, v)| format!("{k}={v:.4}")).collect();
+            say!("{:<8} {}", "", text.join("  "));
+        }
     }
-    progress.finish_and_clear();
     say!("adapter: {}", gpu.describe());
     Ok(())
 }
@@ -514,15 +534,17 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let mut rows = Vec::new();
     // Every technique's visibility, kept for the interactive viewer's data.
     let mut visibilities = Vec::new();
-    for (info, params) in &runs {
-        progress.set_message(info.name);
-        // The overlays always: the HTML report draws them over the visibility.
-        let debug = debug_outputs_for(info, &args.debug_outputs, true);
-        let measured = report::measure(&mut renderer, info, params, args.frames, &debug)?;
+    // The overlays always: the HTML report draws them over the visibility.
+    let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, true)).collect();
+    let jobs: Vec<report::MeasureJob<'_>> =
+        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
+    progress.set_message(args.technique.join(","));
+    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+    for measured in measured {
+        let info = measured.info;
         report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
         rows.extend(report::rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
         visibilities.push((info.name, measured.visibility));
-        progress.inc(1);
     }
     progress.finish_and_clear();
 
@@ -711,14 +733,20 @@ fn run_sweep(
             report::write_images(&dir.join(reference_info.name), &reference, size, &coverage, None)?;
         }
         progress.inc(1);
-        for (point_index, (info, params, technique_point)) in plan.points.iter().enumerate() {
+        // This shard's points of the scene point, measured together (their frames in turns, unless --sequential).
+        let points: Vec<usize> = (0..plan.points.len()).filter(|point| runs.contains(&(first_run + point))).collect();
+        let debug: Vec<Vec<&str>> =
+            points.iter().map(|&point| debug_outputs_for(plan.points[point].0, &args.debug_outputs, false)).collect();
+        let jobs: Vec<report::MeasureJob<'_>> = points
+            .iter()
+            .zip(&debug)
+            .map(|(&point, debug)| report::MeasureJob { info: plan.points[point].0, params: &plan.points[point].1, debug })
+            .collect();
+        progress.set_message(format!("{} points of {scene_name}", jobs.len()));
+        let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+        for (measured, &point_index) in measured.into_iter().zip(&points) {
+            let (info, _, technique_point) = &plan.points[point_index];
             let run = first_run + point_index;
-            if !runs.contains(&run) {
-                continue;
-            }
-            progress.set_message(format!("{} {}", info.name, sweep::point_label(technique_point)));
-            let debug = debug_outputs_for(info, &args.debug_outputs, false);
-            let measured = report::measure(&mut renderer, info, params, args.frames, &debug)?;
             if let Some(dir) = &images {
                 let point_dir = dir.join(info.name).join(sweep::path_component(&sweep::assignment_label(technique_point)));
                 report::write_images(&point_dir, &measured, size, &coverage, Some((&reference, &covered)))?;
@@ -727,7 +755,6 @@ fn run_sweep(
             let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
             all.extend(technique_point.iter().cloned());
             varied.push((run, all));
-            progress.inc(1);
         }
     }
     progress.finish_and_clear();

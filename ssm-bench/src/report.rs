@@ -121,32 +121,130 @@ pub fn measure(
     frames: u32,
     debug: &[&str],
 ) -> Result<Measured> {
-    let memory_before = renderer.gpu.allocated_bytes();
-    let mut technique = renderer.create_technique(info, params)?;
-    // Pipeline compilation and first-use allocation are not the technique's cost.
-    renderer.render(technique.as_mut(), info.name)?;
-    let mut timings = Vec::new();
-    for _ in 0..frames.max(1) {
-        timings.push(renderer.render(technique.as_mut(), info.name)?);
-    }
-    // What the technique holds after its frames, lazily allocated maps included.
-    let memory_mib = (renderer.gpu.allocated_bytes() - memory_before) as f64 / f64::from(1u32 << 20);
-    let visibility =
-        (0..renderer.scene.light_count()).map(|light| renderer.read_visibility(light, info.name)).collect::<Result<Vec<_>>>()?;
-    let shaded = renderer.shade()?;
-    let mut diagnostics = technique.diagnostics(&renderer.gpu);
-    diagnostics.push((MEMORY_DIAGNOSTIC.to_owned(), memory_mib));
-    let requested: Vec<&str> = info.debug_outputs.iter().map(|o| o.name).filter(|name| debug.contains(name)).collect();
-    let extra_images = if requested.is_empty() { Vec::new() } else { technique.debug_outputs(&renderer.gpu, &requested)? };
-    for image in &extra_images {
-        if !info.debug_outputs.iter().any(|o| o.name == image.name && o.overlay == image.overlay) {
-            return Err(ssm_core::Error::Technique {
-                technique: info.name.to_owned(),
-                message: format!("debug output `{}` is not declared in its TechniqueInfo::debug_outputs as returned", image.name),
-            });
+    let job = MeasureJob { info, params, debug };
+    let mut measured = measure_all(renderer, &[job], frames, FrameOrder::Sequential, |_| {})?;
+    Ok(measured.remove(0))
+}
+
+/// One technique for [`measure_all`] to measure: what [`measure`] takes.
+#[derive(Clone, Copy)]
+pub struct MeasureJob<'a> {
+    /// The technique.
+    pub info: &'static TechniqueInfo,
+    /// Its parameters.
+    pub params: &'a ParamValues,
+    /// The debug outputs to read after its frames.
+    pub debug: &'a [&'a str],
+}
+
+/// In what order [`measure_all`] renders the timed frames of several techniques.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FrameOrder {
+    /// In turns: every technique's first frame, then every technique's second, and so on. A slow
+    /// spell of the machine (another process, a clock change) then falls on each technique alike
+    /// and their ratio holds, where a block of frames each would charge it to one. Every
+    /// technique exists until the last turn.
+    #[default]
+    Interleaved,
+    /// Each technique's frames in one block, one technique existing at a time: for sets that do
+    /// not fit in memory together.
+    Sequential,
+}
+
+/// Measures each of `jobs` as [`measure`] does (one warm-up frame, `frames` timed frames, then its
+/// outputs read), its timed frames in `order`; `done` is called as each job's measurement ends.
+/// Each job's `memory_mib` counts what its own creation and frames allocated, whatever the order.
+///
+/// # Errors
+/// As [`measure`], for the first job that fails.
+pub fn measure_all(
+    renderer: &mut Renderer,
+    jobs: &[MeasureJob<'_>],
+    frames: u32,
+    order: FrameOrder,
+    mut done: impl FnMut(&MeasureJob<'_>),
+) -> Result<Vec<Measured>> {
+    let frames = frames.max(1);
+    let mut results = Vec::with_capacity(jobs.len());
+    match order {
+        FrameOrder::Sequential => {
+            for job in jobs {
+                let mut running = Running::start(renderer, job)?;
+                for _ in 0..frames {
+                    running.frame(renderer, job)?;
+                }
+                results.push(running.finish(renderer, job)?);
+                done(job);
+            }
+        }
+        FrameOrder::Interleaved => {
+            let mut running = jobs.iter().map(|job| Running::start(renderer, job)).collect::<Result<Vec<_>>>()?;
+            for _ in 1..frames {
+                for (run, job) in running.iter_mut().zip(jobs) {
+                    run.frame(renderer, job)?;
+                }
+            }
+            // The last turn: each technique's outputs are read right after its own frame, before
+            // the next technique renders into the shared visibility targets.
+            for (mut run, job) in running.into_iter().zip(jobs) {
+                run.frame(renderer, job)?;
+                results.push(run.finish(renderer, job)?);
+                done(job);
+            }
         }
     }
-    Ok(Measured { info, params: params.clone(), frames: timings, diagnostics, visibility, shaded, extra_images })
+    Ok(results)
+}
+
+/// A technique being measured: created, warmed up, its frames so far and what it allocated.
+struct Running {
+    technique: Box<dyn ssm_core::ShadowTechnique>,
+    timings: Vec<FrameTimings>,
+    /// Bytes its creation and frames allocated (less what they freed).
+    allocated: i64,
+}
+
+impl Running {
+    /// Creates the technique and renders its warm-up frame: pipeline compilation and first-use
+    /// allocation are not its cost.
+    fn start(renderer: &mut Renderer, job: &MeasureJob<'_>) -> Result<Self> {
+        let before = renderer.gpu.allocated_bytes();
+        let mut technique = renderer.create_technique(job.info, job.params)?;
+        renderer.render(technique.as_mut(), job.info.name)?;
+        let allocated = renderer.gpu.allocated_bytes() - before;
+        Ok(Self { technique, timings: Vec::new(), allocated })
+    }
+
+    /// One timed frame.
+    fn frame(&mut self, renderer: &mut Renderer, job: &MeasureJob<'_>) -> Result<()> {
+        let before = renderer.gpu.allocated_bytes();
+        self.timings.push(renderer.render(self.technique.as_mut(), job.info.name)?);
+        self.allocated += renderer.gpu.allocated_bytes() - before;
+        Ok(())
+    }
+
+    /// Reads the outputs of its last frame.
+    fn finish(mut self, renderer: &mut Renderer, job: &MeasureJob<'_>) -> Result<Measured> {
+        let info = job.info;
+        // What the technique holds after its frames, lazily allocated maps included.
+        let memory_mib = self.allocated as f64 / f64::from(1u32 << 20);
+        let visibility =
+            (0..renderer.scene.light_count()).map(|light| renderer.read_visibility(light, info.name)).collect::<Result<Vec<_>>>()?;
+        let shaded = renderer.shade()?;
+        let mut diagnostics = self.technique.diagnostics(&renderer.gpu);
+        diagnostics.push((MEMORY_DIAGNOSTIC.to_owned(), memory_mib));
+        let requested: Vec<&str> = info.debug_outputs.iter().map(|o| o.name).filter(|name| job.debug.contains(name)).collect();
+        let extra_images = if requested.is_empty() { Vec::new() } else { self.technique.debug_outputs(&renderer.gpu, &requested)? };
+        for image in &extra_images {
+            if !info.debug_outputs.iter().any(|o| o.name == image.name && o.overlay == image.overlay) {
+                return Err(ssm_core::Error::Technique {
+                    technique: info.name.to_owned(),
+                    message: format!("debug output `{}` is not declared in its TechniqueInfo::debug_outputs as returned", image.name),
+                });
+            }
+        }
+        Ok(Measured { info, params: job.params.clone(), frames: self.timings, diagnostics, visibility, shaded, extra_images })
+    }
 }
 
 /// The stem of light `light`'s image files: `visibility` for light 0, `visibility-light<k>` for the others.

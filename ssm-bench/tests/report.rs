@@ -241,6 +241,46 @@ fn the_memory_a_technique_holds_is_reported() {
     assert!(small > 0.0 && (large / small - 4.0).abs() < 0.1, "{small} MiB, {large} MiB");
 }
 
+/// Techniques measured together with their frames in turns (`FrameOrder::Interleaved`, what
+/// `compare`, `render` and `sweep` do without `--sequential`) each keep their own frames, images
+/// and memory: the same visibility as measured one after the other, every frame, and `hard` at
+/// 1024² holding four times what it holds at 512² though both exist at once.
+#[test]
+fn techniques_measured_in_turns_keep_their_own_images_and_memory() {
+    use ssm_bench::report::{FrameOrder, MeasureJob, measure_all};
+    let gpu = ssm_core::GpuContext::new().unwrap();
+    let registry = ssm_bench::registry().unwrap();
+    let (hard, pcss) = (registry.get("hard").unwrap(), registry.get("pcss").unwrap());
+    let scene = ssm_scene::builtin("sphere-cube").unwrap().build();
+    let hard_params = |size: &str| {
+        let mut params = ssm_core::ParamValues::defaults(hard.name, hard.params);
+        params.set("shadow_map_size", size).unwrap();
+        params
+    };
+    let (small, large, soft) = (hard_params("512"), hard_params("1024"), ssm_core::ParamValues::defaults(pcss.name, pcss.params));
+    let needs = ssm_bench::requirements_of([(hard, &small), (pcss, &soft)]).unwrap();
+    let mut renderer = ssm_core::Renderer::new(&gpu, &scene, 64, 48, &needs).unwrap();
+    let jobs = [
+        MeasureJob { info: hard, params: &small, debug: &[] },
+        MeasureJob { info: pcss, params: &soft, debug: &[] },
+        MeasureJob { info: hard, params: &large, debug: &[] },
+    ];
+    let mut finished = 0;
+    let in_turns = measure_all(&mut renderer, &jobs, 3, FrameOrder::Interleaved, |_| finished += 1).unwrap();
+    let one_by_one = measure_all(&mut renderer, &jobs, 3, FrameOrder::Sequential, |_| {}).unwrap();
+    assert_eq!(finished, 3);
+    let memory = |m: &ssm_bench::report::Measured| m.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).unwrap().1;
+    for (index, (turns, alone)) in in_turns.iter().zip(&one_by_one).enumerate() {
+        assert_eq!(turns.frames.len(), 3, "job {index}");
+        assert!(turns.visibility == alone.visibility, "job {index}: its visibility measured in turns differs from measured alone");
+        println!("job {index}: {} MiB in turns, {} MiB alone", memory(turns), memory(alone));
+        assert!((memory(turns) - memory(alone)).abs() < 1e-3, "job {index}");
+    }
+    assert!(in_turns[0].visibility != in_turns[1].visibility, "hard and PCSS must differ for the test to tell them apart");
+    let (small_mib, large_mib) = (memory(&in_turns[0]), memory(&in_turns[2]));
+    assert!(small_mib > 0.0 && (large_mib / small_mib - 4.0).abs() < 0.1, "{small_mib} MiB, {large_mib} MiB");
+}
+
 /// A sweep split into 3 shards (`--shard K/3`) and merged (`ssm merge`) equals the unsharded
 /// sweep row for row, times aside; the second shard straddles the two scene points. A missing
 /// shard and a shard of another sweep are refused.
