@@ -69,8 +69,9 @@ struct ImageSize {
 #[derive(clap::Args, Clone, Copy)]
 struct FrameOrderArgs {
     /// Time each technique's frames in one block, one technique in memory at a time, instead of
-    /// in turns (every technique's first frame, then every second, ...), which keeps a slow spell
-    /// of the machine from landing on one technique: for sets too large to hold together.
+    /// in turns (every technique's first frame, then every second, ..., each after an untimed
+    /// frame of its own), which keeps a slow spell of the machine from landing on one technique:
+    /// for sets too large to hold together.
     #[arg(long)]
     sequential: bool,
 }

@@ -140,10 +140,11 @@ pub struct MeasureJob<'a> {
 /// In what order [`measure_all`] renders the timed frames of several techniques.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FrameOrder {
-    /// In turns: every technique's first frame, then every technique's second, and so on. A slow
-    /// spell of the machine (another process, a clock change) then falls on each technique alike
-    /// and their ratio holds, where a block of frames each would charge it to one. Every
-    /// technique exists until the last turn.
+    /// In turns: every technique's first frame, then every technique's second, and so on, each
+    /// timed frame right after an untimed one of the same technique, so that it finds the caches
+    /// as its own frame left them, as in a block. A slow spell of the machine (another process, a
+    /// clock change) then falls on each technique alike and their ratio holds, where a block of
+    /// frames each would charge it to one. Every technique exists until the last turn.
     #[default]
     Interleaved,
     /// Each technique's frames in one block, one technique existing at a time: for sets that do
@@ -171,7 +172,7 @@ pub fn measure_all(
             for job in jobs {
                 let mut running = Running::start(renderer, job)?;
                 for _ in 0..frames {
-                    running.frame(renderer, job)?;
+                    running.frame(renderer, job, false)?;
                 }
                 results.push(running.finish(renderer, job)?);
                 done(job);
@@ -181,13 +182,13 @@ pub fn measure_all(
             let mut running = jobs.iter().map(|job| Running::start(renderer, job)).collect::<Result<Vec<_>>>()?;
             for _ in 1..frames {
                 for (run, job) in running.iter_mut().zip(jobs) {
-                    run.frame(renderer, job)?;
+                    run.frame(renderer, job, true)?;
                 }
             }
             // The last turn: each technique's outputs are read right after its own frame, before
             // the next technique renders into the shared visibility targets.
             for (mut run, job) in running.into_iter().zip(jobs) {
-                run.frame(renderer, job)?;
+                run.frame(renderer, job, true)?;
                 results.push(run.finish(renderer, job)?);
                 done(job);
             }
@@ -215,9 +216,12 @@ impl Running {
         Ok(Self { technique, timings: Vec::new(), allocated })
     }
 
-    /// One timed frame.
-    fn frame(&mut self, renderer: &mut Renderer, job: &MeasureJob<'_>) -> Result<()> {
+    /// One timed frame, after an untimed one with `warm`.
+    fn frame(&mut self, renderer: &mut Renderer, job: &MeasureJob<'_>, warm: bool) -> Result<()> {
         let before = renderer.gpu.allocated_bytes();
+        if warm {
+            renderer.render(self.technique.as_mut(), job.info.name)?;
+        }
         self.timings.push(renderer.render(self.technique.as_mut(), job.info.name)?);
         self.allocated += renderer.gpu.allocated_bytes() - before;
         Ok(())
