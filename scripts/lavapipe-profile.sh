@@ -3,7 +3,9 @@
 # render` for long enough to sample it with perf, copies the JIT code out of the process (gdb) and
 # attributes the samples to the functions llvmpipe compiled: the pipelines' shader bodies and the
 # texel-fetch functions they call (those with a gather). Prints, per function, its share of the
-# samples, its instruction count and its gathers, divisions and calls.
+# samples, its instruction count and its gathers, divisions and calls (the first PROFILE_ROWS,
+# default 16; with PROFILE_GROUP=1 the copies of a function with the same instructions are one
+# row, and `copies` counts them).
 #
 #   scripts/lavapipe-profile.sh [ssm render arguments...]
 #   scripts/lavapipe-profile.sh --scene leaves --technique sssm --set sssm.blocker_kernel=29 \
@@ -76,9 +78,12 @@ for address, share in samples.items():
     if i >= 0 and any(s <= address < e for s, e in regions):
         shares[starts[i]] += share
 addresses = [a for a, _ in instructions]
-print(f'JIT code: {sum(shares.values()):.1f}% of the samples, {sum(samples.values()):.1f}% attributed in all')
-print('share  instructions  gathers  divisions  calls  function')
-for start, share in shares.most_common(12):
+# llvmpipe may compile a function again for another pipeline state or shader (one texel fetch
+# serves several passes): with PROFILE_GROUP=1, copies with the same instructions, addresses
+# aside, are one row.
+group_copies = __import__('os').environ.get('PROFILE_GROUP') == '1'
+groups = {}
+for start, share in shares.items():
     i = bisect.bisect_left(addresses, start)
     body = []
     while i < len(instructions):
@@ -86,10 +91,18 @@ for start, share in shares.most_common(12):
         if instructions[i][1].startswith('ret'):
             break
         i += 1
+    key = tuple(re.sub(r'0x[0-9a-f]+', '', t) for t in body) if group_copies else start
+    group = groups.setdefault(key, {'share': 0.0, 'copies': 0, 'start': start, 'body': body})
+    group['share'] += share
+    group['copies'] += 1
+print(f'JIT code: {sum(shares.values()):.1f}% of the samples, {sum(samples.values()):.1f}% attributed in all')
+print('share  copies  instructions  gathers  divisions  calls  function')
+for group in sorted(groups.values(), key=lambda g: -g['share'])[:int(__import__('os').environ.get('PROFILE_ROWS', '16'))]:
+    body = group['body']
     ops = collections.Counter(t.split()[0] for t in body)
     gathers = ops['vpgatherdd'] + ops['vgatherdps']
     # llvmpipe compiles each texture read as a small function called from the shader: one
     # gather for a one-channel texel, per-lane loads for a four-channel one.
     kind = 'shader' if len(body) >= 400 else 'texel fetch, gather' if gathers else 'texel fetch, per-lane loads'
-    print(f'{share:5.1f}%  {len(body):12d}  {gathers:7d}  {ops["vdivps"]:9d}  {ops["call"]:5d}  {kind} at {start:#x}')
+    print(f'{group["share"]:5.1f}%  {group["copies"]:6d}  {len(body):12d}  {gathers:7d}  {ops["vdivps"]:9d}  {ops["call"]:5d}  {kind} at {group["start"]:#x}')
 PY
