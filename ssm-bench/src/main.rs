@@ -402,13 +402,13 @@ fn render(args: &RenderArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
-    let progress = progress_bar(runs.len() as u64);
-    progress.set_message(args.technique.join(","));
+    let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)));
+    progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, false)).collect();
     let jobs: Vec<report::MeasureJob<'_>> =
         runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
     // Technique errors name the technique already.
-    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     progress.finish_and_clear();
     for run in &measured {
         let info = run.info;
@@ -524,7 +524,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     write_positions(&renderer, &args.out.join("position.exr"))?;
 
-    let progress = progress_bar(runs.len() as u64 + 1);
+    let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)) + 1);
     progress.set_message(format!("{} (ground truth)", reference_info.name));
     let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
     let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
@@ -539,8 +539,8 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, true)).collect();
     let jobs: Vec<report::MeasureJob<'_>> =
         runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
-    progress.set_message(args.technique.join(","));
-    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+    progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
+    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     for measured in measured {
         let info = measured.info;
         report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
@@ -705,7 +705,7 @@ fn run_sweep(
     let runs = args.shard.map_or(0..total, |shard| shard.runs(total));
     let scene_points_run =
         plan.scene_points.len().min(runs.clone().map(|r| r / plan.points.len()).collect::<std::collections::BTreeSet<_>>().len());
-    let progress = progress_bar((runs.len() + scene_points_run) as u64);
+    let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)) + scene_points_run as u64);
     let (mut rows, mut varied) = (Vec::new(), Vec::new());
     for (scene_index, (scene_point, overrides)) in plan.scene_points.iter().zip(&plan.scene_overrides).enumerate() {
         let first_run = scene_index * plan.points.len();
@@ -744,7 +744,7 @@ fn run_sweep(
             .map(|(&point, debug)| report::MeasureJob { info: plan.points[point].0, params: &plan.points[point].1, debug })
             .collect();
         progress.set_message(format!("{} points of {scene_name}", jobs.len()));
-        let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), |_| progress.inc(1))?;
+        let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
         for (measured, &point_index) in measured.into_iter().zip(&points) {
             let (info, _, technique_point) = &plan.points[point_index];
             let run = first_run + point_index;

@@ -122,7 +122,7 @@ pub fn measure(
     debug: &[&str],
 ) -> Result<Measured> {
     let job = MeasureJob { info, params, debug };
-    let mut measured = measure_all(renderer, &[job], frames, FrameOrder::Sequential, |_| {})?;
+    let mut measured = measure_all(renderer, &[job], frames, FrameOrder::Sequential, || {})?;
     Ok(measured.remove(0))
 }
 
@@ -153,7 +153,8 @@ pub enum FrameOrder {
 }
 
 /// Measures each of `jobs` as [`measure`] does (one warm-up frame, `frames` timed frames, then its
-/// outputs read), its timed frames in `order`; `done` is called as each job's measurement ends.
+/// outputs read), its timed frames in `order`; `timed` is called after each timed frame (for a
+/// progress bar: `jobs.len() × frames` calls in all).
 /// Each job's `memory_mib` counts what its own creation and frames allocated, whatever the order.
 ///
 /// # Errors
@@ -163,7 +164,7 @@ pub fn measure_all(
     jobs: &[MeasureJob<'_>],
     frames: u32,
     order: FrameOrder,
-    mut done: impl FnMut(&MeasureJob<'_>),
+    mut timed: impl FnMut(),
 ) -> Result<Vec<Measured>> {
     let frames = frames.max(1);
     let mut results = Vec::with_capacity(jobs.len());
@@ -173,9 +174,9 @@ pub fn measure_all(
                 let mut running = Running::start(renderer, job)?;
                 for _ in 0..frames {
                     running.frame(renderer, job, false)?;
+                    timed();
                 }
                 results.push(running.finish(renderer, job)?);
-                done(job);
             }
         }
         FrameOrder::Interleaved => {
@@ -183,14 +184,15 @@ pub fn measure_all(
             for _ in 1..frames {
                 for (run, job) in running.iter_mut().zip(jobs) {
                     run.frame(renderer, job, true)?;
+                    timed();
                 }
             }
             // The last turn: each technique's outputs are read right after its own frame, before
             // the next technique renders into the shared visibility targets.
             for (mut run, job) in running.into_iter().zip(jobs) {
                 run.frame(renderer, job, true)?;
+                timed();
                 results.push(run.finish(renderer, job)?);
-                done(job);
             }
         }
     }

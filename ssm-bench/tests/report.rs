@@ -265,10 +265,10 @@ fn techniques_measured_in_turns_keep_their_own_images_and_memory() {
         MeasureJob { info: pcss, params: &soft, debug: &[] },
         MeasureJob { info: hard, params: &large, debug: &[] },
     ];
-    let mut finished = 0;
-    let in_turns = measure_all(&mut renderer, &jobs, 3, FrameOrder::Interleaved, |_| finished += 1).unwrap();
-    let one_by_one = measure_all(&mut renderer, &jobs, 3, FrameOrder::Sequential, |_| {}).unwrap();
-    assert_eq!(finished, 3);
+    let mut timed = 0;
+    let in_turns = measure_all(&mut renderer, &jobs, 3, FrameOrder::Interleaved, || timed += 1).unwrap();
+    let one_by_one = measure_all(&mut renderer, &jobs, 3, FrameOrder::Sequential, || {}).unwrap();
+    assert_eq!(timed, 9, "one call per timed frame");
     let memory = |m: &ssm_bench::report::Measured| m.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).unwrap().1;
     for (index, (turns, alone)) in in_turns.iter().zip(&one_by_one).enumerate() {
         assert_eq!(turns.frames.len(), 3, "job {index}");
