@@ -82,6 +82,17 @@ impl FrameOrderArgs {
     }
 }
 
+/// A sweep's image size: a preset may carry its paper's.
+#[derive(clap::Args, Clone, Copy)]
+struct SweepImageSize {
+    /// Image width in pixels; default: the preset's (its paper's viewport), else 640.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels; default: the preset's (its paper's viewport), else 480.
+    #[arg(long)]
+    height: Option<u32>,
+}
+
 #[derive(clap::Args)]
 struct MergeArgs {
     /// The shards' output folders (each holds sweep.csv and shard.json), every shard of one sweep once.
@@ -121,7 +132,7 @@ struct SweepArgs {
     #[arg(long)]
     x: Option<String>,
     #[command(flatten)]
-    size: ImageSize,
+    size: SweepImageSize,
     #[command(flatten)]
     frame_order: FrameOrderArgs,
     /// Frames timed per point after one warm-up.
@@ -628,14 +639,17 @@ struct ResolvedSweep {
     x_axis: String,
     error: sweep::ErrorAxis,
     pixels: report::PixelSet,
+    /// (width, height): the command line's, else the preset's, else 640×480.
+    size: (u32, u32),
 }
 
 fn list_presets(registry: &ssm_core::Registry) -> Result<()> {
     for preset in sweep::presets(registry)? {
         let owner = preset.owner.map_or_else(String::new, |o| format!(" [{o}]"));
         say!("{}{owner}: {}", preset.name, preset.summary);
+        let (width, height) = sweep::image_size(None, None, Some(&preset));
         say!(
-            "  --scene {}  --vary {}  (x: {}, y: {}, pixels: {})",
+            "  --scene {}  --vary {}  (x: {}, y: {}, pixels: {}, {width}x{height})",
             preset.scenes.join("|"),
             preset.varies.join(" --vary "),
             preset.x_axis,
@@ -680,7 +694,8 @@ fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&
     }
     let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::MaePenumbra);
     let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(report::PixelSet::All);
-    Ok(ResolvedSweep { scene_spec, specs, out, plan, x_axis, error, pixels })
+    let size = sweep::image_size(args.size.width, args.size.height, preset.as_ref());
+    Ok(ResolvedSweep { scene_spec, specs, out, plan, x_axis, error, pixels, size })
 }
 
 /// Measures every point of the plan (or of `args.shard`'s runs), each scene point with its own
@@ -722,11 +737,11 @@ fn run_sweep(
         } else {
             format!("{}[{}]", sweep.scene_spec, scene_point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";"))
         };
-        let mut renderer = Renderer::new(gpu, &scene, args.size.width, args.size.height, &needs)?;
+        let mut renderer = Renderer::new(gpu, &scene, sweep.size.0, sweep.size.1, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
         let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
         let covered = report::pixel_mask(&renderer, sweep.pixels)?;
-        let size = (args.size.width, args.size.height);
+        let size = sweep.size;
         // Under <out>/images/<scene point>/ when asked: the ground truth, then each technique's points.
         let images = args.images.then(|| sweep.out.join("images").join(sweep::path_component(&sweep::assignment_label(scene_point))));
         let coverage = if images.is_some() { report::pixel_mask(&renderer, report::PixelSet::All)? } else { Vec::new() };
@@ -911,7 +926,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
             scene: sweep.scene_spec.clone(),
             varies: sweep.specs.clone(),
             settings: args.settings.clone(),
-            size: (args.size.width, args.size.height),
+            size: sweep.size,
             frames: args.frames,
             pixels: sweep_pixels_name(sweep.pixels),
             x_axis: sweep.x_axis.clone(),
@@ -926,7 +941,7 @@ fn sweep_command(args: &SweepArgs) -> Result<()> {
         out: &sweep.out,
         name: args.preset.as_deref().unwrap_or("custom"),
         adapter: &gpu.info.name,
-        size: (args.size.width, args.size.height),
+        size: sweep.size,
         frames: args.frames,
         scene_spec: &sweep.scene_spec,
         x_axis: &sweep.x_axis,

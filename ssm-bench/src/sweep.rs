@@ -69,6 +69,9 @@ pub struct PresetSpec {
     pub y_axis: ErrorAxis,
     /// The pixels the errors cover unless `--pixels` says otherwise.
     pub pixels: PixelSet,
+    /// The image size (width, height) unless `--width`/`--height` say otherwise: the paper's,
+    /// where it states one.
+    pub size: Option<(u32, u32)>,
 }
 
 impl PresetSpec {
@@ -90,6 +93,7 @@ impl PresetSpec {
             x_axis: preset.x_axis.to_owned(),
             y_axis,
             pixels,
+            size: preset.size,
         })
     }
 }
@@ -115,6 +119,7 @@ pub fn trade_preset(registry: &Registry) -> PresetSpec {
         x_axis: "time".into(),
         y_axis: ErrorAxis::MaePenumbra,
         pixels: PixelSet::All,
+        size: None,
     }
 }
 
@@ -136,6 +141,7 @@ pub fn lights_preset(registry: &Registry) -> PresetSpec {
         x_axis: "scene.lights".into(),
         y_axis: ErrorAxis::Time,
         pixels: PixelSet::All,
+        size: None,
     }
 }
 
@@ -155,6 +161,17 @@ pub fn presets(registry: &Registry) -> Result<Vec<PresetSpec>> {
         }
     }
     Ok(all)
+}
+
+/// The image size a sweep renders at without `--width`/`--height`.
+pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
+
+/// The image size of a sweep: each of `width` and `height` the command line's, else the preset's
+/// (the paper's viewport, where it states one), else [`DEFAULT_SIZE`]'s.
+#[must_use]
+pub fn image_size(width: Option<u32>, height: Option<u32>, preset: Option<&PresetSpec>) -> (u32, u32) {
+    let preset = preset.and_then(|p| p.size);
+    (width.or(preset.map(|(w, _)| w)).unwrap_or(DEFAULT_SIZE.0), height.or(preset.map(|(_, h)| h)).unwrap_or(DEFAULT_SIZE.1))
 }
 
 /// The preset called `name`.

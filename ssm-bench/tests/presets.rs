@@ -62,3 +62,24 @@ fn a_parameter_varied_twice_is_refused() {
     let scene_twice = ["scene.light_scale=1,2".to_owned(), "scene.light_scale=3".to_owned(), "pcss".to_owned()];
     assert!(SweepPlan::new(registry, &scene_twice, &[]).is_err());
 }
+
+/// A preset that reproduces a paper's measurements renders at the paper's viewport unless the
+/// command line gives a size, each dimension on its own; one without a viewport at 640×480.
+#[test]
+fn a_preset_carries_its_papers_image_size() {
+    use ssm_bench::sweep::{DEFAULT_SIZE, image_size};
+    let registry = ssm_bench::registry().unwrap();
+    let table4 = preset(registry, "sssm-table4").unwrap();
+    assert_eq!(table4.size, Some((1280, 720)), "Buades et al., Sec. 5: a 1,280 × 720 viewport");
+    assert_eq!(image_size(None, None, Some(&table4)), (1280, 720));
+    assert_eq!(image_size(Some(320), None, Some(&table4)), (320, 720));
+    assert_eq!(image_size(Some(320), Some(240), Some(&table4)), (320, 240));
+    let trade = trade_preset(registry);
+    assert_eq!(image_size(None, None, Some(&trade)), DEFAULT_SIZE);
+    assert_eq!(image_size(None, Some(100), None), (DEFAULT_SIZE.0, 100));
+    for spec in presets(registry).unwrap() {
+        if let Some((width, height)) = spec.size {
+            assert!(width > 0 && height > 0, "preset {}: {width}x{height}", spec.name);
+        }
+    }
+}

@@ -199,13 +199,16 @@ pub struct Preset {
     pub y_axis: &'static str,
     /// Which pixels the errors cover: `all` or `receivers`.
     pub pixels: &'static str,
+    /// The image size (width, height) the paper measured at, where it says: `ssm sweep --preset`
+    /// renders at it unless `--width`/`--height` say otherwise (without one, 640×480).
+    pub size: Option<(u32, u32)>,
 }
 
 impl Preset {
     /// A preset with the usual axes (time against penumbra error, all pixels); set
     /// the other fields with struct update syntax.
     pub const DEFAULT: Self =
-        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae-penumbra", pixels: "all" };
+        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae-penumbra", pixels: "all", size: None };
 }
 
 /// Size and field offsets of a Rust struct uploaded as a uniform

@@ -590,6 +590,10 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
     Ok(screen_space_requirements(SssmSettings::from_params(params)?.shadow_map_size))
 }
 
+/// The viewport of every measurement in Buades et al. (Sec. 5: "1,024 × 1,024 shadow maps rendered
+/// to a 1,280 × 720 HD viewport"): the image size of the presets that reproduce them.
+const PAPER_VIEWPORT: (u32, u32) = (1280, 720);
+
 /// Buades et al.'s evaluations, as sweeps.
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
@@ -602,6 +606,7 @@ const PRESETS: &[ssm_core::Preset] = &[
             "sssm.alpha:beta=0.001:0.001,0.01:0.01,0.02:0.02,0.05:0.05,0.2:0.2",
             "vssm",
         ],
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -627,6 +632,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         ],
         x_axis: "sssm.alpha",
         y_axis: "time",
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -635,6 +641,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["leaves"],
         varies: &["sssm.alpha=0.01,0.1,0.15,0.2,0.5", "sssm.blocker_kernel=7,11,29", "sssm.penumbra_error=true"],
         x_axis: "sssm.alpha",
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -647,6 +654,7 @@ const PRESETS: &[ssm_core::Preset] = &[
             "sssm.blocker_kernel:blur_kernel=29:41",
             "sssm.alpha:beta=0.01:0.01,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
         ],
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -656,6 +664,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         varies: &["scene.lights=1,2,3", "sssm", "pcss"],
         x_axis: "scene.lights",
         y_axis: "time",
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {
@@ -663,6 +672,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         summary: "Buades et al., Fig. 5: the mean filter against the Gaussian, error against the ground truth at Table 4's kernel pairs (the images: ssm compare with --set sssm.filter=mean)",
         scenes: &["leaves"],
         varies: &["sssm.filter=mean,gaussian", "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41"],
+        size: Some(PAPER_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
 ];
