@@ -35,7 +35,7 @@ perf record -e cpu-clock -F 4000 -p "$pid" -o "$work/perf.data" -- sleep "${PROF
 cat "/proc/$pid/maps" >"$work/maps"
 perf report -i "$work/perf.data" --sort sym --stdio 2>/dev/null | grep -v '^#' | grep -v '^$' >"$work/samples" || true
 python3 - "$pid" "$work" <<'PY'
-import bisect, collections, glob, re, subprocess, sys
+import bisect, collections, glob, os, re, subprocess, sys
 pid, work = sys.argv[1], sys.argv[2]
 executable = []
 for line in open(f'{work}/maps'):
@@ -81,7 +81,7 @@ addresses = [a for a, _ in instructions]
 # llvmpipe may compile a function again for another pipeline state or shader (one texel fetch
 # serves several passes): with PROFILE_GROUP=1, copies with the same instructions, addresses
 # aside, are one row.
-group_copies = __import__('os').environ.get('PROFILE_GROUP') == '1'
+group_copies = os.environ.get('PROFILE_GROUP') == '1'
 groups = {}
 for start, share in shares.items():
     i = bisect.bisect_left(addresses, start)
@@ -97,7 +97,7 @@ for start, share in shares.items():
     group['copies'] += 1
 print(f'JIT code: {sum(shares.values()):.1f}% of the samples, {sum(samples.values()):.1f}% attributed in all')
 print('share  copies  instructions  gathers  divisions  calls  function')
-for group in sorted(groups.values(), key=lambda g: -g['share'])[:int(__import__('os').environ.get('PROFILE_ROWS', '16'))]:
+for group in sorted(groups.values(), key=lambda g: -g['share'])[:int(os.environ.get('PROFILE_ROWS', '16'))]:
     body = group['body']
     ops = collections.Counter(t.split()[0] for t in body)
     gathers = ops['vpgatherdd'] + ops['vgatherdps']
