@@ -7,7 +7,8 @@
 // `horizontal_source(texel)`, where a blur tap's pixel comes from, and binds `penumbra_error`, the
 // target of the Table 5 measurement (with MEASURE_PENUMBRA_ERROR: per pixel, (the penumbra width
 // from the reused rows − the width from every row read)², shadow-map texels²; -1 where step 2
-// computed no penumbra either way).
+// computed no penumbra either way). Each also hands on packed_vertical_tap_source per pixel,
+// what step 3's taps read.
 
 // #import sssm/sssm_common.wgsl
 

@@ -2,7 +2,7 @@
 // of one screen row. After their blocker searches, the group loads once into workgroup memory the
 // row segment their horizontal blurs reach (its pixels, widened by the widest blur half-width of
 // the group, up to SEGMENT_CAPACITY texels), and every blur tap inside it reads from there instead
-// of from three textures; taps beyond it read the textures as the fragment pass does, so the
+// of from the texture; taps beyond it read the texture as the fragment pass does, so the
 // result is the fragment pass's.
 
 // #import sssm/sssm_blocker_blur.wgsl
@@ -10,6 +10,7 @@
 
 @group(2) @binding(6) var horizontal_blur_target: texture_storage_2d<rgba32float, write>;
 @group(2) @binding(7) var penumbra_error: texture_storage_2d<r32float, write>;
+@group(2) @binding(8) var vertical_tap_source: texture_storage_2d<rgba32float, write>;
 
 fn horizontal_source(texel: vec2<i32>) -> BlurSource {
     let index = segment_index(texel.x);
@@ -67,6 +68,7 @@ fn sssm_blocker_blur_rows(
     }
     if (inside) {
         textureStore(horizontal_blur_target, texel, result);
+        textureStore(vertical_tap_source, texel, packed_vertical_tap_source(result.x, point));
     }
     record_reads_of(1u, texel, u32(computed));
 }

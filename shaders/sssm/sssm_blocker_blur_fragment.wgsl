@@ -8,15 +8,21 @@ fn horizontal_source(texel: vec2<i32>) -> BlurSource {
     return load_horizontal_source(texel);
 }
 
-// (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker rows
-// reused); w = -1 where nothing was computed (background, behind the light).
+struct BlockerBlurOutput {
+    // (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker
+    // rows reused); w = -1 where nothing was computed (background, behind the light).
+    @location(0) horizontal_blur: vec4<f32>,
+    // packed_vertical_tap_source.
+    @location(1) vertical_tap_source: vec4<f32>,
+};
+
 @fragment
-fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
+fn sssm_blocker_blur(in: FullscreenVertex) -> BlockerBlurOutput {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
     if (own.x < 0.0) {
         store_penumbra_error(point.texel);
-        return vec4<f32>(own.w, 0.0, 0.0, -1.0);
+        return BlockerBlurOutput(vec4<f32>(own.w, 0.0, 0.0, -1.0), packed_vertical_tap_source(own.w, point));
     }
     reads = 3u;
     let searched = blocker_search(point, own);
@@ -26,5 +32,5 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> @location(0) vec4<f32> {
         result = horizontal_blur(in.clip.xy, point, own, result);
     }
     record_reads(1u, point.texel);
-    return result;
+    return BlockerBlurOutput(result, packed_vertical_tap_source(result.x, point));
 }

@@ -296,6 +296,28 @@ fn unpack_blur_source(value: f32, packed: vec4<f32>) -> BlurSource {
     return BlurSource(value, abs(packed.w), packed.xyz);
 }
 
+// What step 2 writes per pixel for the vertical blur's taps (the `vertical_tap_source` target),
+// so that a tap reads one texel instead of step 2's result and step 1's blur source: the
+// horizontally blurred `value` in x, the distance from the eye in y (0 where nothing covers the
+// pixel), its sign the sign of the normal's z, and the normal's x and y in z and w (its z follows
+// from them: a unit vector).
+fn packed_vertical_tap_source(value: f32, point: ScreenPoint) -> vec4<f32> {
+    if (!point.covered) {
+        return vec4<f32>(value, 0.0, 0.0, 0.0);
+    }
+    let eye_distance = distance(point.position, camera.position.xyz);
+    return vec4<f32>(value, select(-eye_distance, eye_distance, point.normal.z >= 0.0), point.normal.xy);
+}
+
+// The BlurSource of a `vertical_tap_source` texel.
+fn unpack_vertical_tap_source(packed: vec4<f32>) -> BlurSource {
+    if (packed.y == 0.0) {
+        return BlurSource(packed.x, -1.0, vec3<f32>(0.0));
+    }
+    let normal_z = sqrt(max(1.0 - dot(packed.zw, packed.zw), 0.0));
+    return BlurSource(packed.x, abs(packed.y), vec3<f32>(packed.zw, select(-normal_z, normal_z, packed.y > 0.0)));
+}
+
 // Bilateral weight of a blur tap landing on `source`, for the pixel seen with normal `normal`,
 // where `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
 // pixel's ray (tap_line_distance): how much the surface seen there looks like this pixel's

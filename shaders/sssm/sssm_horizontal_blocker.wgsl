@@ -7,22 +7,24 @@
 
 // #import sssm/sssm_common.wgsl
 
-@group(2) @binding(4) var blur_source: texture_storage_2d<rgba32float, write>;
+struct HorizontalBlockerOutput {
+    // (d, partial sum, partial count, hard visibility); d = -1 where there is nothing to compute.
+    @location(0) blocker: vec4<f32>,
+    // packed_blur_source.
+    @location(1) blur_source: vec4<f32>,
+};
 
-// (d, partial sum, partial count, hard visibility); d = -1 where there is nothing to compute.
 @fragment
-fn sssm_horizontal_blocker(in: FullscreenVertex) -> @location(0) vec4<f32> {
+fn sssm_horizontal_blocker(in: FullscreenVertex) -> HorizontalBlockerOutput {
     let point = screen_point(in);
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
-        textureStore(blur_source, point.texel, packed_blur_source(trivial, point));
-        return vec4<f32>(-1.0, 0.0, 0.0, trivial);
+        return HorizontalBlockerOutput(vec4<f32>(-1.0, 0.0, 0.0, trivial), packed_blur_source(trivial, point));
     }
     reads = 2u;
     let result = partial_blocker(point);
-    textureStore(blur_source, point.texel, packed_blur_source(result.w, point));
     record_reads(0u, point.texel);
-    return result;
+    return HorizontalBlockerOutput(result, packed_blur_source(result.w, point));
 }
 
 fn partial_blocker(point: ScreenPoint) -> vec4<f32> {

@@ -10,15 +10,14 @@
 // #import sssm/sssm_common.wgsl
 
 @group(2) @binding(4) var horizontal_blur: texture_2d<f32>;
-@group(2) @binding(5) var reuse_share: texture_storage_2d<r32float, write>;
-@group(2) @binding(6) var blur_source: texture_2d<f32>;
+@group(2) @binding(5) var blur_source: texture_2d<f32>;
+@group(2) @binding(6) var vertical_tap_source: texture_2d<f32>;
 
-// A blur tap's pixel read from the textures: step 2's horizontal result, and from step 1's
-// blur_source what the β test and the bilateral weight compare.
+// A blur tap's pixel read from step 2's vertical_tap_source: its horizontal result, and what the
+// β test and the bilateral weight compare.
 fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
-    let value = textureLoad(horizontal_blur, texel, 0).x;
-    reads += 2u;
-    return unpack_blur_source(value, textureLoad(blur_source, texel, 0));
+    reads += 1u;
+    return unpack_vertical_tap_source(textureLoad(vertical_tap_source, texel, 0));
 }
 
 // The vertical blur's half-width in pixels at a computed pixel whose step 2 result is `own`

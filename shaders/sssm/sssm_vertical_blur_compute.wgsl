@@ -1,13 +1,15 @@
 // SSSM step 3 as a compute pass with a shared column: each workgroup is a run of SEGMENT_PIXELS
 // pixels of one screen column, which loads once into workgroup memory the column segment their
 // vertical blurs reach (widened by the group's widest blur half-height, up to SEGMENT_CAPACITY
-// texels); every tap inside it reads from there instead of from three textures, taps beyond it
-// read the textures as the fragment pass does, so the result is the fragment pass's.
+// texels); every tap inside it reads from there instead of from the texture, taps beyond it
+// read the texture as the fragment pass does, so the result is the fragment pass's.
 
 // #import sssm/sssm_vertical_blur.wgsl
 // #import sssm/sssm_segment.wgsl
 
-@group(2) @binding(7) var visibility_target: texture_storage_2d<r32float, write>;
+// (The fragment pass renders these two.)
+@group(2) @binding(7) var reuse_share: texture_storage_2d<r32float, write>;
+@group(2) @binding(8) var visibility_target: texture_storage_2d<r32float, write>;
 
 fn vertical_source(texel: vec2<i32>) -> BlurSource {
     let index = segment_index(texel.y);

@@ -6,19 +6,24 @@ fn vertical_source(texel: vec2<i32>) -> BlurSource {
     return load_vertical_source(texel);
 }
 
+struct VerticalBlurOutput {
+    // The soft visibility.
+    @location(0) visibility: f32,
+    // The share of rows reused (Fig. 10); -1 where nothing was computed (background, behind the
+    // light), which keeps the pixel out of the average.
+    @location(1) reuse_share: f32,
+};
+
 @fragment
-fn sssm_vertical_blur(in: FullscreenVertex) -> @location(0) f32 {
+fn sssm_vertical_blur(in: FullscreenVertex) -> VerticalBlurOutput {
     let point = screen_point(in);
     // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
     let own = textureLoad(horizontal_blur, point.texel, 0);
     if (own.w < 0.0) {
-        // Nothing computed here (background, behind the light): -1 keeps it out of the average.
-        textureStore(reuse_share, point.texel, vec4<f32>(-1.0));
-        return own.x;
+        return VerticalBlurOutput(own.x, -1.0);
     }
     reads = 3u;
     let result = vertical(in.clip.xy, point, own);
-    textureStore(reuse_share, point.texel, vec4<f32>(result.y));
     record_reads(2u, point.texel);
-    return result.x;
+    return VerticalBlurOutput(result.x, result.y);
 }

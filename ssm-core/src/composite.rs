@@ -37,7 +37,7 @@ impl Composite {
                 let module = create_shader(gpu, "composite_shader", include_str!("../../shaders/core/composite.wgsl"))?;
                 let layouts = [gpu.uniform_layout(), gpu.gbuffer_layout(), gpu.texture_layout()];
                 let target = wgpu::ColorTargetState { format: Self::FORMAT, blend, write_mask: wgpu::ColorWrites::ALL };
-                Ok(fullscreen_pipeline(&gpu.device, &format!("{entry}_pipeline"), &module, entry, &layouts, target, &[]))
+                Ok(fullscreen_pipeline(&gpu.device, &format!("{entry}_pipeline"), &module, entry, &layouts, &[target], &[]))
             })
         };
         let base_pipeline = build("composite_base", None)?;

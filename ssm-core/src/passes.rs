@@ -57,7 +57,7 @@ pub fn labelled_view(texture: &wgpu::Texture, label: &str) -> wgpu::TextureView 
 
 /// A full-screen pass pipeline: the shared full-screen triangle vertex stage
 /// (`common/fullscreen.wgsl`, imported by `module`) and the fragment entry
-/// point `fragment` writing one `target`, with values for the fragment stage's
+/// point `fragment` writing `targets` (its `@location`s in order), with values for the fragment stage's
 /// pipeline-overridable constants (WGSL `override`, by name; `&[]` for none): code a
 /// setting switches off is then compiled out of the pipeline instead of skipped at run
 /// time, which a SIMD rasteriser (lavapipe) pays for anyway.
@@ -68,9 +68,10 @@ pub fn fullscreen_pipeline(
     module: &wgpu::ShaderModule,
     fragment: &str,
     bind_group_layouts: &[&wgpu::BindGroupLayout],
-    target: wgpu::ColorTargetState,
+    targets: &[wgpu::ColorTargetState],
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
+    let targets: Vec<Option<wgpu::ColorTargetState>> = targets.iter().cloned().map(Some).collect();
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = bind_group_layouts.iter().copied().map(Some).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(&format!("{label}_layout")),
@@ -88,7 +89,7 @@ pub fn fullscreen_pipeline(
             module,
             entry_point: Some(fragment),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            targets: &[Some(target)],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,

@@ -37,10 +37,28 @@ impl ScreenPass {
         target: wgpu::ColorTargetState,
         constants: &[(&str, f64)],
     ) -> Result<Self> {
+        Self::with_targets(setup, technique, label, (module, fragment), own_layout, &[target], constants)
+    }
+
+    /// [`ScreenPass::new`] writing several `targets` at once, the fragment's `@location(0)`,
+    /// `@location(1)`, ... in order: what a pass hands on in more than one texture, written as
+    /// render targets (cheaper than a storage-texture store per pixel on a CPU rasteriser).
+    ///
+    /// # Errors
+    /// As [`ScreenPass::new`].
+    pub fn with_targets(
+        setup: &TechniqueSetup<'_>,
+        technique: &str,
+        label: &str,
+        (module, fragment): (&wgpu::ShaderModule, &str),
+        own_layout: Option<&wgpu::BindGroupLayout>,
+        targets: &[wgpu::ColorTargetState],
+        constants: &[(&str, f64)],
+    ) -> Result<Self> {
         let gbuffer = setup.shared.gbuffer(technique)?;
         let mut layouts = vec![&setup.scene.uniform_layout, &gbuffer.layout];
         layouts.extend(own_layout);
-        let pipeline = fullscreen_pipeline(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, target, constants);
+        let pipeline = fullscreen_pipeline(&setup.gpu.device, &format!("{label}_pipeline"), module, fragment, &layouts, targets, constants);
         Ok(Self { label: label.to_owned(), pipeline, gbuffer_bind_group: gbuffer.bind_group.clone() })
     }
 
@@ -54,8 +72,22 @@ impl ScreenPass {
         own_group: Option<&wgpu::BindGroup>,
         clear: Option<wgpu::Color>,
     ) {
+        self.encode_targets(frame, light, &[target], own_group, clear);
+    }
+
+    /// [`ScreenPass::encode`] into the targets of a pass built
+    /// [`with_targets`](ScreenPass::with_targets), in the same order; `clear` clears them all.
+    pub fn encode_targets(
+        &self,
+        frame: &mut Frame<'_>,
+        light: usize,
+        targets: &[&wgpu::TextureView],
+        own_group: Option<&wgpu::BindGroup>,
+        clear: Option<wgpu::Color>,
+    ) {
         let light_frame = &frame.scene.light_bind_groups[light];
-        let mut pass = frame.render_pass(&self.label, &[color_attachment(target, clear)], None);
+        let attachments: Vec<_> = targets.iter().map(|target| color_attachment(target, clear)).collect();
+        let mut pass = frame.render_pass(&self.label, &attachments, None);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);
         pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);

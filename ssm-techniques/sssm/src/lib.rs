@@ -60,7 +60,7 @@ pub enum BlurFilter {
 /// How steps 2 and 3 run (the same pixels either way).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
 pub enum BlurPasses {
-    /// Full-screen fragment passes: every blur tap reads its pixel from three textures.
+    /// Full-screen fragment passes: every blur tap reads its pixel from a texture (one texel: step 1 and step 2 each hand on what the next step's taps read, packed).
     Fragment,
     /// Compute passes whose workgroups (64 pixels of a row in step 2, of a column in step 3) load
     /// the screen segment their blurs reach into workgroup memory once; taps read it from there.
@@ -173,8 +173,14 @@ pub struct SeparableSoftShadowMaps {
     /// Step 1's bind group (the light frame is the screen pass's group 0).
     horizontal_blocker_group: wgpu::BindGroup,
     horizontal_blocker_view: wgpu::TextureView,
+    /// Step 1's second target.
+    blur_source_view: wgpu::TextureView,
     horizontal_blur_view: wgpu::TextureView,
+    /// Step 2's second target (written by the fragment pass as a render target).
+    vertical_tap_source_view: wgpu::TextureView,
     reuse: wgpu::Texture,
+    /// Step 3's second target (written by the fragment pass as a render target).
+    reuse_view: wgpu::TextureView,
     /// Step 2's squared penumbra-width error per pixel, with `penumbra_error`; `None` without.
     penumbra_error: Option<wgpu::Texture>,
     read_counts: ReadCounts,
@@ -209,6 +215,8 @@ struct Targets {
     /// Step 1's packed blur source per pixel (normal, eye distance signed by the hard value), read by the blur taps.
     blur_source: wgpu::TextureView,
     horizontal_blur: wgpu::TextureView,
+    /// Step 2's packed vertical tap source per pixel (its horizontal result, eye distance and normal), read by step 3's taps.
+    vertical_tap_source: wgpu::TextureView,
     reuse: wgpu::Texture,
     reuse_view: wgpu::TextureView,
     /// Step 2's squared penumbra-width error per pixel (written with `penumbra_error`).
@@ -237,10 +245,12 @@ impl Targets {
         let penumbra_error = readable("sssm_penumbra_error");
         Self {
             horizontal_blocker: target("sssm_horizontal_blocker_target", wgpu::TextureUsages::empty()),
-            // Written by step 1 as a storage texture.
-            blur_source: target("sssm_blur_source", wgpu::TextureUsages::STORAGE_BINDING),
+            // Step 1's second render target.
+            blur_source: target("sssm_blur_source", wgpu::TextureUsages::empty()),
             // Written by step 2's compute pass as a storage texture.
             horizontal_blur: target("sssm_horizontal_blur_target", wgpu::TextureUsages::STORAGE_BINDING),
+            // Step 2's second render target, or written by its compute pass as a storage texture.
+            vertical_tap_source: target("sssm_vertical_tap_source", wgpu::TextureUsages::STORAGE_BINDING),
             reuse_view: labelled_view(&reuse, "sssm_reuse_share"),
             reuse,
             penumbra_error_view: labelled_view(&penumbra_error, "sssm_penumbra_error"),
@@ -269,20 +279,16 @@ impl SeparableSoftShadowMaps {
             measure_penumbra_error: settings.penumbra_error,
             targets: &targets,
         };
-        let horizontal_blocker_layout =
-            shared.layout("sssm_horizontal_blocker_layout", &[write_storage_texture_entry(4, wgpu::TextureFormat::Rgba32Float)]);
-        let horizontal_blocker_group = shared.group(
-            "sssm_horizontal_blocker_bind_group",
-            &horizontal_blocker_layout,
-            &[wgpu::BindingResource::TextureView(&targets.blur_source)],
-        );
-        let horizontal_blocker = ScreenPass::new(
+        let horizontal_blocker_layout = shared.layout("sssm_horizontal_blocker_layout", &[]);
+        let horizontal_blocker_group = shared.group("sssm_horizontal_blocker_bind_group", &horizontal_blocker_layout, &[]);
+        // Its partial blocker sums and its blur sources, as two render targets.
+        let horizontal_blocker = ScreenPass::with_targets(
             setup,
             NAME,
             "sssm_horizontal_blocker",
             (&shared.module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
             Some(&horizontal_blocker_layout),
-            wgpu::TextureFormat::Rgba32Float.into(),
+            &[wgpu::TextureFormat::Rgba32Float.into(), wgpu::TextureFormat::Rgba32Float.into()],
             &read_counts.pipeline_constants(),
         )?;
         let blur_steps = match settings.blur_passes {
@@ -295,8 +301,11 @@ impl SeparableSoftShadowMaps {
             blur_steps,
             horizontal_blocker_group,
             horizontal_blocker_view: targets.horizontal_blocker,
+            blur_source_view: targets.blur_source,
             horizontal_blur_view: targets.horizontal_blur,
+            vertical_tap_source_view: targets.vertical_tap_source,
             reuse: targets.reuse,
+            reuse_view: targets.reuse_view,
             penumbra_error: settings.penumbra_error.then_some(targets.penumbra_error),
             read_counts,
         })
@@ -372,18 +381,23 @@ impl Shared<'_> {
         write_storage_texture_entry(binding, wgpu::TextureFormat::R32Float)
     }
 
-    /// Step 3's inputs (bindings 4 to 6): step 2's target, the reuse share it writes, and step 1's
-    /// blur sources (which also hold each pixel's own hard value).
+    /// Step 2's vertical tap sources in the compute pass (the fragment pass renders them).
+    fn vertical_tap_source_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        write_storage_texture_entry(binding, wgpu::TextureFormat::Rgba32Float)
+    }
+
+    /// Step 3's inputs (bindings 4 to 6): step 2's target, step 1's blur sources (for each
+    /// pixel's own hard value) and step 2's vertical tap sources.
     fn vertical_inputs(&self) -> [wgpu::BindingResource<'_>; 3] {
         [
             wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
-            wgpu::BindingResource::TextureView(&self.targets.reuse_view),
             wgpu::BindingResource::TextureView(&self.targets.blur_source),
+            wgpu::BindingResource::TextureView(&self.targets.vertical_tap_source),
         ]
     }
 
     fn vertical_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
-        [texture_entry(4), write_storage_texture_entry(5, wgpu::TextureFormat::R32Float), texture_entry(6)]
+        [texture_entry(4), texture_entry(5), texture_entry(6)]
     }
 
     fn fragment_steps(&self) -> Result<BlurSteps> {
@@ -398,22 +412,24 @@ impl Shared<'_> {
             ),
             self.group("sssm_vertical_blur_bind_group", &vertical_blur_layout, &self.vertical_inputs()),
         ];
-        let blocker_blur = ScreenPass::new(
+        // Its horizontal blur and the vertical blur's tap sources, as two render targets.
+        let blocker_blur = ScreenPass::with_targets(
             self.setup,
             NAME,
             "sssm_blocker_and_horizontal_blur",
             (&self.module("sssm_blocker_blur_fragment_shader", BLOCKER_BLUR_FRAGMENT_SHADER)?, "sssm_blocker_blur"),
             Some(&blocker_blur_layout),
-            wgpu::TextureFormat::Rgba32Float.into(),
+            &[wgpu::TextureFormat::Rgba32Float.into(), wgpu::TextureFormat::Rgba32Float.into()],
             &self.blocker_blur_constants(),
         )?;
-        let vertical_blur = ScreenPass::new(
+        // The visibility and the reuse share, as two render targets.
+        let vertical_blur = ScreenPass::with_targets(
             self.setup,
             NAME,
             "sssm_vertical_blur",
             (&self.module("sssm_vertical_blur_fragment_shader", VERTICAL_BLUR_FRAGMENT_SHADER)?, "sssm_vertical_blur"),
             Some(&vertical_blur_layout),
-            VISIBILITY_FORMAT.into(),
+            &[VISIBILITY_FORMAT.into(), wgpu::TextureFormat::R32Float.into()],
             &self.read_counts.pipeline_constants(),
         )?;
         Ok(BlurSteps::Fragment { blocker_blur, vertical_blur, groups })
@@ -430,10 +446,13 @@ impl Shared<'_> {
                 texture_entry(5),
                 write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float),
                 Self::penumbra_error_entry(7),
+                Self::vertical_tap_source_entry(8),
             ],
         );
+        // What the fragment pass renders: the reuse share and the visibility.
         let mut vertical_entries = Self::vertical_entries().to_vec();
-        vertical_entries.push(write_storage_texture_entry(7, VISIBILITY_FORMAT));
+        vertical_entries.push(write_storage_texture_entry(7, wgpu::TextureFormat::R32Float));
+        vertical_entries.push(write_storage_texture_entry(8, VISIBILITY_FORMAT));
         let vertical_blur_layout = self.layout("sssm_vertical_blur_columns_layout", &vertical_entries);
         let blocker_blur_group = self.group(
             "sssm_blocker_blur_rows_bind_group",
@@ -443,6 +462,7 @@ impl Shared<'_> {
                 &[
                     wgpu::BindingResource::TextureView(&self.targets.horizontal_blur),
                     wgpu::BindingResource::TextureView(&self.targets.penumbra_error_view),
+                    wgpu::BindingResource::TextureView(&self.targets.vertical_tap_source),
                 ],
             ]
             .concat(),
@@ -453,6 +473,7 @@ impl Shared<'_> {
             .enumerate()
             .map(|(light, output)| {
                 let mut resources = self.vertical_inputs().to_vec();
+                resources.push(wgpu::BindingResource::TextureView(&self.targets.reuse_view));
                 resources.push(wgpu::BindingResource::TextureView(output));
                 self.group(&format!("sssm_vertical_blur_columns_bind_group_{light}"), &vertical_blur_layout, &resources)
             })
@@ -493,17 +514,23 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
-        self.horizontal_blocker.encode(
+        self.horizontal_blocker.encode_targets(
             frame,
             light,
-            &self.horizontal_blocker_view,
+            &[&self.horizontal_blocker_view, &self.blur_source_view],
             Some(&self.horizontal_blocker_group),
             Some(wgpu::Color::TRANSPARENT),
         );
         match &self.blur_steps {
             BlurSteps::Fragment { blocker_blur, vertical_blur, groups: [blocker_blur_group, vertical_blur_group] } => {
-                blocker_blur.encode(frame, light, &self.horizontal_blur_view, Some(blocker_blur_group), Some(wgpu::Color::TRANSPARENT));
-                vertical_blur.encode(frame, light, output, Some(vertical_blur_group), None);
+                blocker_blur.encode_targets(
+                    frame,
+                    light,
+                    &[&self.horizontal_blur_view, &self.vertical_tap_source_view],
+                    Some(blocker_blur_group),
+                    Some(wgpu::Color::TRANSPARENT),
+                );
+                vertical_blur.encode_targets(frame, light, &[output, &self.reuse_view], Some(vertical_blur_group), None);
             }
             BlurSteps::SharedRows {
                 blocker_blur,
