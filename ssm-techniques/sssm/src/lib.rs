@@ -212,7 +212,7 @@ const COUNTED_PASSES: &[&str] = &["sssm_horizontal_blocker", "sssm_blocker_and_h
 /// The intermediate targets between the three passes.
 struct Targets {
     horizontal_blocker: wgpu::TextureView,
-    /// Step 1's packed blur source per pixel (normal, eye distance signed by the hard value), read by the blur taps.
+    /// Step 1's packed blur source per pixel (normal, eye distance signed by the hard value), read by step 2's blur taps and by step 3 for a pixel's own hard value.
     blur_source: wgpu::TextureView,
     horizontal_blur: wgpu::TextureView,
     /// Step 2's packed vertical tap source per pixel (its horizontal result, eye distance and normal), read by step 3's taps.
