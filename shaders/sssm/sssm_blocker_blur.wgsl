@@ -79,7 +79,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     let uvd = light_uv_depth(frame, lookup);
     let receiver = compared_plane(lookup, point.normal, d);
     let search = light_half_extent_uv(frame, frame.projection.z, d);
-    let n = runtime_count(max(settings.blocker_kernel, 1u));
+    let n = runtime_count(max(settings.blocker_kernel, 1u), point.texel);
     var sum = 0.0;
     var count = 0.0;
     var reused = 0.0;
@@ -160,7 +160,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
 // from `horizontal_source`.
 fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
     let radii = searched.yz;
-    let m = runtime_count(max(settings.blur_kernel, 1u));
+    let m = runtime_count(max(settings.blur_kernel, 1u), point.texel);
     let rays = camera_rays();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(radii.x, 0.0));
     var blurred = 0.0;

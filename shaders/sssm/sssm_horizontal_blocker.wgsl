@@ -35,7 +35,7 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     reads += 1u;
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
     let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
-    let n = runtime_count(max(settings.blocker_kernel, 1u));
+    let n = runtime_count(max(settings.blocker_kernel, 1u), point.texel);
     var sum = 0.0;
     var count = 0.0;
     for (var i = 0u; i < n; i++) {

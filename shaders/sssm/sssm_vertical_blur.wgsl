@@ -35,7 +35,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         // No blur: only the blocker rows counted.
         return vec2<f32>(own.x, own.w / n);
     }
-    let m = runtime_count(max(settings.blur_kernel, 1u));
+    let m = runtime_count(max(settings.blur_kernel, 1u), point.texel);
     let rays = camera_rays();
     let own_hard = packed_hard_value(textureLoad(blur_source, point.texel, 0));
     reads += 1u;
