@@ -94,9 +94,12 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         let ndc = clip.xy / clip.w;
         let screen = vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
         var reuse = false;
-        if (screen.z > 0.0 && on_screen(screen.xy)) {
+        var no_data = false;
+        let visible = screen.z > 0.0 && on_screen(screen.xy);
+        if (visible) {
             let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
             reads += 1u;
+            no_data = other.x < 0.0;
             if (other.x >= 0.0 && abs(d - other.x) < scene_length(frame, settings.alpha)) {
                 sum += other.y;
                 count += other.z;
@@ -106,6 +109,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         }
         if (!reuse) {
             mark_failed_row(&failed_rows, t);
+            count_failed_row(!visible, no_data);
         }
     }
     loop {

@@ -37,6 +37,28 @@ struct SssmSettings {
 // Texture reads of this invocation so far (G-buffer, shadow map, the passes' own targets).
 var<private> reads: u32;
 
+// Rows of this invocation's kernel that failed their reuse test (α in step 2, β in step 3), by
+// cause, when counting: the row's pixel lies off the screen; it holds nothing the test can use
+// (step 1 computed nothing there: no surface, or trivially lit or dark; in step 3, no surface);
+// or it holds a value whose depth differs by the threshold or more. Only the last depends on α
+// and β: the first two are rows the screen cannot supply at any threshold.
+var<private> failed_rows_off_screen: u32;
+var<private> failed_rows_no_data: u32;
+var<private> failed_rows_depth: u32;
+
+// The counters after the three passes' read counts (sssm's COUNTED): the causes of step 2's
+// failed blocker rows at 3-5, of step 3's failed blur rows at 6-8.
+const FAILED_ROW_COUNTERS: u32 = 3u;
+
+// Counts a kernel row that failed its reuse test, by cause (see failed_rows_off_screen), when counting.
+fn count_failed_row(off_screen: bool, no_data: bool) {
+    if (COUNT_READS) {
+        failed_rows_off_screen += select(0u, 1u, off_screen);
+        failed_rows_no_data += select(0u, 1u, !off_screen && no_data);
+        failed_rows_depth += select(0u, 1u, !off_screen && !no_data);
+    }
+}
+
 // Adds this pixel and its reads to pass `pass_index`'s counts, when counting (COUNT_READS).
 fn record_reads(pass_index: u32, texel: vec2<i32>) {
     record_reads_of(pass_index, texel, 1u);
@@ -49,6 +71,16 @@ fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
         let word = read_count_word(pass_index, texel);
         atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
+    }
+    // Steps 2 and 3 also count their failed rows by cause, per computed pixel.
+    if (COUNT_READS && pixels != 0u && (pass_index == 1u || pass_index == 2u)) {
+        let first = 3u + (pass_index - 1u) * FAILED_ROW_COUNTERS;
+        let causes = array<u32, 3>(failed_rows_off_screen, failed_rows_no_data, failed_rows_depth);
+        for (var cause = 0u; cause < FAILED_ROW_COUNTERS; cause++) {
+            let word = read_count_word(first + cause, texel);
+            atomicAdd(&read_counts[word], pixels);
+            atomicAdd(&read_counts[word + 1u], causes[cause]);
+        }
     }
 }
 

@@ -60,6 +60,9 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         total += weight;
         reused += select(0.0, 1.0, reuse);
         mark_failed_row_if(&failed_rows, j, !reuse);
+        if (COUNT_READS && !reuse) {
+            count_failed_row(!on_screen(row), source.eye_distance < 0.0);
+        }
     }
     loop {
         let failed = pop_failed_row(&failed_rows);

@@ -27,7 +27,9 @@ pub const READ_COUNT_BUCKETS: usize = 64;
 /// `2(k·B + b)` and `2(k·B + b) + 1`, B = [`READ_COUNT_BUCKETS`].
 pub struct ReadCounts {
     buffer: wgpu::Buffer,
-    passes: &'static [&'static str],
+    /// Each counter's name and the unit of its second word (`reads`, or another a shader counts
+    /// the same way, such as `rows`).
+    counters: Vec<(&'static str, &'static str)>,
     /// Whether the technique counts (its `count_reads`): otherwise nothing is cleared or read back.
     enabled: bool,
 }
@@ -37,8 +39,17 @@ impl ReadCounts {
     /// whether the shaders count (the buffer is bound either way).
     #[must_use]
     pub fn new(device: &wgpu::Device, label: &str, passes: &'static [&'static str], enabled: bool) -> Self {
-        let buffer = crate::passes::storage_buffer(device, label, (passes.len().max(1) * READ_COUNT_BUCKETS * 8) as u64);
-        Self { buffer, passes, enabled }
+        let counters: Vec<_> = passes.iter().map(|pass| (*pass, "reads")).collect();
+        Self::with_units(device, label, &counters, enabled)
+    }
+
+    /// As [`ReadCounts::new`], for counters of other things per pixel besides reads: counter `k`
+    /// is `(name, unit)`, and its diagnostic `<name>_<unit>_per_pixel` (SSSM counts its rows that
+    /// fail the reuse tests, by cause, as `rows` beside its passes' `reads`).
+    #[must_use]
+    pub fn with_units(device: &wgpu::Device, label: &str, counters: &[(&'static str, &'static str)], enabled: bool) -> Self {
+        let buffer = crate::passes::storage_buffer(device, label, (counters.len().max(1) * READ_COUNT_BUCKETS * 8) as u64);
+        Self { buffer, counters: counters.to_vec(), enabled }
     }
 
     /// The pipeline-overridable constant that switches the shaders' counting on or off
@@ -76,8 +87,8 @@ impl ReadCounts {
         }
     }
 
-    /// `<pass>_reads_per_pixel` and `<pass>_pixels` for each pass with pixels, after a frame;
-    /// nothing when not counting.
+    /// `<pass>_reads_per_pixel` (`<name>_<unit>_per_pixel`) and `<pass>_pixels` for each counter
+    /// with pixels, after a frame; nothing when not counting.
     #[must_use]
     pub fn diagnostics(&self, gpu: &GpuContext) -> Vec<(String, f64)> {
         if !self.enabled {
@@ -87,14 +98,15 @@ impl ReadCounts {
             return Vec::new();
         };
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        self.passes
+        self.counters
             .iter()
             .zip(words.chunks_exact(2 * READ_COUNT_BUCKETS))
-            .filter_map(|(pass, buckets)| {
+            .filter_map(|((name, unit), buckets)| {
                 let pixels: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[0])).sum();
-                let reads: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[1])).sum();
-                (pixels > 0)
-                    .then(|| [(format!("{pass}_reads_per_pixel"), reads as f64 / pixels as f64), (format!("{pass}_pixels"), pixels as f64)])
+                let counted: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[1])).sum();
+                (pixels > 0).then(|| {
+                    [(format!("{name}_{unit}_per_pixel"), counted as f64 / pixels as f64), (format!("{name}_pixels"), pixels as f64)]
+                })
             })
             .flatten()
             .collect()

@@ -102,7 +102,7 @@ pub struct SssmSettings {
     /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
     #[param(choice, default = "fragment")]
     pub blur_passes: BlurPasses,
-    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`); the atomics cost time, so off when timing.
+    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`) and the kernel rows that failed their reuse test per pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
     /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostics `sssm_penumbra_mse_texels2` over the pixels either search finds a blocker for and `sssm_penumbra_mse_all_texels2` over every pixel computed, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
@@ -206,8 +206,21 @@ enum BlurSteps {
     },
 }
 
-/// The names of the passes whose reads are counted, in the shaders' order.
-const COUNTED_PASSES: &[&str] = &["sssm_horizontal_blocker", "sssm_blocker_and_horizontal_blur", "sssm_vertical_blur"];
+/// What `count_reads` counts per computed pixel, in the shaders' order (`record_reads_of` and
+/// `count_failed_row` in sssm_common.wgsl): each pass's texture reads, then the rows of step 2's
+/// blocker search and of step 3's blur that failed their reuse test, by cause (off the screen, no
+/// data in the pixel there, a depth difference of α or β or more).
+const COUNTED: &[(&str, &str)] = &[
+    ("sssm_horizontal_blocker", "reads"),
+    ("sssm_blocker_and_horizontal_blur", "reads"),
+    ("sssm_vertical_blur", "reads"),
+    ("sssm_blocker_rows_failed_off_screen", "rows"),
+    ("sssm_blocker_rows_failed_no_data", "rows"),
+    ("sssm_blocker_rows_failed_depth", "rows"),
+    ("sssm_blur_rows_failed_off_screen", "rows"),
+    ("sssm_blur_rows_failed_no_data", "rows"),
+    ("sssm_blur_rows_failed_depth", "rows"),
+];
 
 /// The intermediate targets between the three passes.
 struct Targets {
@@ -270,7 +283,7 @@ impl SeparableSoftShadowMaps {
         let depth_map = settings.bias.depth_map(setup, "sssm_shadow_map", settings.shadow_map_size)?;
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
-        let read_counts = ReadCounts::new(device, "sssm_read_counts", COUNTED_PASSES, settings.count_reads);
+        let read_counts = ReadCounts::with_units(device, "sssm_read_counts", COUNTED, settings.count_reads);
         let shared = Shared {
             setup,
             settings: &settings_buffer,

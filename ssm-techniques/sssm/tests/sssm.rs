@@ -261,6 +261,44 @@ fn read_counters_count_the_taps() {
     assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| !k.contains("reads")), "counted only on request");
 }
 
+/// The failed-row counters split each row that fails its reuse test by cause, per computed pixel:
+/// with α = 0 every blocker row fails (the three causes add up to n at every pixel); the rows off
+/// the screen or without data do not depend on the thresholds; with thresholds as wide as the
+/// scene no row fails for its depth.
+#[test]
+fn failed_rows_are_counted_by_cause() {
+    let scene = builtin("parallel-square").unwrap().build();
+    let counts_in = |scene: &Scene, alpha: &str, beta: &str| {
+        let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", alpha), ("beta", beta), ("count_reads", "true")];
+        let diagnostics = diagnostics_of(&ssm_sssm::INFO, scene, &settings);
+        let rows = |step: &str| {
+            ["off_screen", "no_data", "depth"].map(|cause| value(&diagnostics, &format!("sssm_{step}_rows_failed_{cause}_rows_per_pixel")))
+        };
+        (rows("blocker"), rows("blur"))
+    };
+    let counts = |alpha: &str, beta: &str| counts_in(&scene, alpha, beta);
+    let (blocker_none, blur_none) = counts("0", "0");
+    let (blocker_all, blur_all) = counts("0", "1");
+    println!("alpha = 0: blocker rows failed {blocker_none:?}; blur rows failed at beta = 0 {blur_none:?}, at beta = 1 {blur_all:?}");
+    assert!((blocker_none.iter().sum::<f64>() - 7.0).abs() < 1e-9, "every blocker row fails with alpha = 0: {blocker_none:?}");
+    assert!(blocker_none[0] > 0.0, "parallel-square's search reaches past the screen's edges: {blocker_none:?}");
+    assert_eq!(blocker_none, blocker_all, "beta does not change step 2");
+    assert_eq!(blur_none[..2], blur_all[..2], "beta changes only the rows that fail for their depth");
+    assert!(blur_none[2] > 0.0 && blur_all[2] == 0.0, "{blur_none:?} against {blur_all:?}");
+    let (blocker_wide, _) = counts("1", "1");
+    assert_eq!(blocker_wide[..2], blocker_none[..2], "alpha changes only the rows that fail for their depth");
+    assert_eq!(blocker_wide[2], 0.0, "{blocker_wide:?}");
+    // A light large enough that the blurs reach past the screen's edges.
+    let mut large_light = scene.clone();
+    large_light.lights[0].half_size *= 4.0;
+    let (_, blur_strict) = counts_in(&large_light, "0", "0");
+    let (_, blur_wide) = counts_in(&large_light, "0", "1");
+    println!("a 4 times larger light: blur rows failed at beta = 0 {blur_strict:?}, at beta = 1 {blur_wide:?}");
+    assert!(blur_strict[0] > 0.0, "{blur_strict:?}");
+    assert_eq!(blur_strict[..2], blur_wide[..2], "beta changes only the rows that fail for their depth");
+    assert_eq!(blur_wide[2], 0.0, "{blur_wide:?}");
+}
+
 /// A named scene at an image size, with settings.
 type Case = (&'static str, Scene, (u32, u32), &'static [(&'static str, &'static str)]);
 
