@@ -14,8 +14,11 @@
 //! lit; one that covers the pyramid: dark; a few: each ray tested against
 //! them; too many: the light cut into quarters, each with its own pyramid),
 //! and rays that still traverse the BVH first try the triangles that blocked
-//! the pixel's last rays. `GroundTruth::visibility_per_ray` is the plain
-//! definition, which a test compares it with.
+//! the pixel's last rays. Those tests use each triangle's edges and normal
+//! computed once (obvhs's arithmetic, so the same answers bit for bit), and a
+//! gather tests a BVH node's eight children against the pyramid at once.
+//! `GroundTruth::visibility_per_ray` is the plain definition, which a test
+//! compares it with.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -23,6 +26,7 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
@@ -66,12 +70,73 @@ impl Pyramid {
         Some(Self { apex, base, planes })
     }
 
-    /// True when the box lies wholly beyond one plane by more than `margin`.
-    fn box_outside(&self, min: Vec3, max: Vec3, margin: f32) -> bool {
-        self.planes.iter().any(|(normal, offset)| {
-            let nearest = Vec3::select(normal.cmpge(Vec3::ZERO), min, max);
-            normal.dot(nearest) > offset + margin
-        })
+    /// Bit k set when child k of `node` lies wholly beyond one plane by more than `margin` (the
+    /// eight children at once): each plane moved into the node's quantised child frame, where a
+    /// child's box is its six bytes of bounds.
+    fn children_outside(&self, node: &CwBvhNode, margin: f32) -> u8 {
+        let extent = Vec3::new(
+            f32::from_bits(u32::from(node.e[0]) << 23),
+            f32::from_bits(u32::from(node.e[1]) << 23),
+            f32::from_bits(u32::from(node.e[2]) << 23),
+        );
+        let mut outside = [false; 8];
+        for (normal, offset) in &self.planes {
+            let scaled = *normal * extent;
+            let limit = offset + margin - normal.dot(node.p);
+            // The child's corner nearest the inside of the plane, one axis at a time.
+            let xs = if normal.x >= 0.0 { &node.child_min_x } else { &node.child_max_x };
+            let ys = if normal.y >= 0.0 { &node.child_min_y } else { &node.child_max_y };
+            let zs = if normal.z >= 0.0 { &node.child_min_z } else { &node.child_max_z };
+            for k in 0..8 {
+                let distance = scaled.x * f32::from(xs[k]) + scaled.y * f32::from(ys[k]) + scaled.z * f32::from(zs[k]);
+                outside[k] |= distance > limit;
+            }
+        }
+        outside.iter().enumerate().fold(0, |bits, (k, out)| bits | (u8::from(*out) << k))
+    }
+}
+
+/// A triangle as the shortcuts test it: its first corner, two edges and (unnormalised) normal
+/// computed once, so that each test does what `Triangle::intersect` does without computing them
+/// again. The same operations on the same values, in the same order: the same answer, bit for bit
+/// (the tests compare the shortcuts, which use it, with the per-ray traversal, which does not).
+#[derive(Clone, Copy)]
+struct PreparedTriangle {
+    v0: Vec3A,
+    /// `v0 - v1`.
+    e1: Vec3A,
+    /// `v2 - v0`.
+    e2: Vec3A,
+    /// `e1 × e2`.
+    normal: Vec3A,
+}
+
+impl PreparedTriangle {
+    fn new(triangle: &Triangle) -> Self {
+        let e1 = triangle.v0 - triangle.v1;
+        let e2 = triangle.v2 - triangle.v0;
+        Self { v0: triangle.v0, e1, e2, normal: e1.cross(e2) }
+    }
+
+    /// The distance along `ray` to the triangle, `f32::INFINITY` for none in [tmin, tmax]:
+    /// obvhs 0.4's `Triangle::intersect` (Möller and Trumbore), step for step.
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray) -> f32 {
+        let c = self.v0 - ray.origin;
+        let r = ray.direction.cross(c);
+        let inv_det = 1.0 / self.normal.dot(ray.direction);
+        let u = r.dot(self.e2) * inv_det;
+        let v = r.dot(self.e1) * inv_det;
+        let w = 1.0 - u - v;
+        // Every barycentric's sign bit clear (as obvhs: -0.0 counts as outside).
+        let hit = u.to_bits() | v.to_bits() | w.to_bits();
+        if inv_det != 0.0 && hit & 0x8000_0000 == 0 {
+            let t = self.normal.dot(c) * inv_det;
+            if t >= ray.tmin && t <= ray.tmax {
+                return t;
+            }
+        }
+        f32::INFINITY
     }
 }
 
@@ -125,6 +190,10 @@ fn segment_ray(origin: Vec3, target: Vec3) -> Option<Ray> {
 /// The scene's triangles in a BVH, ready for shadow rays.
 pub struct GroundTruth {
     triangles: Vec<Triangle>,
+    /// The same triangles, prepared for the shortcuts' tests.
+    prepared: Vec<PreparedTriangle>,
+    /// Each triangle's unit normal (zero where it has none), for [`GroundTruth::may_cross`].
+    normals: Vec<Vec3>,
     bvh: CwBvh,
     /// Offset of ray origins off the surface, world units (scaled to the scene).
     surface_offset: f32,
@@ -297,9 +366,25 @@ impl GroundTruth {
         let triangles: Vec<Triangle> = traced_triangles(scene)
             .map(|[v0, v1, v2]| Triangle { v0: Vec3A::from(v0), v1: Vec3A::from(v1), v2: Vec3A::from(v2) })
             .collect();
+        let prepared = triangles.iter().map(PreparedTriangle::new).collect();
+        let normals = triangles
+            .iter()
+            .map(|t| {
+                let corners = [Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2)];
+                (corners[1] - corners[0]).cross(corners[2] - corners[0]).try_normalize().unwrap_or(Vec3::ZERO)
+            })
+            .collect();
         let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
         let extent = scene.bounds().size().length().max(1e-6);
-        Self { triangles, bvh, surface_offset: extent * 1e-5, cache: ReferenceCache::of(scene), traversal: Traversal::Shortcuts }
+        Self {
+            triangles,
+            prepared,
+            normals,
+            bvh,
+            surface_offset: extent * 1e-5,
+            cache: ReferenceCache::of(scene),
+            traversal: Traversal::Shortcuts,
+        }
     }
 
     /// This tracer with `traversal` for [`GroundTruth::trace`] (the same visibility either way).
@@ -328,12 +413,9 @@ impl GroundTruth {
         stack.push(0);
         while let Some(index) = stack.pop() {
             let node = &self.bvh.nodes[index as usize];
+            let outside = pyramid.children_outside(node, margin);
             for child in 0..8 {
-                if node.is_child_empty(child) {
-                    continue;
-                }
-                let aabb = node.child_aabb(child);
-                if pyramid.box_outside(Vec3::from(aabb.min), Vec3::from(aabb.max), margin) {
+                if node.is_child_empty(child) || outside & (1 << child) != 0 {
                     continue;
                 }
                 if node.is_leaf(child) {
@@ -373,9 +455,10 @@ impl GroundTruth {
         if pyramid.planes.iter().any(|(normal, offset)| corners.iter().all(|c| normal.dot(*c) > offset + margin)) {
             return false;
         }
-        let Some(normal) = (corners[1] - corners[0]).cross(corners[2] - corners[0]).try_normalize() else {
+        let normal = self.normals[index as usize];
+        if normal == Vec3::ZERO {
             return true;
-        };
+        }
         let clearance = 0.5 * self.surface_offset;
         let side = |p: Vec3| normal.dot(p - corners[0]);
         let first = side(pyramid.apex);
@@ -388,14 +471,13 @@ impl GroundTruth {
         })
     }
 
-    /// The triangle the BVH finds first on the segment from `origin` to `target` (the segment and
-    /// test of [`GroundTruth::unoccluded`]), if any.
-    fn first_blocker(&self, origin: Vec3, target: Vec3) -> Option<u32> {
-        let ray = segment_ray(origin, target)?;
+    /// The triangle the BVH finds first on `ray` (a [`segment_ray`], with the test of
+    /// [`GroundTruth::unoccluded`]), if any.
+    fn first_blocker(&self, ray: Ray) -> Option<u32> {
         let mut found = None;
         self.bvh.ray_traverse_miss(ray, |ray, id| {
             let index = self.bvh.primitive_indices[id];
-            let t = self.triangles[index as usize].intersect(ray);
+            let t = self.prepared[index as usize].intersect(ray);
             if t < ray.tmax {
                 found = Some(index);
             }
@@ -408,7 +490,7 @@ impl GroundTruth {
     /// segment and intersection test as [`GroundTruth::unoccluded`]).
     fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
         segment_ray(origin, target)
-            .is_some_and(|ray| candidates.iter().any(|index| self.triangles[*index as usize].intersect(&ray) < ray.tmax))
+            .is_some_and(|ray| candidates.iter().any(|index| self.prepared[*index as usize].intersect(&ray) < ray.tmax))
     }
 
     /// True when the ray from `origin` to `target` is blocked: by one of the triangles in
@@ -416,8 +498,9 @@ impl GroundTruth {
     /// triangle the BVH finds, which `recent` then remembers. The same answer as
     /// `!unoccluded`: a ray a remembered triangle blocks is blocked.
     fn blocked_remembering(&self, origin: Vec3, target: Vec3, recent: &mut RecentBlockers) -> bool {
-        self.blocked_by(origin, target, recent.triangles())
-            || self.first_blocker(origin, target).map(|blocker| recent.push(blocker)).is_some()
+        let Some(ray) = segment_ray(origin, target) else { return false };
+        recent.triangles().iter().any(|index| self.prepared[*index as usize].intersect(&ray) < ray.tmax)
+            || self.first_blocker(ray).map(|blocker| recent.push(blocker)).is_some()
     }
 
     /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
@@ -788,6 +871,96 @@ mod tests {
         assert!((mean - 0.5).abs() < 0.01, "{mean}");
         assert_eq!(samples[0], b.next_f32());
         assert_ne!(SplitMix64::for_pixel(7, 4).next_u64(), SplitMix64::for_pixel(7, 3).next_u64());
+    }
+
+    /// A point in [-1, 1)^3 from `rng`.
+    fn random_point(rng: &mut SplitMix64) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE
+    }
+
+    /// The prepared triangle answers as obvhs's `Triangle::intersect`, bit for bit: on random
+    /// rays, on rays through a corner or an edge (where rounding decides), inside it, in its
+    /// plane, and on segments that end before it.
+    #[test]
+    fn prepared_triangles_intersect_as_obvhs_bit_for_bit() {
+        let mut rng = SplitMix64::for_pixel(11, 0);
+        let (mut compared, mut hits) = (0, 0);
+        for _ in 0..2_000 {
+            let triangle = Triangle {
+                v0: Vec3A::from(random_point(&mut rng)),
+                v1: Vec3A::from(random_point(&mut rng)),
+                v2: Vec3A::from(random_point(&mut rng)),
+            };
+            let prepared = PreparedTriangle::new(&triangle);
+            let [v0, v1, v2] = [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from);
+            let origin = random_point(&mut rng) * 3.0;
+            let (a, b) = (rng.next_f32(), rng.next_f32());
+            let targets = [
+                random_point(&mut rng) * 3.0,
+                v0,
+                v1,
+                (v1 + v2) * 0.5,
+                v0 + (v1 - v0) * a,
+                v0 + (v1 - v0) * a + (v2 - v0) * b,
+                // In the triangle's plane: beside it or through it.
+                origin + (v1 - v0) * a + (v2 - v0) * b,
+            ];
+            for aim in targets {
+                // Past the point aimed at, so that the segment crosses the triangle's plane.
+                let target = origin + (aim - origin) * 2.0;
+                let Some(ray) = segment_ray(origin, target) else { continue };
+                for ray in [ray, Ray { tmax: ray.tmax * 0.5, ..ray }] {
+                    let (expected, actual) = (triangle.intersect(&ray), prepared.intersect(&ray));
+                    assert_eq!(expected.to_bits(), actual.to_bits(), "origin {origin}, through {aim}: {expected} against {actual}");
+                    compared += 1;
+                    hits += usize::from(expected.is_finite());
+                }
+            }
+        }
+        assert!(hits > compared / 10 && hits < compared, "{hits} hits of {compared}: both cases must be seen");
+    }
+
+    /// All eight children of a BVH node tested against a pyramid at once say what each child's
+    /// own box says: never outside where its box meets the pyramid, and outside wherever the box
+    /// lies beyond a plane by more than rounding.
+    #[test]
+    fn children_outside_a_pyramid_agree_with_each_childs_box() {
+        let mut rng = SplitMix64::for_pixel(12, 0);
+        let triangles: Vec<Triangle> = (0..3_000)
+            .map(|_| {
+                let centre = random_point(&mut rng) * 4.0;
+                let [a, b, c] = [(); 3].map(|()| Vec3A::from(centre + random_point(&mut rng) * 0.2));
+                Triangle { v0: a, v1: b, v2: c }
+            })
+            .collect();
+        let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
+        let light = RectLight::try_facing(Vec3::new(0.0, 6.0, 0.0), Vec3::NEG_Y, Vec3::X, Vec2::splat(1.5), 1.0).unwrap();
+        let (mut outside, mut inside) = (0, 0);
+        for _ in 0..50 {
+            let apex = random_point(&mut rng) * Vec3::new(4.0, 1.0, 4.0) - Vec3::Y * 4.0;
+            let (s, t) = (rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.0);
+            let corners = [light.point(-1.0, -1.0), light.point(s, -1.0), light.point(s, t), light.point(-1.0, t)];
+            let Some(pyramid) = Pyramid::new(apex, corners, &light) else { continue };
+            for node in &bvh.nodes {
+                let bits = pyramid.children_outside(node, 0.0);
+                for child in (0..8).filter(|child| !node.is_child_empty(*child)) {
+                    let aabb = node.child_aabb(child);
+                    let (min, max) = (Vec3::from(aabb.min), Vec3::from(aabb.max));
+                    // How far the box lies beyond its farthest plane (negative: it meets every half-space).
+                    let beyond = pyramid
+                        .planes
+                        .iter()
+                        .map(|(normal, offset)| normal.dot(Vec3::select(normal.cmpge(Vec3::ZERO), min, max)) - offset)
+                        .fold(f32::NEG_INFINITY, f32::max);
+                    let said_outside = bits & (1 << child) != 0;
+                    if beyond.abs() > 1e-4 {
+                        assert_eq!(said_outside, beyond > 0.0, "child {child}: beyond by {beyond}");
+                    }
+                    if said_outside { outside += 1 } else { inside += 1 }
+                }
+            }
+        }
+        assert!(outside > 1_000 && inside > 1_000, "{outside} outside, {inside} inside: both must be seen");
     }
 }
 
