@@ -159,7 +159,7 @@ impl PixelRays<'_> {
     }
 }
 
-/// The last few triangles that blocked a pixel's rays, newest first.
+/// The last few triangles that blocked a pixel's rays (their BVH slots), newest first.
 #[derive(Default)]
 struct RecentBlockers {
     slots: [u32; 4],
@@ -190,7 +190,9 @@ fn segment_ray(origin: Vec3, target: Vec3) -> Option<Ray> {
 /// The scene's triangles in a BVH, ready for shadow rays.
 pub struct GroundTruth {
     triangles: Vec<Triangle>,
-    /// The same triangles, prepared for the shortcuts' tests.
+    /// The same triangles prepared for the shortcuts' tests, in the BVH's primitive order (slot
+    /// k holds triangle `bvh.primitive_indices[k]`), so that a traversal reads a leaf's triangles
+    /// side by side without looking their indices up. The shortcuts name triangles by slot.
     prepared: Vec<PreparedTriangle>,
     /// Each triangle's unit normal (zero where it has none), for [`GroundTruth::may_cross`].
     normals: Vec<Vec3>,
@@ -366,7 +368,6 @@ impl GroundTruth {
         let triangles: Vec<Triangle> = traced_triangles(scene)
             .map(|[v0, v1, v2]| Triangle { v0: Vec3A::from(v0), v1: Vec3A::from(v1), v2: Vec3A::from(v2) })
             .collect();
-        let prepared = triangles.iter().map(PreparedTriangle::new).collect();
         let normals = triangles
             .iter()
             .map(|t| {
@@ -375,6 +376,7 @@ impl GroundTruth {
             })
             .collect();
         let bvh = build_cwbvh_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
+        let prepared = bvh.primitive_indices.iter().map(|index| PreparedTriangle::new(&triangles[*index as usize])).collect();
         let extent = scene.bounds().size().length().max(1e-6);
         Self {
             triangles,
@@ -402,7 +404,7 @@ impl GroundTruth {
 
     /// The triangles that can cross a segment inside `pyramid` (their BVH leaf boxes meet it,
     /// no plane of it has all three corners beyond, and their own plane does not pass beside
-    /// it), into `found`; `false` as soon as there are more than `limit`.
+    /// it), by BVH slot, into `found`; `false` as soon as there are more than `limit`.
     fn pyramid_candidates(&self, pyramid: &Pyramid, limit: usize, found: &mut Vec<u32>) -> bool {
         found.clear();
         if self.bvh.nodes.is_empty() {
@@ -421,9 +423,8 @@ impl GroundTruth {
                 if node.is_leaf(child) {
                     let (start, count) = node.child_primitives(child);
                     for slot in start..start + count {
-                        let index = self.bvh.primitive_indices[slot as usize];
-                        if self.may_cross(index, pyramid) {
-                            found.push(index);
+                        if self.may_cross(self.bvh.primitive_indices[slot as usize], pyramid) {
+                            found.push(slot);
                         }
                     }
                     if found.len() > limit {
@@ -471,26 +472,25 @@ impl GroundTruth {
         })
     }
 
-    /// The triangle the BVH finds first on `ray` (a [`segment_ray`], with the test of
-    /// [`GroundTruth::unoccluded`]), if any.
+    /// The BVH slot of the triangle the BVH finds first on `ray` (a [`segment_ray`], with the
+    /// test of [`GroundTruth::unoccluded`]), if any.
     fn first_blocker(&self, ray: Ray) -> Option<u32> {
         let mut found = None;
-        self.bvh.ray_traverse_miss(ray, |ray, id| {
-            let index = self.bvh.primitive_indices[id];
-            let t = self.prepared[index as usize].intersect(ray);
+        self.bvh.ray_traverse_miss(ray, |ray, slot| {
+            let t = self.prepared[slot].intersect(ray);
             if t < ray.tmax {
-                found = Some(index);
+                found = Some(slot as u32);
             }
             t
         });
         found
     }
 
-    /// True when the ray from `origin` to `target` crosses one of `candidates` (the same
+    /// True when the ray from `origin` to `target` crosses one of `candidates` (BVH slots; the same
     /// segment and intersection test as [`GroundTruth::unoccluded`]).
     fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
         segment_ray(origin, target)
-            .is_some_and(|ray| candidates.iter().any(|index| self.prepared[*index as usize].intersect(&ray) < ray.tmax))
+            .is_some_and(|ray| candidates.iter().any(|slot| self.prepared[*slot as usize].intersect(&ray) < ray.tmax))
     }
 
     /// True when the ray from `origin` to `target` is blocked: by one of the triangles in
@@ -499,7 +499,7 @@ impl GroundTruth {
     /// `!unoccluded`: a ray a remembered triangle blocks is blocked.
     fn blocked_remembering(&self, origin: Vec3, target: Vec3, recent: &mut RecentBlockers) -> bool {
         let Some(ray) = segment_ray(origin, target) else { return false };
-        recent.triangles().iter().any(|index| self.prepared[*index as usize].intersect(&ray) < ray.tmax)
+        recent.triangles().iter().any(|slot| self.prepared[*slot as usize].intersect(&ray) < ray.tmax)
             || self.first_blocker(ray).map(|blocker| recent.push(blocker)).is_some()
     }
 
@@ -567,7 +567,8 @@ impl GroundTruth {
             let mut found = Vec::new();
             let complete = match parent {
                 Some(parent) => {
-                    found.extend(parent.iter().copied().filter(|index| self.may_cross(*index, &pyramid)));
+                    found
+                        .extend(parent.iter().copied().filter(|slot| self.may_cross(self.bvh.primitive_indices[*slot as usize], &pyramid)));
                     true
                 }
                 // Gathering from the BVH costs a traversal: only for the whole light and its quarters.
@@ -578,7 +579,7 @@ impl GroundTruth {
         });
         match gathered {
             Some(candidates) if candidates.is_empty() => strata,
-            Some(candidates) if candidates.iter().any(|index| corners.iter().all(|c| self.blocked_by(rays.origin, *c, &[*index]))) => 0,
+            Some(candidates) if candidates.iter().any(|slot| corners.iter().all(|c| self.blocked_by(rays.origin, *c, &[*slot]))) => 0,
             Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
                 let mut visible = 0;
                 for j in j0..j1 {
