@@ -69,10 +69,12 @@ fn a_parameter_varied_twice_is_refused() {
 fn a_preset_carries_its_papers_image_size() {
     use ssm_bench::sweep::{DEFAULT_SIZE, image_size};
     let registry = ssm_bench::registry().unwrap();
+    let steps = preset(registry, "sssm-steps").unwrap();
+    assert_eq!(steps.size, Some((1280, 720)), "Buades et al., Sec. 5: a 1,280 × 720 viewport");
     let table4 = preset(registry, "sssm-table4").unwrap();
-    assert_eq!(table4.size, Some((1280, 720)), "Buades et al., Sec. 5: a 1,280 × 720 viewport");
-    assert_eq!(image_size(None, None, Some(&table4)), (1280, 720));
-    assert_eq!(image_size(Some(320), None, Some(&table4)), (320, 720));
+    assert_eq!(table4.size, Some((1280, 960)), "Buades et al., Table 4's caption: a 1,280 × 960 viewport");
+    assert_eq!(image_size(None, None, Some(&table4)), (1280, 960));
+    assert_eq!(image_size(Some(320), None, Some(&table4)), (320, 960));
     assert_eq!(image_size(Some(320), Some(240), Some(&table4)), (320, 240));
     let trade = trade_preset(registry);
     assert_eq!(image_size(None, None, Some(&trade)), DEFAULT_SIZE);
@@ -81,5 +83,20 @@ fn a_preset_carries_its_papers_image_size() {
         if let Some((width, height)) = spec.size {
             assert!(width > 0 && height > 0, "preset {}: {width}x{height}", spec.name);
         }
+    }
+}
+
+/// Buades et al.'s Table 4 preset sweeps the table's own rows: its three kernel pairs for both
+/// techniques and its five SSSM thresholds (α; β with it), the paper's headline α = 0.1 among them.
+#[test]
+fn the_table4_preset_sweeps_the_tables_rows() {
+    let registry = ssm_bench::registry().unwrap();
+    let table4 = preset(registry, "sssm-table4").unwrap();
+    for expected in [
+        "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+        "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+        "sssm.alpha:beta=0.01:0.01,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
+    ] {
+        assert!(table4.varies.iter().any(|vary| vary == expected), "{expected} missing from {:?}", table4.varies);
     }
 }
