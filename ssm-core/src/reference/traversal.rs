@@ -1,13 +1,14 @@
-//! A shadow ray's traversal of the ground truth's CWBVH for the shortcuts' rays that still
-//! traverse it: obvhs 0.4's `CwBvh::ray_traverse_miss` (its `traverse!` loop and its SSE node
-//! test, `CwBvhNode::intersect_ray_simd`), with each node's quantised child bounds converted to
-//! floats once, when the BVH is built, rather than at every visit. By obvhs's own comment that
-//! conversion is the costliest part of its node test; here a node test is plain float arithmetic
-//! on eight lanes, which the compiler vectorises without unsafe code.
+//! The ground truth's CWBVH as the shortcuts read it: obvhs 0.4's nodes with each child's
+//! quantised bounds converted to floats once, when the BVH is built, rather than at every visit
+//! (by obvhs's own comment, that conversion is the costliest part of its node test). A node's
+//! eight boxes are then plain float arithmetic on eight lanes, which the compiler vectorises
+//! without unsafe code, for the two traversals the shortcuts make: a shadow ray's, which is
+//! obvhs's `CwBvh::ray_traverse_miss` (its `traverse!` loop and its SSE node test,
+//! `CwBvhNode::intersect_ray_simd`) step for step, and a pyramid's gather of the leaves it meets.
 //!
 //! The same float operations in the same order on the same values (a byte converted to a float
-//! is exact either way): the same children are entered, in the same order, so the same triangles
-//! are offered to the caller in the same order. A test compares the sequence with obvhs's.
+//! is exact either way): a ray enters the same children in the same order, so it is offered the
+//! same triangles in the same order. A test compares the sequence with obvhs's.
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
@@ -44,6 +45,9 @@ struct DecodedNode {
 
 impl DecodedNode {
     fn new(node: &CwBvhNode) -> Self {
+        // `hit_mask` places inner child k's bit as obvhs's builder numbers it (meta byte 24 + k);
+        // the traversal test fails if a new obvhs numbers them otherwise.
+        debug_assert!((0..8).all(|k| node.imask & (1 << k) == 0 || usize::from(node.child_meta[k] & 0b1_1111) == 24 + k));
         let floats = |bytes: &[u8; 8]| bytes.map(f32::from);
         // obvhs's `get_child_and_index_bits` for a leaf child, whose bits do not depend on the
         // octant: the unary triangle count (the meta byte's top three bits) shifted to the
@@ -98,9 +102,7 @@ impl DecodedNode {
         }
         (permute_by_xor(entered & u32::from(self.inner), octant) << 24) | leaves
     }
-}
 
-impl DecodedNode {
     /// Bit k set when child k lies wholly beyond one of `planes` (outward normal, offset) by
     /// more than `margin`, the eight children at once: each plane moved into the node's
     /// quantisation frame, where a child's box is its six bounds.
@@ -155,7 +157,11 @@ fn min_ps(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }
 }
 
-/// The ground truth's CWBVH with its nodes decoded for [`DecodedBvh::traverse`].
+// Four cache lines: the bounds (192 bytes), the leaf bits (32) and the rest (24), padded.
+const _: () = assert!(std::mem::size_of::<DecodedNode>() == 256);
+
+/// The ground truth's CWBVH with its nodes decoded for [`DecodedBvh::traverse`] and
+/// [`DecodedBvh::gather`].
 pub(super) struct DecodedBvh {
     nodes: Vec<DecodedNode>,
 }
