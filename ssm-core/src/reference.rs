@@ -391,7 +391,7 @@ impl GroundTruth {
     fn pyramid_candidates(&self, pyramid: &Pyramid, limit: usize, found: &mut Vec<u32>) -> bool {
         found.clear();
         self.decoded.gather(&pyramid.planes, self.pyramid_margin(), |first, count| {
-            found.extend((first..first + count).filter(|slot| self.may_cross(self.bvh.primitive_indices[*slot as usize], pyramid)));
+            found.extend((first..first + count).filter(|slot| self.may_cross(*slot, pyramid)));
             found.len() <= limit
         })
     }
@@ -402,19 +402,20 @@ impl GroundTruth {
         self.surface_offset * 10.0
     }
 
-    /// Whether triangle `index` can cross a segment from the pyramid's apex to its base: no
+    /// Whether the triangle in BVH slot `slot` can cross a segment from the pyramid's apex to its base: no
     /// plane of the pyramid has all three of its corners beyond, and its own plane does not
     /// have the apex and the base's corners all on one side, clear of it by half the surface
     /// offset (no segment then crosses it: this drops the surface a point lies on, which its
     /// rays leave by the surface offset, and faces turned away from the light).
-    fn may_cross(&self, index: u32, pyramid: &Pyramid) -> bool {
-        let triangle = &self.triangles[index as usize];
+    fn may_cross(&self, slot: u32, pyramid: &Pyramid) -> bool {
+        let index = self.bvh.primitive_indices[slot as usize] as usize;
+        let triangle = &self.triangles[index];
         let corners = [Vec3::from(triangle.v0), Vec3::from(triangle.v1), Vec3::from(triangle.v2)];
         let margin = self.pyramid_margin();
         if pyramid.planes.iter().any(|(normal, offset)| corners.iter().all(|c| normal.dot(*c) > offset + margin)) {
             return false;
         }
-        let normal = self.normals[index as usize];
+        let normal = self.normals[index];
         if normal == Vec3::ZERO {
             return true;
         }
@@ -435,7 +436,7 @@ impl GroundTruth {
     fn first_blocker(&self, ray: &Ray, stack: &mut Vec<UVec2>) -> Option<u32> {
         let mut found = None;
         self.decoded.traverse(ray, stack, |slot| {
-            let blocks = self.prepared[slot].intersect(ray) < ray.tmax;
+            let blocks = self.crosses(ray, slot as u32);
             if blocks {
                 found = Some(slot as u32);
             }
@@ -444,11 +445,16 @@ impl GroundTruth {
         found
     }
 
+    /// True when `ray` crosses the triangle in BVH slot `slot` before its `tmax`.
+    #[inline(always)]
+    fn crosses(&self, ray: &Ray, slot: u32) -> bool {
+        self.prepared[slot as usize].intersect(ray) < ray.tmax
+    }
+
     /// True when the ray from `origin` to `target` crosses one of `candidates` (BVH slots; the same
     /// segment and intersection test as [`GroundTruth::unoccluded`]).
     fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
-        segment_ray(origin, target)
-            .is_some_and(|ray| candidates.iter().any(|slot| self.prepared[*slot as usize].intersect(&ray) < ray.tmax))
+        segment_ray(origin, target).is_some_and(|ray| candidates.iter().any(|slot| self.crosses(&ray, *slot)))
     }
 
     /// True when the ray from `origin` to `target` is blocked: by one of the triangles in
@@ -457,7 +463,7 @@ impl GroundTruth {
     /// `!unoccluded`: a ray a remembered triangle blocks is blocked.
     fn blocked_remembering(&self, origin: Vec3, target: Vec3, recent: &mut RecentBlockers) -> bool {
         let Some(ray) = segment_ray(origin, target) else { return false };
-        recent.triangles().iter().any(|slot| self.prepared[*slot as usize].intersect(&ray) < ray.tmax)
+        recent.triangles().iter().any(|slot| self.crosses(&ray, *slot))
             || self.first_blocker(&ray, &mut recent.traversal_stack).map(|blocker| recent.push(blocker)).is_some()
     }
 
@@ -525,8 +531,7 @@ impl GroundTruth {
             let mut found = Vec::new();
             let complete = match parent {
                 Some(parent) => {
-                    found
-                        .extend(parent.iter().copied().filter(|slot| self.may_cross(self.bvh.primitive_indices[*slot as usize], &pyramid)));
+                    found.extend(parent.iter().copied().filter(|slot| self.may_cross(*slot, &pyramid)));
                     true
                 }
                 // Gathering from the BVH costs a traversal: only for the whole light and its quarters.

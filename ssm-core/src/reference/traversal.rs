@@ -74,6 +74,17 @@ impl DecodedNode {
         }
     }
 
+    /// The size of one quantisation step on each axis (obvhs's `CwBvhNode::compute_extent`):
+    /// a power of two, from its exponent byte.
+    #[inline(always)]
+    fn extent(&self) -> Vec3A {
+        Vec3A::new(
+            f32::from_bits(u32::from(self.exponents[0]) << 23),
+            f32::from_bits(u32::from(self.exponents[1]) << 23),
+            f32::from_bits(u32::from(self.exponents[2]) << 23),
+        )
+    }
+
     /// The node's hit mask for `ray`, as `CwBvhNode::intersect_ray_simd` computes it: the inner
     /// children entered in the high byte (inner child k at bit 24 + (k ^ octant): obvhs's builder
     /// gives it meta byte 24 + k), the entered leaves' triangles in the low 24 bits. `near` holds,
@@ -81,12 +92,7 @@ impl DecodedNode {
     /// obvhs's `oct_inv4`.
     #[inline(always)]
     fn hit_mask(&self, ray: &Ray, near: [usize; 3], octant: u32) -> u32 {
-        let extent = Vec3A::new(
-            f32::from_bits(u32::from(self.exponents[0]) << 23),
-            f32::from_bits(u32::from(self.exponents[1]) << 23),
-            f32::from_bits(u32::from(self.exponents[2]) << 23),
-        );
-        let scale = extent * ray.inv_direction;
+        let scale = self.extent() * ray.inv_direction;
         let offset = (Vec3A::from(self.origin) - ray.origin) * ray.inv_direction;
         let (near_x, near_y, near_z) = (&self.bounds[near[0]], &self.bounds[near[1]], &self.bounds[near[2]]);
         let (far_x, far_y, far_z) = (&self.bounds[near[0] ^ 1], &self.bounds[near[1] ^ 1], &self.bounds[near[2] ^ 1]);
@@ -108,11 +114,7 @@ impl DecodedNode {
     /// quantisation frame, where a child's box is its six bounds.
     #[inline(always)]
     fn children_beyond(&self, planes: &[(Vec3, f32)], margin: f32) -> u8 {
-        let extent = Vec3::new(
-            f32::from_bits(u32::from(self.exponents[0]) << 23),
-            f32::from_bits(u32::from(self.exponents[1]) << 23),
-            f32::from_bits(u32::from(self.exponents[2]) << 23),
-        );
+        let extent = Vec3::from(self.extent());
         let mut beyond = [false; 8];
         for (normal, offset) in planes {
             let scaled = *normal * extent;
