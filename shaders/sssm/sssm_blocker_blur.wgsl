@@ -32,11 +32,12 @@ fn store_penumbra_error(texel: vec2<i32>) {
 // The blocker sum and count over every row of the n×n window, none reused: PCSS's search, and
 // what SSSM's rows add up to with α = 0.
 fn full_blocker_search(uvd: vec3<f32>, search: vec2<f32>, receiver: TapPlane, n: u32) -> vec2<f32> {
+    let steps = kernel_steps(n);
     var sum = 0.0;
     var count = 0.0;
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
-            let tap = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
+            let tap = uvd.xy + vec2<f32>(kernel_offset(steps, i), kernel_offset(steps, j)) * search;
             let depth = shadow_map_depth(shadow_map, tap);
             if (depth < tap_plane_depth(receiver, tap)) {
                 sum += depth;
@@ -80,6 +81,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     let receiver = compared_plane(lookup, point.normal, d);
     let search = light_half_extent_uv(frame, frame.projection.z, d);
     let n = runtime_count(max(settings.blocker_kernel, 1u), point.texel);
+    let steps = kernel_steps(n);
     var sum = 0.0;
     var count = 0.0;
     var reused = 0.0;
@@ -90,8 +92,8 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     var failed_rows = FailedRows();
     for (var t = 0u; t < n; t++) {
         // The pixel that sees the point of this row at the same light depth d (Fig. 4).
-        let clip = mix(first_clip, last_clip, grid_offset(t, n) * 0.5 + 0.5);
-        let ndc = clip.xy / clip.w;
+        let clip = mix(first_clip, last_clip, kernel_offset(steps, t) * 0.5 + 0.5);
+        let ndc = clip.xy * (1.0 / clip.w);
         let screen = vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
         var reuse = false;
         var no_data = false;
@@ -117,9 +119,9 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         if (failed < 0) {
             break;
         }
-        let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(u32(failed), n) * search.y);
+        let row_uv = vec2<f32>(uvd.x, uvd.y + kernel_offset(steps, u32(failed)) * search.y);
         for (var i = 0u; i < n; i++) {
-            let tap = row_uv + vec2<f32>(grid_offset(i, n) * search.x, 0.0);
+            let tap = row_uv + vec2<f32>(kernel_offset(steps, i) * search.x, 0.0);
             let depth = shadow_map_depth(shadow_map, tap);
             reads += 1u;
             if (depth < tap_plane_depth(receiver, tap)) {
@@ -165,6 +167,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
 fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
     let radii = searched.yz;
     let m = runtime_count(max(settings.blur_kernel, 1u), point.texel);
+    let steps = kernel_steps(m);
     let rays = camera_rays();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(radii.x, 0.0));
     var blurred = 0.0;
@@ -173,7 +176,7 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
     var first_on_screen = m;
     var last_on_screen = -1;
     for (var j = 0u; j < m; j++) {
-        let offset = grid_offset(j, m);
+        let offset = kernel_offset(steps, j);
         let tap = vec2<f32>(centre.x + offset * radii.x, centre.y);
         if (on_screen(tap)) {
             let source = horizontal_source(vec2<i32>(tap));
@@ -195,7 +198,7 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
     let after = select(m - 1u - u32(last_on_screen), 0u, last_on_screen < 0);
     for (var k = 0u; k < before + after; k++) {
         let j = select(k, u32(last_on_screen + 1) + (k - before), k >= before);
-        let tap = vec2<f32>(centre.x + grid_offset(j, m) * radii.x, centre.y);
+        let tap = vec2<f32>(centre.x + kernel_offset(steps, j) * radii.x, centre.y);
         let plane = tangent_plane_point(rays, point.position, point.normal, tap);
         let weight = tap_weight(j);
         blurred += weight * select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);

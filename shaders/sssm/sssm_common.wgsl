@@ -165,6 +165,27 @@ fn tap_line_distance(line: TapLine, offset: f32) -> f32 {
     return select(-1.0, t * length(direction), abs(denominator) >= 1e-12 && t > 0.0);
 }
 
+// The offsets in [-1, 1] of a kernel's `count` taps, grid_offset's, as (2i + 1 - count) / count
+// with the reciprocal taken once: a multiply-add and a product per tap where grid_offset divides
+// by the count (PCSS's loops need not: lavapipe inlines its kernel sizes and folds the division
+// away; SSSM's are kept out of its reach, see runtime_count). The centre tap of an odd kernel is
+// exactly 0 and the offsets exactly symmetric, as grid_offset's: a search window as wide as a
+// grazing light's makes a blocker search tell an offset of 1e-7 from 0.
+struct KernelSteps {
+    // 1 - count.
+    first: f32,
+    // 1 / count.
+    inverse_count: f32,
+};
+
+fn kernel_steps(count: u32) -> KernelSteps {
+    return KernelSteps(1.0 - f32(count), 1.0 / f32(count));
+}
+
+fn kernel_offset(steps: KernelSteps, i: u32) -> f32 {
+    return (2.0 * f32(i) + steps.first) * steps.inverse_count;
+}
+
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
 fn hard_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
     return tap_visibility(world, lookup_offset(world, normal));
@@ -357,7 +378,8 @@ fn unpack_vertical_tap_source(packed: vec4<f32>) -> BlurSource {
 // test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
 // not leak over edges.
 fn bilateral_weight_of(source: BlurSource, expected_distance: f32, normal: vec3<f32>) -> f32 {
-    let gap = (source.eye_distance - expected_distance) / scene_length(frame, settings.bilateral_depth);
+    // A product with the reciprocal, which the compiler hoists out of the tap loops.
+    let gap = (source.eye_distance - expected_distance) * (1.0 / scene_length(frame, settings.bilateral_depth));
     let turn = max(dot(normal, source.normal), 0.0);
     // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
     // falls to 1/2 at about 23°.

@@ -36,6 +36,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         return vec2<f32>(own.x, own.w / n);
     }
     let m = runtime_count(max(settings.blur_kernel, 1u), point.texel);
+    let steps = kernel_steps(m);
     let rays = camera_rays();
     let own_hard = packed_hard_value(textureLoad(blur_source, point.texel, 0));
     reads += 1u;
@@ -50,7 +51,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // the screen reads the nearest on-screen texel, whose value it does not use.
     let last_texel = vec2<i32>(camera.viewport.xy) - 1;
     for (var j = 0u; j < m; j++) {
-        let offset = grid_offset(j, m);
+        let offset = kernel_offset(steps, j);
         let row = centre + vec2<f32>(0.0, offset * radii.y);
         let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), last_texel));
         let expected = tap_line_distance(line, offset);
@@ -69,7 +70,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         if (failed < 0) {
             break;
         }
-        let row = centre + vec2<f32>(0.0, grid_offset(u32(failed), m) * radii.y);
+        let row = centre + vec2<f32>(0.0, kernel_offset(steps, u32(failed)) * radii.y);
         let weight = tap_weight(u32(failed));
         blurred += weight * recomputed_row(rays, point, offset, own_hard, row, radii.x, m);
         total += weight;
@@ -95,7 +96,7 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
     let axes = mat3x3<f32>(frame.u_axis.xyz, frame.v_axis.xyz, frame.normal.xyz);
     let eye_light = (eye - frame.centre.xyz) * axes;
     let lookup_light = (eye + offset - frame.centre.xyz) * axes;
-    let first_ray = rays.base + (row.x + grid_offset(0u, m) * radius_x) * rays.per_x + row.y * rays.per_y;
+    let first_ray = rays.base + (row.x + kernel_offset(kernel_steps(m), 0u) * radius_x) * rays.per_x + row.y * rays.per_y;
     let ray_step = (2.0 * radius_x / f32(m)) * rays.per_x;
     let first_den = dot(first_ray, normal);
     let den_step = dot(ray_step, normal);
@@ -107,6 +108,34 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
     let first_front = eye_light.z * first_den + plane_offset * first_ray_light.z;
     let front_step = eye_light.z * den_step + plane_offset * ray_step_light.z;
     let half_inverse_projection = 0.5 / frame.projection.xy;
+    // den and the plane point's front distance are linear in the tap index: where each has one
+    // sign at both ends of the row it has that sign at every tap, and so have the plane test
+    // (meets_plane below) and the light test (in_front). Where both pass at every tap, each tap
+    // only compares depths: the same values as the general loop after it, which handles the rows
+    // that cross the eye's or the light's plane (grazing views).
+    let last = f32(m - 1u);
+    let last_den = first_den + last * den_step;
+    let last_front = first_front + last * front_step;
+    let den_kept = first_den * last_den > 0.0 && min(abs(first_den), abs(last_den)) >= 1e-12;
+    let front_kept = first_front * last_front > 0.0;
+    if (den_kept && front_kept && plane_offset * first_den > 0.0 && first_front * first_den > 0.0) {
+        // With den's sign s: s·h.z <= the map's depth · s·den is h.z / den <= the map's depth.
+        let den_sign = select(-1.0, 1.0, first_den > 0.0);
+        let first_signed_h = den_sign * first_h;
+        let signed_h_step = den_sign * h_step;
+        let first_signed_den = den_sign * first_den;
+        let signed_den_step = den_sign * den_step;
+        var lit_sum = 0.0;
+        for (var i = 0u; i < m; i++) {
+            let index = f32(i);
+            let h = first_signed_h + index * signed_h_step;
+            let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
+            reads += 1u;
+            let lit = h.z <= shadow_map_depth(shadow_map, uv) * (first_signed_den + index * signed_den_step);
+            lit_sum += select(0.0, tap_weight(i), lit);
+        }
+        return lit_sum / settings.blur_weight_total;
+    }
     var row_sum = 0.0;
     // Selects rather than branches, and products rather than quotients where a sign decides: a
     // tap costs one division (its light depth's reciprocal) and the same few instructions in
@@ -119,7 +148,8 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
         // In front of the light's plane (tap_visibility's first test).
         let in_front = (first_front + index * front_step) * den > 0.0;
         let h = first_h + index * h_step;
-        let uv = 0.5 + h.xy * (half_inverse_projection / h.z);
+        // One reciprocal for both coordinates.
+        let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
         reads += 1u;
         // h.z / den <= the map's depth, with den's sign.
         let map_depth = shadow_map_depth(shadow_map, uv) * den;
