@@ -3,7 +3,7 @@
 // #import pcss/pcss_common.wgsl
 
 fn tap_depth(uv: vec2<f32>) -> f32 {
-    return shadow_map_depth(shadow_map, uv);
+    return shadow_map_tap(shadow_map, shadow_map_storage, uv);
 }
 
 @fragment

@@ -35,6 +35,8 @@ struct PcssSettings {
 };
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
+// The same map as a read-only storage texture, for the settings' shadow_map_reads = storage.
+@group(2) @binding(3) var shadow_map_storage: texture_storage_2d<r32float, read>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
 // Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;

@@ -24,7 +24,7 @@ var<private> tiled: bool;
 
 fn tap_depth(uv: vec2<f32>) -> f32 {
     if (!tiled || any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
-        return shadow_map_depth(shadow_map, uv);
+        return shadow_map_tap(shadow_map, shadow_map_storage, uv);
     }
     // The texel shadow_map_depth reads, inside the union by construction.
     let texel = vec2<i32>(uv * vec2<f32>(textureDimensions(shadow_map))) - tile_origin;
@@ -68,7 +68,7 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     tile_width = extent.x;
     if (tiled) {
         for (var index = i32(local); index < extent.x * extent.y; index += 64) {
-            tile[index] = textureLoad(shadow_map, low + vec2<i32>(index % extent.x, index / extent.x), 0).x;
+            tile[index] = shadow_map_texel(shadow_map, shadow_map_storage, low + vec2<i32>(index % extent.x, index / extent.x));
         }
     }
     workgroupBarrier();

@@ -38,7 +38,7 @@ fn full_blocker_search(uvd: vec3<f32>, search: vec2<f32>, receiver: TapPlane, n:
     for (var j = 0u; j < n; j++) {
         for (var i = 0u; i < n; i++) {
             let tap = uvd.xy + vec2<f32>(kernel_offset(steps, i), kernel_offset(steps, j)) * search;
-            let depth = shadow_map_depth(shadow_map, tap);
+            let depth = tap_depth(tap);
             if (depth < tap_plane_depth(receiver, tap)) {
                 sum += depth;
                 count += 1.0;
@@ -122,7 +122,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         let row_uv = vec2<f32>(uvd.x, uvd.y + kernel_offset(steps, u32(failed)) * search.y);
         for (var i = 0u; i < n; i++) {
             let tap = row_uv + vec2<f32>(kernel_offset(steps, i) * search.x, 0.0);
-            let depth = shadow_map_depth(shadow_map, tap);
+            let depth = tap_depth(tap);
             reads += 1u;
             if (depth < tap_plane_depth(receiver, tap)) {
                 sum += depth;

@@ -30,6 +30,8 @@ struct SssmSettings {
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
+// The same map as a read-only storage texture, for the settings' shadow_map_reads = storage.
+@group(2) @binding(15) var shadow_map_storage: texture_storage_2d<r32float, read>;
 // Per pass (0 horizontal blocker, 1 blocker and horizontal blur, 2 vertical blur): (pixels,
 // reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
@@ -82,6 +84,11 @@ fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
             atomicAdd(&read_counts[word + 1u], causes[cause]);
         }
     }
+}
+
+// The shadow map's depth at `uv` (shadow_map_depth), read as the settings' shadow_map_reads say.
+fn tap_depth(uv: vec2<f32>) -> f32 {
+    return shadow_map_tap(shadow_map, shadow_map_storage, uv);
 }
 
 // The world point at shadow-map coordinates `uv` and linear light depth `depth` (inverse of light_uv_depth).
@@ -203,7 +210,7 @@ fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
     }
     let uvd = light_uv_depth(frame, world + offset);
     reads += 1u;
-    return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+    return select(0.0, 1.0, uvd.z <= tap_depth(uvd.xy));
 }
 
 // Weight of blur tap `i` of the m taps (Sec. 4.4: Gaussian, or 1 for the mean filter).

@@ -31,7 +31,7 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let receiver = compared_plane(lookup, point.normal, uvd.z);
-    let hard = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+    let hard = select(0.0, 1.0, uvd.z <= tap_depth(uvd.xy));
     reads += 1u;
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
     let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
@@ -41,7 +41,7 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     var count = 0.0;
     for (var i = 0u; i < n; i++) {
         let tap = uvd.xy + vec2<f32>(kernel_offset(steps, i) * search.x, 0.0);
-        let depth = shadow_map_depth(shadow_map, tap);
+        let depth = tap_depth(tap);
         reads += 1u;
         if (depth < tap_plane_depth(receiver, tap)) {
             sum += depth;

@@ -131,7 +131,7 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
             let h = first_signed_h + index * signed_h_step;
             let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
             reads += 1u;
-            let lit = h.z <= shadow_map_depth(shadow_map, uv) * (first_signed_den + index * signed_den_step);
+            let lit = h.z <= tap_depth(uv) * (first_signed_den + index * signed_den_step);
             lit_sum += select(0.0, tap_weight(i), lit);
         }
         return lit_sum / settings.blur_weight_total;
@@ -152,7 +152,7 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
         let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
         reads += 1u;
         // h.z / den <= the map's depth, with den's sign.
-        let map_depth = shadow_map_depth(shadow_map, uv) * den;
+        let map_depth = tap_depth(uv) * den;
         let lit = select(h.z >= map_depth, h.z <= map_depth, den > 0.0);
         let visible = select(own_hard, select(0.0, select(0.0, 1.0, lit), in_front), meets_plane);
         row_sum += tap_weight(i) * visible;

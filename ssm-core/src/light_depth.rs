@@ -85,8 +85,15 @@ impl LightDepthMap {
         let device = &gpu.device;
         let label = desc.label;
         let indices = scene.index_range(label, desc.geometry)?;
-        let linear_depth =
-            render_texture(device, &format!("{label}_linear_depth"), desc.width, desc.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
+        let linear_depth = render_texture(
+            device,
+            &format!("{label}_linear_depth"),
+            desc.width,
+            desc.height,
+            Self::FORMAT,
+            // Storage: for shaders that read it as a read-only storage texture (ShadowMapReads::Storage).
+            wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
+        );
         let depth =
             render_texture(device, &format!("{label}_depth"), desc.width, desc.height, Self::DEPTH_FORMAT, wgpu::TextureUsages::empty());
         let bias_bind_group =
@@ -249,6 +256,49 @@ impl LightDepthMap {
 pub const SHADOW_MAP_MIN_SIZE: u32 = 16;
 /// Largest side of a shadow map a technique may ask for, texels (devices may allow less).
 pub const SHADOW_MAP_MAX_SIZE: u32 = 16384;
+
+/// How a technique's shaders read the texels of its light depth map: the same texels and the
+/// same values either way (`shadow_map_tap` in `shaders/common/shadow_map.wgsl`), so the
+/// choice is the implementation's, not the algorithm's. On lavapipe (Mesa's CPU rasteriser)
+/// a sampled texel fetch goes through a generic function that works out each lane's mip level
+/// and costs several times a storage-texture read, the gather alone; on `leaves` at 320×240
+/// PCSS at 29/41 takes about a third less time with storage reads (the pcss and sssm READMEs
+/// have the figures). GPUs read both through the same caches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, crate::Choice)]
+pub enum ShadowMapReads {
+    /// `textureLoad` of the map bound as a sampled texture (`texture_2d<f32>`).
+    Sampled,
+    /// `textureLoad` of the same map bound as a read-only storage texture
+    /// (`texture_storage_2d<r32float, read>`).
+    Storage,
+}
+
+impl ShadowMapReads {
+    /// The WGSL pipeline constant that selects the read (`SHADOW_MAP_STORAGE_READS`, declared in
+    /// `shaders/common/shadow_map.wgsl`), for the pipelines of shaders that read through
+    /// `shadow_map_tap`.
+    #[must_use]
+    pub fn pipeline_constant(self) -> (&'static str, f64) {
+        ("SHADOW_MAP_STORAGE_READS", f64::from(u8::from(self == Self::Storage)))
+    }
+
+    /// The layout entry of the map as a read-only storage texture at `binding`, in fragment and
+    /// compute stages; bind [`LightDepthMap::linear_depth_view`] to it, beside the sampled binding
+    /// (both are bound whichever read the pipeline uses).
+    #[must_use]
+    pub const fn storage_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::ReadOnly,
+                format: LightDepthMap::FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        }
+    }
+}
 
 /// The bias of a light depth map and of its lookups, shared by the shadow-map
 /// techniques (flatten it into their settings).

@@ -12,7 +12,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
-    bind_group, bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
+    bind_group_layout, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer, uniform_entry,
     write_storage_texture_entry,
 };
 use ssm_core::read_counts::ReadCounts;
@@ -20,8 +20,8 @@ use ssm_core::readback::read_texture;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
     Choice, DebugOutput, ExtraImage, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result,
-    SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind,
-    TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
+    SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias, ShadowMapReads, ShadowTechnique, TechniqueInfo,
+    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -44,6 +44,9 @@ const BLOCKER_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/ss
 const VERTICAL_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_fragment.wgsl");
 /// Step 3 as a compute pass sharing each workgroup's screen column.
 const VERTICAL_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_compute.wgsl");
+/// The binding of the shadow map as a read-only storage texture in every pass's group 2
+/// (`shadow_map_storage` of sssm_common.wgsl), past the passes' own.
+const SHADOW_MAP_STORAGE_BINDING: u32 = 15;
 /// Pixels per workgroup of the compute passes: along the row in step 2, down the column in step 3
 /// (`SEGMENT_PIXELS` of `sssm_segment.wgsl`; step 3's workgroup grid is (row runs, columns)).
 const SHARED_SEGMENT_PIXELS: u32 = 64;
@@ -99,6 +102,9 @@ pub struct SssmSettings {
     /// Blur taps are weighted by exp(-(Δ/t)²) for a camera-distance gap Δ to this pixel's tangent plane, t this fraction of the scene's diagonal, and by their normals' agreement, so shadow does not leak across silhouettes (0: the paper's unweighted blur).
     #[param(default = 0.005, min = 0.0, max = 1.0)]
     pub bilateral_depth: f32,
+    /// How every pass reads the shadow map's texels: sampled (a sampled texture) or storage (the same map as a read-only storage texture; the same texels, cheaper on lavapipe); as pcss's, which has the same choice.
+    #[param(choice, default = "sampled")]
+    pub shadow_map_reads: ShadowMapReads,
     /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
     #[param(choice, default = "fragment")]
     pub blur_passes: BlurPasses,
@@ -290,6 +296,7 @@ impl SeparableSoftShadowMaps {
             depth_map: &depth_map,
             read_counts: &read_counts,
             measure_penumbra_error: settings.penumbra_error,
+            shadow_map_reads: settings.shadow_map_reads,
             targets: &targets,
         };
         let horizontal_blocker_layout = shared.layout("sssm_horizontal_blocker_layout", &[]);
@@ -302,7 +309,7 @@ impl SeparableSoftShadowMaps {
             (&shared.module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
             Some(&horizontal_blocker_layout),
             &[wgpu::TextureFormat::Rgba32Float.into(), wgpu::TextureFormat::Rgba32Float.into()],
-            &read_counts.pipeline_constants(),
+            &shared.constants(),
         )?;
         let blur_steps = match settings.blur_passes {
             BlurPasses::Fragment => shared.fragment_steps()?,
@@ -347,6 +354,8 @@ struct Shared<'a> {
     read_counts: &'a ReadCounts,
     /// The settings' `penumbra_error` (step 2's `MEASURE_PENUMBRA_ERROR`).
     measure_penumbra_error: bool,
+    /// The settings' `shadow_map_reads` (every pass's `SHADOW_MAP_STORAGE_READS`).
+    shadow_map_reads: ShadowMapReads,
     targets: &'a Targets,
 }
 
@@ -355,29 +364,48 @@ impl Shared<'_> {
         create_shader_with_imports(self.setup.gpu, label, source, LOCAL_SHADERS)
     }
 
-    /// Step 2's pipeline constants: whether it counts reads and measures the penumbra error.
-    fn blocker_blur_constants(&self) -> [(&'static str, f64); 2] {
+    /// Every pass's pipeline constants: whether it counts reads and how it reads the shadow map.
+    fn constants(&self) -> [(&'static str, f64); 2] {
         let [count_reads] = self.read_counts.pipeline_constants();
-        [count_reads, ("MEASURE_PENUMBRA_ERROR", f64::from(u8::from(self.measure_penumbra_error)))]
+        [count_reads, self.shadow_map_reads.pipeline_constant()]
+    }
+
+    /// Step 2's pipeline constants: those of every pass, and whether it measures the penumbra error.
+    fn blocker_blur_constants(&self) -> [(&'static str, f64); 3] {
+        let [count_reads, reads] = self.constants();
+        [count_reads, reads, ("MEASURE_PENUMBRA_ERROR", f64::from(u8::from(self.measure_penumbra_error)))]
     }
 
     /// A layout of the shared entries and `extra`.
     fn layout(&self, label: &str, extra: &[wgpu::BindGroupLayoutEntry]) -> wgpu::BindGroupLayout {
-        let common = [uniform_entry(0), uniform_entry(1), texture_entry(2), ReadCounts::layout_entry(3)];
+        let common = [
+            uniform_entry(0),
+            uniform_entry(1),
+            texture_entry(2),
+            ReadCounts::layout_entry(3),
+            ShadowMapReads::storage_layout_entry(SHADOW_MAP_STORAGE_BINDING),
+        ];
         let entries: Vec<wgpu::BindGroupLayoutEntry> = common.iter().chain(extra).copied().collect();
         bind_group_layout(&self.setup.gpu.device, label, &entries)
     }
 
-    /// A group of the shared resources and `extra` (bindings 4 on).
+    /// A group of the shared resources (bindings 0 to 3 and SHADOW_MAP_STORAGE_BINDING) and `extra` (bindings 4 on).
     fn group(&self, label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource<'_>]) -> wgpu::BindGroup {
-        let mut resources = vec![
+        let map = wgpu::BindingResource::TextureView(&self.depth_map.linear_depth_view);
+        let resources = [
             self.setup.scene.camera_buffer.as_entire_binding(),
             self.settings.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&self.depth_map.linear_depth_view),
+            map.clone(),
             self.read_counts.buffer().as_entire_binding(),
         ];
-        resources.extend_from_slice(extra);
-        bind_group(&self.setup.gpu.device, label, layout, &resources)
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+            .into_iter()
+            .chain(extra.iter().cloned())
+            .zip(0..)
+            .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource })
+            .chain([wgpu::BindGroupEntry { binding: SHADOW_MAP_STORAGE_BINDING, resource: map }])
+            .collect();
+        self.setup.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
     }
 
     /// Step 2's inputs (bindings 4 and 5): step 1's target and its blur sources.
@@ -443,7 +471,7 @@ impl Shared<'_> {
             (&self.module("sssm_vertical_blur_fragment_shader", VERTICAL_BLUR_FRAGMENT_SHADER)?, "sssm_vertical_blur"),
             Some(&vertical_blur_layout),
             &[VISIBILITY_FORMAT.into(), wgpu::TextureFormat::R32Float.into()],
-            &self.read_counts.pipeline_constants(),
+            &self.constants(),
         )?;
         Ok(BlurSteps::Fragment { blocker_blur, vertical_blur, groups })
     }
@@ -505,7 +533,7 @@ impl Shared<'_> {
             &self.module("sssm_vertical_blur_compute_shader", VERTICAL_BLUR_COMPUTE_SHADER)?,
             "sssm_vertical_blur_columns",
             &[&setup.scene.uniform_layout, &gbuffer.layout, &vertical_blur_layout],
-            &self.read_counts.pipeline_constants(),
+            &self.constants(),
         );
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
@@ -661,6 +689,19 @@ const PRESETS: &[ssm_core::Preset] = &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
             "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
             "sssm.blur_passes=fragment,shared_rows",
+            "sssm.alpha:beta=0.1:0.1",
+        ],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "sssm-reads",
+        summary: "PCSS and SSSM reading the shadow map as a sampled texture and as a read-only storage texture (the same texels), at Table 4's kernel pairs with alpha = beta = 0.1 (on leaves): what the read, not the algorithm, costs on this adapter; compare each technique's speed-up with both reading the same way",
+        scenes: &["leaves"],
+        varies: &[
+            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+            "pcss.shadow_map_reads=sampled,storage",
+            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+            "sssm.shadow_map_reads=sampled,storage",
             "sssm.alpha:beta=0.1:0.1",
         ],
         ..ssm_core::Preset::DEFAULT

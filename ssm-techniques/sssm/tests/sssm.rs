@@ -344,6 +344,43 @@ fn shared_row_passes_give_the_fragment_passes_pixels() {
     }
 }
 
+/// `shadow_map_reads = storage` reads every pass's shadow-map texels from the map bound as a
+/// read-only storage texture: the same texels as the sampled reads, so the same pixels to the
+/// bit, with fragment and shared-row passes, on the plant at Table 4's largest kernels and on a
+/// grazing light whose recomputed rows leave the map.
+#[test]
+fn storage_reads_give_the_sampled_reads_pixels() {
+    let gpu = gpu();
+    let cases: [Case; 3] = [
+        (
+            "leaves 29/41",
+            builtin("leaves").unwrap().build(),
+            SIZE,
+            &[("blocker_kernel", "29"), ("blur_kernel", "41"), ("alpha", "0.1"), ("beta", "0.1")],
+        ),
+        (
+            "leaves shared rows",
+            builtin("leaves").unwrap().build(),
+            SIZE,
+            &[("blur_passes", "shared_rows"), ("alpha", "0.1"), ("beta", "0.1")],
+        ),
+        ("grazing light", scene_from_manifest(GRAZING_LIGHT), SIZE, &[("blocker_kernel", "11"), ("blur_kernel", "21")]),
+    ];
+    for (name, scene, (width, height), settings) in cases {
+        let with = |reads: &'static str| {
+            let mut all = settings.to_vec();
+            all.push(("shadow_map_reads", reads));
+            render(&gpu, &scene, &ssm_sssm::INFO, &all, width, height).unwrap().visibility
+        };
+        let (storage, sampled) = (with("storage"), with("sampled"));
+        let largest = storage.iter().zip(&sampled).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        let shadowed = sampled.iter().filter(|v| **v < 0.999).count();
+        println!("{name}: largest difference {largest:e}, {shadowed} pixels in shadow or penumbra");
+        assert!(shadowed > 100, "{name}: the case has too little shadow");
+        assert_eq!(largest, 0.0, "{name}: storage reads differ from sampled reads by up to {largest}");
+    }
+}
+
 /// The restructured passes (failed rows recomputed after the reused ones, recomputed rows stepped
 /// in homogeneous coordinates, blur weights from a table) keep the error against the exact
 /// penumbra of `parallel-square` within 1% of the passes before them: the bounds are the errors
