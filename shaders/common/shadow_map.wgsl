@@ -15,32 +15,6 @@ fn shadow_map_depth(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return textureLoad(map, vec2<i32>(uv * size), 0).x;
 }
 
-// Whether shadow_map_tap reads the map bound as a read-only storage texture rather than as a
-// sampled texture (ssm-core's ShadowMapReads; a constant of the pipeline): the same texel either way.
-override SHADOW_MAP_STORAGE_READS: bool = false;
-
-// shadow_map_depth of `map`, read from `storage_map` (the same texture, bound as a read-only
-// storage texture) with SHADOW_MAP_STORAGE_READS.
-fn shadow_map_tap(map: texture_2d<f32>, storage_map: texture_storage_2d<r32float, read>, uv: vec2<f32>) -> f32 {
-    if (!SHADOW_MAP_STORAGE_READS) {
-        return shadow_map_depth(map, uv);
-    }
-    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
-        return NO_SURFACE;
-    }
-    let size = vec2<f32>(textureDimensions(storage_map));
-    return textureLoad(storage_map, vec2<i32>(uv * size)).x;
-}
-
-// The depth stored at `texel` of `map`, read from `storage_map` (the same texture) with
-// SHADOW_MAP_STORAGE_READS; `texel` must lie inside the map.
-fn shadow_map_texel(map: texture_2d<f32>, storage_map: texture_storage_2d<r32float, read>, texel: vec2<i32>) -> f32 {
-    if (SHADOW_MAP_STORAGE_READS) {
-        return textureLoad(storage_map, texel).x;
-    }
-    return textureLoad(map, texel, 0).x;
-}
-
 // World-space side of one texel of `map` at linear depth `depth` (the larger of its two sides).
 fn shadow_texel_size(frame: LightFrame, map: texture_2d<f32>, depth: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(map));

@@ -21,6 +21,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/shadow_map_reads.wgsl
 // #import common/read_counts.wgsl
 
 struct PcssSettings {

@@ -21,6 +21,7 @@ pub const COMMON_SHADERS: &[(&str, &str)] = &[
     common_shader!("scene.wgsl"),
     common_shader!("light_frame.wgsl"),
     common_shader!("shadow_map.wgsl"),
+    common_shader!("shadow_map_reads.wgsl"),
     common_shader!("screen_pass.wgsl"),
     common_shader!("read_counts.wgsl"),
 ];

@@ -136,7 +136,7 @@ impl Pcss {
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = PcssSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
+        let depth_map = settings.bias.depth_map_read_as(setup, "pcss_shadow_map", settings.shadow_map_size, settings.shadow_map_reads)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
         let read_counts = ReadCounts::new(device, "pcss_read_counts", &[PASS], settings.count_reads);
         let map_layout = bind_group_layout(
@@ -152,7 +152,7 @@ impl Pcss {
                 wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
                 settings_buffer.as_entire_binding(),
                 read_counts.buffer().as_entire_binding(),
-                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                wgpu::BindingResource::TextureView(&depth_map.storage_view),
             ],
         );
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.

@@ -45,7 +45,9 @@ const VERTICAL_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/
 /// Step 3 as a compute pass sharing each workgroup's screen column.
 const VERTICAL_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_compute.wgsl");
 /// The binding of the shadow map as a read-only storage texture in every pass's group 2
-/// (`shadow_map_storage` of sssm_common.wgsl), past the passes' own.
+/// (`shadow_map_storage` of sssm_common.wgsl), past the passes' own. With it the shared-row step
+/// 2 binds four storage textures (its three targets and this), WebGPU's guaranteed minimum per
+/// stage: a fifth would need an adapter limit above it.
 const SHADOW_MAP_STORAGE_BINDING: u32 = 15;
 /// Pixels per workgroup of the compute passes: along the row in step 2, down the column in step 3
 /// (`SEGMENT_PIXELS` of `sssm_segment.wgsl`; step 3's workgroup grid is (row runs, columns)).
@@ -286,7 +288,7 @@ impl SeparableSoftShadowMaps {
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = SssmSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let depth_map = settings.bias.depth_map(setup, "sssm_shadow_map", settings.shadow_map_size)?;
+        let depth_map = settings.bias.depth_map_read_as(setup, "sssm_shadow_map", settings.shadow_map_size, settings.shadow_map_reads)?;
         let targets = Targets::new(device, setup.scene.width, setup.scene.height);
         let settings_buffer = uniform_buffer(device, "sssm_settings_uniform", &SssmSettingsUniform::from(&settings));
         let read_counts = ReadCounts::with_units(device, "sssm_read_counts", COUNTED, settings.count_reads);
@@ -395,7 +397,7 @@ impl Shared<'_> {
         let resources = [
             self.setup.scene.camera_buffer.as_entire_binding(),
             self.settings.as_entire_binding(),
-            map.clone(),
+            map,
             self.read_counts.buffer().as_entire_binding(),
         ];
         let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
@@ -403,7 +405,10 @@ impl Shared<'_> {
             .chain(extra.iter().cloned())
             .zip(0..)
             .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource })
-            .chain([wgpu::BindGroupEntry { binding: SHADOW_MAP_STORAGE_BINDING, resource: map }])
+            .chain([wgpu::BindGroupEntry {
+                binding: SHADOW_MAP_STORAGE_BINDING,
+                resource: wgpu::BindingResource::TextureView(&self.depth_map.storage_view),
+            }])
             .collect();
         self.setup.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
     }
