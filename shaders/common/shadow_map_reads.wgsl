@@ -8,17 +8,14 @@
 // sampled texture (ssm-core's ShadowMapReads; a constant of the pipeline): the same texel either way.
 override SHADOW_MAP_STORAGE_READS: bool = false;
 
-// shadow_map_depth of `map`, read from `storage_map` (the same texture, bound as a read-only
-// storage texture) with SHADOW_MAP_STORAGE_READS.
+// shadow_map_depth of `map`, read through shadow_map_texel: NO_SURFACE outside the map, else
+// the nearest texel, from `storage_map` (the same texture, bound as a read-only storage texture)
+// with SHADOW_MAP_STORAGE_READS.
 fn shadow_map_tap(map: texture_2d<f32>, storage_map: texture_storage_2d<r32float, read>, uv: vec2<f32>) -> f32 {
-    if (!SHADOW_MAP_STORAGE_READS) {
-        return shadow_map_depth(map, uv);
-    }
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
         return NO_SURFACE;
     }
-    let size = vec2<f32>(textureDimensions(storage_map));
-    return textureLoad(storage_map, vec2<i32>(uv * size)).x;
+    return shadow_map_texel(map, storage_map, vec2<i32>(uv * vec2<f32>(textureDimensions(map))));
 }
 
 // The depth stored at `texel` of `map`, read from `storage_map` (the same texture) with

@@ -26,7 +26,7 @@ fn tap_depth(uv: vec2<f32>) -> f32 {
     if (!tiled || any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
         return shadow_map_tap(shadow_map, shadow_map_storage, uv);
     }
-    // The texel shadow_map_depth reads, inside the union by construction.
+    // The texel shadow_map_tap reads, inside the union by construction.
     let texel = vec2<i32>(uv * vec2<f32>(textureDimensions(shadow_map))) - tile_origin;
     return tile[texel.y * tile_width + texel.x];
 }
