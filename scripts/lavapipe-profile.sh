@@ -5,7 +5,7 @@
 # texel-fetch functions they call (those with a gather). Prints, per function, its share of the
 # samples, its instruction count and its gathers, divisions and calls (the first PROFILE_ROWS,
 # default 16; with PROFILE_GROUP=1 the copies of a function with the same instructions are one
-# row, and `copies` counts them).
+# row, and `copies` counts them). PROFILE_WIDTH and PROFILE_HEIGHT set the image (640×480).
 #
 #   scripts/lavapipe-profile.sh [ssm render arguments...]
 #   scripts/lavapipe-profile.sh --scene leaves --technique sssm --set sssm.blocker_kernel=29 \
@@ -27,7 +27,7 @@ work=$(mktemp -d)
 pid=
 trap '[ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$work"' EXIT
 # Enough frames to outlast the start-up and the sampling window.
-"$ssm" render --frames "${PROFILE_FRAMES:-150}" --width 640 --height 480 "$@" --out "$work/out" >/dev/null 2>&1 &
+"$ssm" render --frames "${PROFILE_FRAMES:-150}" --width "${PROFILE_WIDTH:-640}" --height "${PROFILE_HEIGHT:-480}" "$@" --out "$work/out" >/dev/null 2>&1 &
 pid=$!
 sleep "${PROFILE_WARMUP_S:-8}"
 kill -0 "$pid" 2>/dev/null || { echo "lavapipe-profile: the render ended before sampling (raise PROFILE_FRAMES)" >&2; exit 1; }
