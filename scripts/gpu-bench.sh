@@ -7,7 +7,9 @@
 #
 # Environment: SSM_BENCH_WIDTH, SSM_BENCH_HEIGHT (1920, 1080), SSM_BENCH_FRAMES (5),
 # SSM_BENCH_PRESETS (space-separated preset names; default below), SSM_BENCH_SET (extra
-# `--set` assignments, space-separated, e.g. "reference.samples=64" to shorten the ground truth).
+# `--set` assignments, space-separated, e.g. "reference.samples=64" to shorten the ground truth),
+# SSM_BIN (a prebuilt `ssm` to run instead of building one with cargo: a machine without a Rust
+# toolchain or a network, such as a lent GPU machine; scripts/gpu-bench-pack.sh makes one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,8 +27,13 @@ for assignment in ${SSM_BENCH_SET:-}; do
     settings+=(--set "$assignment")
 done
 
-cargo build --release --locked --bin ssm
-ssm() { cargo run --release --locked --quiet --bin ssm -- "$@"; }
+if [ -n "${SSM_BIN:-}" ]; then
+    [ -x "$SSM_BIN" ] || { echo "gpu-bench: SSM_BIN=$SSM_BIN is not an executable" >&2; exit 1; }
+    ssm() { "$SSM_BIN" "$@"; }
+else
+    cargo build --release --locked --bin ssm
+    ssm() { cargo run --release --locked --quiet --bin ssm -- "$@"; }
+fi
 mkdir -p "$out"
 table="$out/gpu-bench.md"
 first=1

@@ -1,0 +1,95 @@
+//! `scripts/gpu-bench-device.sh`, what a session lent a GPU machine runs there (issue 13, item 7),
+//! run here with this build's `ssm` in a packed folder as `scripts/gpu-bench-pack.sh` lays it out:
+//! it refuses to time a software adapter unless told to, and otherwise hands back through `$OUT`
+//! the adapter's name, one Markdown table with every point of the preset, and an archive of the
+//! preset's sweep.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ssm-gpu-bench-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A packed folder holding this build's `ssm` (no loader packages: this machine has its own).
+fn pack() -> PathBuf {
+    let pack = scratch("pack");
+    std::fs::copy(env!("CARGO_BIN_EXE_ssm"), pack.join("ssm")).unwrap();
+    pack
+}
+
+fn device_script(pack: &Path, out: &Path, allow_cpu: bool) -> Output {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/gpu-bench-device.sh");
+    let mut command = Command::new("bash");
+    command
+        .arg(script)
+        .env("OUT", out)
+        .env("SSM_BENCH_PACK", pack)
+        .env("SSM_BENCH_PRESETS", "atty-map-size-time")
+        .env("SSM_BENCH_WIDTH", "48")
+        .env("SSM_BENCH_HEIGHT", "36")
+        .env("SSM_BENCH_FRAMES", "1")
+        .env("SSM_BENCH_SET", "reference.samples=4")
+        .env("SSM_CACHE_DIR", scratch("cache"))
+        .env_remove("SSM_BENCH_ALLOW_CPU");
+    if allow_cpu {
+        command.env("SSM_BENCH_ALLOW_CPU", "1");
+    }
+    command.output().expect("bash runs the script")
+}
+
+fn is_software(adapter: &str) -> bool {
+    adapter.contains("llvmpipe") || adapter.contains("Vulkan Cpu") || adapter.contains("SwiftShader")
+}
+
+#[test]
+fn the_device_script_refuses_a_software_adapter_unless_told() {
+    let (pack, out) = (pack(), scratch("refuse-out"));
+    let output = device_script(&pack, &out, false);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let adapter = std::fs::read_to_string(out.join("adapter.txt")).expect("the script writes adapter.txt first");
+    assert!(adapter.starts_with("adapter: "), "adapter.txt: {adapter}");
+    if is_software(&adapter) {
+        assert!(!output.status.success(), "a software adapter was timed: {stderr}");
+        assert!(stderr.contains("software adapter"), "the refusal says why: {stderr}");
+        assert!(!out.join("gpu-bench.md").exists(), "nothing was to be timed");
+    } else {
+        assert!(output.status.success(), "on a hardware adapter the bench runs: {stderr}");
+        assert!(out.join("gpu-bench.md").exists());
+    }
+}
+
+#[test]
+fn the_device_script_hands_back_the_table_and_the_sweeps() {
+    let (pack, out) = (pack(), scratch("run-out"));
+    let output = device_script(&pack, &out, true);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "the script failed: {stderr}");
+
+    let adapter = std::fs::read_to_string(out.join("adapter.txt")).unwrap();
+    let name = adapter.trim().trim_start_matches("adapter: ");
+    // The adapter's own name, before wgpu's backend details in brackets.
+    let name = name.split(" [").next().unwrap();
+    let table = std::fs::read_to_string(out.join("gpu-bench.md")).expect("gpu-bench.md comes back");
+    assert!(table.starts_with("# ssm speed presets"), "{table}");
+    assert!(table.contains(name), "the table names the adapter `{name}`:\n{table}");
+    // atty-map-size-time: three occluder-map sizes, one- and two-sided.
+    let rows: Vec<&str> = table.lines().filter(|line| line.starts_with("| atty-map-size-time |")).collect();
+    assert_eq!(rows.len(), 6, "one row per point of the preset:\n{table}");
+    for row in rows {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let ms: f64 = cells[5].parse().unwrap_or_else(|_| panic!("a time in `{row}`"));
+        assert!(ms.is_finite() && ms > 0.0, "{row}");
+    }
+
+    let listing = Command::new("tar").arg("-tzf").arg(out.join("sweeps.tar.gz")).output().expect("tar runs");
+    let listing = String::from_utf8_lossy(&listing.stdout);
+    assert!(listing.contains("atty-map-size-time/sweep.csv"), "the archive holds the sweep: {listing}");
+    assert!(listing.contains("atty-map-size-time/sweep.md"), "{listing}");
+}
