@@ -6,6 +6,20 @@
 // #import common/camera.wgsl
 // #import common/read_counts.wgsl
 
+// The blur weights stepped outward from the kernel's centre (sssm's BlurWeightSteps): the taps
+// pair up about the centre and share a weight; pair k + 1's weight is pair k's times a ratio that
+// itself changes by a constant factor (a Gaussian's), so a recomputed row reads no weight table.
+struct BlurWeightSteps {
+    // Weight of the centre tap of an odd kernel.
+    centre: f32,
+    // Weight of the pair next to the centre.
+    first_pair: f32,
+    // Ratio of the second pair's weight to the first's.
+    first_ratio: f32,
+    // Ratio of each ratio to the one before.
+    ratio_step: f32,
+};
+
 struct SssmSettings {
     // Samples per axis of the blocker search (n) and of the blur (m).
     blocker_kernel: u32,
@@ -22,6 +36,8 @@ struct SssmSettings {
     bilateral_depth: f32,
     // The sum of the blur_kernel tap weights below.
     blur_weight_total: f32,
+    // The same weights as a recurrence outward from the kernel's centre (recomputed_row).
+    blur_weight_steps: BlurWeightSteps,
     // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
     // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
     // exponential per tap.

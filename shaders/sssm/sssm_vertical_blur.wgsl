@@ -118,44 +118,88 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
     let last_front = first_front + last * front_step;
     let den_kept = first_den * last_den > 0.0 && min(abs(first_den), abs(last_den)) >= 1e-12;
     let front_kept = first_front * last_front > 0.0;
+    // The taps pair up about the row's centre and share a weight (settings.blur_weight_steps):
+    // pair k is taps half - 1 - k and half + odd + k, after the centre tap of an odd kernel. The
+    // weights follow by two products a pair rather than tap_weight's table: on lavapipe a lookup
+    // indexed by the loop counter is a load per SIMD lane (about 5% of this pass at 29/41).
+    let half = m / 2u;
+    let odd = m % 2u;
+    let weights = settings.blur_weight_steps;
+    var row_sum = 0.0;
+    var weight = weights.first_pair;
+    var ratio = weights.first_ratio;
     if (den_kept && front_kept && plane_offset * first_den > 0.0 && first_front * first_den > 0.0) {
         // With den's sign s: s·h.z <= the map's depth · s·den is h.z / den <= the map's depth.
         let den_sign = select(-1.0, 1.0, first_den > 0.0);
-        let first_signed_h = den_sign * first_h;
-        let signed_h_step = den_sign * h_step;
-        let first_signed_den = den_sign * first_den;
-        let signed_den_step = den_sign * den_step;
-        var lit_sum = 0.0;
-        for (var i = 0u; i < m; i++) {
-            let index = f32(i);
-            let h = first_signed_h + index * signed_h_step;
-            let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
-            reads += 1u;
-            let lit = h.z <= tap_depth(uv) * (first_signed_den + index * signed_den_step);
-            lit_sum += select(0.0, tap_weight(i), lit);
+        let stepped = DepthOnlyRow(den_sign * first_h, den_sign * h_step, den_sign * first_den, den_sign * den_step, half_inverse_projection);
+        if (odd == 1u) {
+            row_sum = weights.centre * depth_only_lit(stepped, f32(half));
         }
-        return lit_sum / settings.blur_weight_total;
+        for (var k = 0u; k < half; k++) {
+            row_sum += weight * (depth_only_lit(stepped, f32(half - 1u - k)) + depth_only_lit(stepped, f32(half + odd + k)));
+            weight *= ratio;
+            ratio *= weights.ratio_step;
+        }
+        return row_sum / settings.blur_weight_total;
     }
-    var row_sum = 0.0;
-    // Selects rather than branches, and products rather than quotients where a sign decides: a
-    // tap costs one division (its light depth's reciprocal) and the same few instructions in
-    // every lane.
-    for (var i = 0u; i < m; i++) {
-        let index = f32(i);
-        let den = first_den + index * den_step;
-        // The ray meets the plane in front of the eye (tangent_plane_point's w).
-        let meets_plane = abs(den) >= 1e-12 && plane_offset * den > 0.0;
-        // In front of the light's plane (tap_visibility's first test).
-        let in_front = (first_front + index * front_step) * den > 0.0;
-        let h = first_h + index * h_step;
-        // One reciprocal for both coordinates.
-        let uv = 0.5 + h.xy * half_inverse_projection * (1.0 / h.z);
-        reads += 1u;
-        // h.z / den <= the map's depth, with den's sign.
-        let map_depth = tap_depth(uv) * den;
-        let lit = select(h.z >= map_depth, h.z <= map_depth, den > 0.0);
-        let visible = select(own_hard, select(0.0, select(0.0, 1.0, lit), in_front), meets_plane);
-        row_sum += tap_weight(i) * visible;
+    let stepped = GeneralRow(first_h, h_step, first_den, den_step, first_front, front_step, plane_offset, own_hard, half_inverse_projection);
+    if (odd == 1u) {
+        row_sum = weights.centre * general_visibility(stepped, f32(half));
+    }
+    for (var k = 0u; k < half; k++) {
+        row_sum += weight * (general_visibility(stepped, f32(half - 1u - k)) + general_visibility(stepped, f32(half + odd + k)));
+        weight *= ratio;
+        ratio *= weights.ratio_step;
     }
     return row_sum / settings.blur_weight_total;
+}
+
+// A recomputed row whose taps all lie on the plane in front of the eye and of the light, its
+// stepped values multiplied by den's sign (recomputed_row).
+struct DepthOnlyRow {
+    first_h: vec3<f32>,
+    h_step: vec3<f32>,
+    first_den: f32,
+    den_step: f32,
+    half_inverse_projection: vec2<f32>,
+};
+
+// 1 where tap `index` of `row` is lit, else 0: only a depth comparison.
+fn depth_only_lit(row: DepthOnlyRow, index: f32) -> f32 {
+    let h = row.first_h + index * row.h_step;
+    let uv = 0.5 + h.xy * row.half_inverse_projection * (1.0 / h.z);
+    reads += 1u;
+    return select(0.0, 1.0, h.z <= tap_depth(uv) * (row.first_den + index * row.den_step));
+}
+
+// Any recomputed row (recomputed_row's stepped values), for rows that cross the eye's or the light's plane.
+struct GeneralRow {
+    first_h: vec3<f32>,
+    h_step: vec3<f32>,
+    first_den: f32,
+    den_step: f32,
+    first_front: f32,
+    front_step: f32,
+    plane_offset: f32,
+    own_hard: f32,
+    half_inverse_projection: vec2<f32>,
+};
+
+// The hard visibility of tap `index` of `row`. Selects rather than branches, and products rather
+// than quotients where a sign decides: a tap costs one division (its light depth's reciprocal)
+// and the same few instructions in every lane.
+fn general_visibility(row: GeneralRow, index: f32) -> f32 {
+    let den = row.first_den + index * row.den_step;
+    // The ray meets the plane in front of the eye (tangent_plane_point's w).
+    let meets_plane = abs(den) >= 1e-12 && row.plane_offset * den > 0.0;
+    // In front of the light's plane (tap_visibility's first test).
+    let in_front = (row.first_front + index * row.front_step) * den > 0.0;
+    let h = row.first_h + index * row.h_step;
+    // One reciprocal for both coordinates.
+    let uv = 0.5 + h.xy * row.half_inverse_projection * (1.0 / h.z);
+    reads += 1u;
+    // h.z / den <= the map's depth, with den's sign.
+    let map_depth = tap_depth(uv) * den;
+    let lit = select(h.z >= map_depth, h.z <= map_depth, den > 0.0);
+    return select(row.own_hard, select(0.0, select(0.0, 1.0, lit), in_front), meets_plane);
 }

@@ -133,7 +133,49 @@ pub struct SssmSettingsUniform {
     normal_offset: f32,
     bilateral_depth: f32,
     blur_weight_total: f32,
+    blur_weight_steps: BlurWeightSteps,
     blur_weights: [[f32; 4]; 32],
+}
+
+/// The blur weights as a recurrence outward from the kernel's centre, for the loops that recompute
+/// a row (the shaders' `recomputed_row`): the taps pair up symmetrically about the centre and
+/// share a weight, the Gaussian's ratio of one pair's weight to the next is itself a geometric
+/// sequence, so a pair costs two products instead of a table lookup per tap (on lavapipe a lookup
+/// indexed by the loop counter is a load per SIMD lane). The same weights as `blur_weights` to
+/// a few units in the last place (`blur_weight_steps_follow_the_table`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+struct BlurWeightSteps {
+    /// Weight of the centre tap of an odd kernel.
+    centre: f32,
+    /// Weight of the pair next to the centre.
+    first_pair: f32,
+    /// Ratio of the second pair's weight to the first's.
+    first_ratio: f32,
+    /// Ratio of each ratio to the one before.
+    ratio_step: f32,
+}
+
+/// [`BlurWeightSteps`] of the settings' filter and kernel, computed in double precision: the
+/// Gaussian exp(-x²/2σ²) at offsets x_k = (2k + 1 + odd)/m of pair k, whose weights' ratio
+/// exp(-(2x_k d + d²)/2σ²) (d = 2/m) changes by exp(-d²/σ²) from pair to pair.
+fn blur_weight_steps(settings: &SssmSettings) -> BlurWeightSteps {
+    match settings.filter {
+        BlurFilter::Mean => BlurWeightSteps { centre: 1.0, first_pair: 1.0, first_ratio: 1.0, ratio_step: 1.0 },
+        BlurFilter::Gaussian => {
+            let taps = f64::from(settings.blur_kernel.clamp(1, 128));
+            let sigma = f64::from(settings.sigma.max(1e-3));
+            let a = 0.5 / (sigma * sigma);
+            let step = 2.0 / taps;
+            let first = f64::from(1 + settings.blur_kernel.clamp(1, 128) % 2) / taps;
+            BlurWeightSteps {
+                centre: 1.0,
+                first_pair: (-a * first * first).exp() as f32,
+                first_ratio: (-a * (2.0 * first * step + step * step)).exp() as f32,
+                ratio_step: (-2.0 * a * step * step).exp() as f32,
+            }
+        }
+    }
 }
 
 /// The weights of the m blur taps (Sec. 4.4): a Gaussian of standard deviation `sigma`
@@ -167,6 +209,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             normal_offset: settings.bias.normal_offset,
             bilateral_depth: settings.bilateral_depth,
             blur_weight_total: blur_weights.iter().flatten().sum(),
+            blur_weight_steps: blur_weight_steps(settings),
             blur_weights,
         }
     }
@@ -799,3 +842,65 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 };
 
 register_technique!(INFO);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shaders' recurrence (`recomputed_row`, in f32 as they run it) gives each tap the
+    /// filter's weight, the Gaussian evaluated in double precision, to (k + 1)² units in the
+    /// last place at pair k from the centre (each pair's ratio carries the rounding of the ones
+    /// before it); for both parities, narrow and wide Gaussians and the mean filter. The f32 table
+    /// (`blur_weights`) is within 16(1 + e) units of it for an exponent of magnitude e: its
+    /// offsets and exponent (up to 200 at σ = 0.05) are computed in f32. Seen to fail with the ratio's step one power short, and with
+    /// the even and odd kernels' first offsets swapped.
+    #[test]
+    fn blur_weight_steps_follow_the_filter() {
+        for filter in [BlurFilter::Gaussian, BlurFilter::Mean] {
+            for sigma in [0.05_f32, 0.2, 0.5, 1.0, 4.0] {
+                for taps in [1_u32, 2, 3, 8, 15, 16, 21, 41, 45, 128] {
+                    let settings = SssmSettings { blur_kernel: taps, filter, sigma, ..SssmSettings::default() };
+                    let table = blur_weights(&settings);
+                    // The weight and its exponent's magnitude.
+                    let exact = |tap: u32| match filter {
+                        BlurFilter::Mean => (1.0, 0.0),
+                        BlurFilter::Gaussian => {
+                            let x = (2.0 * f64::from(tap) + 1.0 - f64::from(taps)) / f64::from(taps) / f64::from(sigma);
+                            ((-0.5 * x * x).exp(), 0.5 * x * x)
+                        }
+                    };
+                    let steps = blur_weight_steps(&settings);
+                    let (half, odd) = (taps / 2, taps % 2);
+                    let mut stepped = vec![(0.0_f32, 0_u32); taps as usize];
+                    if odd == 1 {
+                        stepped[half as usize] = (steps.centre, 0);
+                    }
+                    let (mut weight, mut ratio) = (steps.first_pair, steps.first_ratio);
+                    for pair in 0..half {
+                        stepped[(half - 1 - pair) as usize] = (weight, pair);
+                        stepped[(half + odd + pair) as usize] = (weight, pair);
+                        weight *= ratio;
+                        ratio *= steps.ratio_step;
+                    }
+                    for (tap, &(stepped, pair)) in stepped.iter().enumerate() {
+                        let tap = tap as u32;
+                        let (expected, exponent) = exact(tap);
+                        let ulps = f64::from((pair + 1) * (pair + 1));
+                        let error = (f64::from(stepped) - expected).abs();
+                        let context = format!("{filter:?} sigma {sigma} m {taps} tap {tap} (pair {pair})");
+                        assert!(
+                            error <= ulps * f64::from(f32::EPSILON) * expected + 1e-37,
+                            "{context}: stepped {stepped} against {expected}"
+                        );
+                        let from_table = f64::from(table[tap as usize / 4][tap as usize % 4]);
+                        let table_ulps = 16.0 * (1.0 + exponent);
+                        assert!(
+                            (from_table - expected).abs() <= table_ulps * f64::from(f32::EPSILON) * expected + 1e-37,
+                            "{context}: the table's {from_table} against {expected}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
