@@ -12,16 +12,24 @@
 # packed folder, relative to the repository's root or absolute.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ldconfig lives in /sbin, which a user other than root may not have on PATH.
+PATH="$PATH:/sbin:/usr/sbin"
 
 out="${OUT:?gpu-bench-device: OUT is not set (the device tool sets it)}"
 pack="${SSM_BENCH_PACK:-.gpu-bench}"
 [ -x "$pack/ssm" ] || { echo "gpu-bench-device: $pack/ssm is missing: run scripts/gpu-bench-pack.sh first and carry $pack" >&2; exit 1; }
 
-# The Vulkan loader, where the machine has none (unpacked into /, as the device tool's notes say).
-# (grep reads the whole list: `grep -q` would close the pipe on ldconfig, failing the pipeline.)
-if ! ldconfig -p | grep 'libvulkan\.so\.1' >/dev/null; then
+# The Vulkan loader and the GL dispatch libraries the NVIDIA driver's Vulkan library loads, where
+# the machine lacks one (unpacked into /, as the device tool's notes say). (grep reads the whole
+# list: `grep -q` would close the pipe on ldconfig, failing the pipeline.)
+libraries=$(ldconfig -p)
+missing=0
+for library in libvulkan.so.1 libGLX.so.0 libEGL.so.1 libGLdispatch.so.0; do
+    grep -F "$library" <<<"$libraries" >/dev/null || missing=1
+done
+if [ "$missing" = 1 ]; then
     debs=("$pack"/debs/*.deb)
-    [ -e "${debs[0]}" ] || { echo "gpu-bench-device: this machine has no Vulkan loader and $pack/debs none to unpack" >&2; exit 1; }
+    [ -e "${debs[0]}" ] || { echo "gpu-bench-device: this machine lacks the Vulkan loader or GL dispatch libraries and $pack/debs has none to unpack" >&2; exit 1; }
     for deb in "${debs[@]}"; do
         dpkg -x "$deb" /
     done
@@ -37,7 +45,7 @@ export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 
 # sed reads the whole listing: `head` would close the pipe on `ssm`, which fails on the write.
-adapter=$("$pack/ssm" list | sed -n 1p)
+adapter=$("$pack/ssm" list | sed -n 1p) || { echo "gpu-bench-device: \`ssm list\` failed: no adapter, or the binary does not run here" >&2; exit 1; }
 echo "gpu-bench-device: $adapter" >&2
 echo "$adapter" > "$out/adapter.txt"
 case "$adapter" in
@@ -51,7 +59,8 @@ esac
 
 work=$(mktemp -d)
 status=0
-SSM_BIN="$(cd "$pack" && pwd)/ssm" timeout "${SSM_BENCH_LIMIT_S:-480}" scripts/gpu-bench.sh "$work" || status=$?
+# SIGKILL 20 s after the SIGTERM, for an `ssm` stuck in the driver.
+SSM_BIN="$(cd "$pack" && pwd)/ssm" timeout -k 20 "${SSM_BENCH_LIMIT_S:-480}" scripts/gpu-bench.sh "$work" || status=$?
 # What finished comes back, also after the time limit (status 124).
 [ -f "$work/gpu-bench.md" ] && cp "$work/gpu-bench.md" "$out/gpu-bench.md"
 (cd "$work" && find . -name 'sweep.csv' -o -name 'sweep.md' | sort | tar -czf "$out/sweeps.tar.gz" -T -)

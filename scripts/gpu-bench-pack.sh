@@ -4,8 +4,10 @@
 #
 #   .gpu-bench/ssm      the release `ssm`, stripped of its debug information (about 20 MB: the
 #                       device tool carries at most 64 MiB with the working tree)
-#   .gpu-bench/debs/    Debian's Vulkan loader (libvulkan1), unpacked there only where the
-#                       machine has none; the NVIDIA driver brings the Vulkan driver itself
+#   .gpu-bench/debs/    Debian's Vulkan loader and GL dispatch libraries (the device tool's
+#                       list: libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2,
+#                       which the NVIDIA driver's Vulkan library loads), unpacked there only
+#                       where the machine lacks them; the driver itself is the machine's
 #
 # Then prints the device tool's `run` call. Run on x86-64 Debian or Ubuntu (the machine's
 # processor is x86-64); needs apt-get for the loader.
@@ -32,7 +34,7 @@ trap 'rm -rf "$lists"' EXIT
 mkdir -p "$lists/partial"
 apt_options=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 "-oDir::State::Lists=$lists")
 apt-get "${apt_options[@]}" update -q >/dev/null
-(cd "$pack/debs" && apt-get "${apt_options[@]}" download libvulkan1 >/dev/null)
+(cd "$pack/debs" && apt-get "${apt_options[@]}" download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2 >/dev/null)
 du -sh "$pack"
 cat <<'EOF'
 gpu-bench-pack: ready. On the lent machine (the device tool's run), with carry [".gpu-bench"]:

@@ -17,14 +17,16 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// A packed folder holding this build's `ssm` (no loader packages: this machine has its own).
-fn pack() -> PathBuf {
-    let pack = scratch("pack");
+/// A packed folder holding this build's `ssm` (no loader packages: this machine has its own), one
+/// per test: the tests run in parallel in one process, and a shared folder would be emptied under
+/// the other's feet.
+fn pack(test: &str) -> PathBuf {
+    let pack = scratch(&format!("{test}-pack"));
     std::fs::copy(env!("CARGO_BIN_EXE_ssm"), pack.join("ssm")).unwrap();
     pack
 }
 
-fn device_script(pack: &Path, out: &Path, allow_cpu: bool) -> Output {
+fn device_script(test: &str, pack: &Path, out: &Path, allow_cpu: bool) -> Output {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/gpu-bench-device.sh");
     let mut command = Command::new("bash");
     command
@@ -36,7 +38,7 @@ fn device_script(pack: &Path, out: &Path, allow_cpu: bool) -> Output {
         .env("SSM_BENCH_HEIGHT", "36")
         .env("SSM_BENCH_FRAMES", "1")
         .env("SSM_BENCH_SET", "reference.samples=4")
-        .env("SSM_CACHE_DIR", scratch("cache"))
+        .env("SSM_CACHE_DIR", scratch(&format!("{test}-cache")))
         .env_remove("SSM_BENCH_ALLOW_CPU");
     if allow_cpu {
         command.env("SSM_BENCH_ALLOW_CPU", "1");
@@ -50,8 +52,8 @@ fn is_software(adapter: &str) -> bool {
 
 #[test]
 fn the_device_script_refuses_a_software_adapter_unless_told() {
-    let (pack, out) = (pack(), scratch("refuse-out"));
-    let output = device_script(&pack, &out, false);
+    let (pack, out) = (pack("refuse"), scratch("refuse-out"));
+    let output = device_script("refuse", &pack, &out, false);
     let stderr = String::from_utf8_lossy(&output.stderr);
     let adapter = std::fs::read_to_string(out.join("adapter.txt")).expect("the script writes adapter.txt first");
     assert!(adapter.starts_with("adapter: "), "adapter.txt: {adapter}");
@@ -67,8 +69,8 @@ fn the_device_script_refuses_a_software_adapter_unless_told() {
 
 #[test]
 fn the_device_script_hands_back_the_table_and_the_sweeps() {
-    let (pack, out) = (pack(), scratch("run-out"));
-    let output = device_script(&pack, &out, true);
+    let (pack, out) = (pack("run"), scratch("run-out"));
+    let output = device_script("run", &pack, &out, true);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "the script failed: {stderr}");
 

@@ -141,8 +141,8 @@ pub struct SssmSettingsUniform {
 /// a row (the shaders' `recomputed_row`): the taps pair up symmetrically about the centre and
 /// share a weight, the Gaussian's ratio of one pair's weight to the next is itself a geometric
 /// sequence, so a pair costs two products instead of a table lookup per tap (on lavapipe a lookup
-/// indexed by the loop counter is a load per SIMD lane). The same weights as `blur_weights` to
-/// a few units in the last place (`blur_weight_steps_follow_the_table`).
+/// indexed by the loop counter is a load per SIMD lane). The Gaussian's weights to (k + 1)² units
+/// in the last place at pair k (`blur_weight_steps_follow_the_filter`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 struct BlurWeightSteps {
