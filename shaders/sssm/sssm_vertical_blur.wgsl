@@ -50,20 +50,21 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // Selects rather than branches: every lane of a SIMD vector runs every tap anyway. A row off
     // the screen reads the nearest on-screen texel, whose value it does not use.
     let last_texel = vec2<i32>(camera.viewport.xy) - 1;
-    for (var j = 0u; j < m; j++) {
-        let offset = kernel_offset(steps, j);
-        let row = centre + vec2<f32>(0.0, offset * radii.y);
-        let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), last_texel));
-        let expected = tap_line_distance(line, offset);
-        let reuse = on_screen(row) && within_beta(source, expected);
-        let weight = select(0.0, tap_weight(j) * bilateral_weight_of(source, expected, point.normal), reuse);
-        blurred += weight * source.value;
-        total += weight;
-        reused += select(0.0, 1.0, reuse);
-        mark_failed_row_if(&failed_rows, j, !reuse);
-        if (COUNT_READS && !reuse) {
-            count_failed_row(!on_screen(row), source.eye_distance < 0.0);
-        }
+    let column = VerticalColumn(steps, centre, radii.y, line, last_texel, point.normal);
+    // The taps in pairs about the centre, weighted as recomputed_row's (settings.blur_weight_steps).
+    let half = m / 2u;
+    let odd = m % 2u;
+    let weights = settings.blur_weight_steps;
+    if (odd == 1u) {
+        vertical_tap(column, half, weights.centre, &blurred, &total, &reused, &failed_rows);
+    }
+    var pair_weight = weights.first_pair;
+    var ratio = weights.first_ratio;
+    for (var k = 0u; k < half; k++) {
+        vertical_tap(column, half - 1u - k, pair_weight, &blurred, &total, &reused, &failed_rows);
+        vertical_tap(column, half + odd + k, pair_weight, &blurred, &total, &reused, &failed_rows);
+        pair_weight *= ratio;
+        ratio *= weights.ratio_step;
     }
     loop {
         let failed = pop_failed_row(&failed_rows);
@@ -77,6 +78,34 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     }
     let visibility = clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
     return vec2<f32>(visibility, (own.w + reused) / (n + f32(m)));
+}
+
+// What every vertical tap of a pixel shares.
+struct VerticalColumn {
+    steps: KernelSteps,
+    centre: vec2<f32>,
+    radius_y: f32,
+    line: TapLine,
+    last_texel: vec2<i32>,
+    normal: vec3<f32>,
+};
+
+// Vertical tap j of weight `weight`: its row reused (added to blurred, total and reused) when the
+// β test passes, else marked failed.
+fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<function, f32>, total: ptr<function, f32>, reused: ptr<function, f32>, failed_rows: ptr<function, FailedRows>) {
+    let offset = kernel_offset(column.steps, j);
+    let row = column.centre + vec2<f32>(0.0, offset * column.radius_y);
+    let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), column.last_texel));
+    let expected = tap_line_distance(column.line, offset);
+    let reuse = on_screen(row) && within_beta(source, expected);
+    let tap_weight_value = select(0.0, weight * bilateral_weight_of(source, expected, column.normal), reuse);
+    *blurred += tap_weight_value * source.value;
+    *total += tap_weight_value;
+    *reused += select(0.0, 1.0, reuse);
+    mark_failed_row_if(failed_rows, j, !reuse);
+    if (COUNT_READS && !reuse) {
+        count_failed_row(!on_screen(row), source.eye_distance < 0.0);
+    }
 }
 
 // A row of step 2's horizontal blur recomputed on this pixel's tangent plane with this pixel's
