@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs scripts/gpu-bench.sh on a lent GPU machine with what scripts/gpu-bench-pack.sh packed in
-# .gpu-bench/ (a prebuilt `ssm`, the Vulkan loader), and hands back through $OUT (the device
+# .gpu-bench/ (a prebuilt `ssm`, the Vulkan loader and GL dispatch libraries), and hands back through $OUT (the device
 # tool's folder) the one Markdown table and an archive of every preset's sweep.csv and sweep.md.
 # Refuses to time a software adapter unless SSM_BENCH_ALLOW_CPU=1 (how it is tested here).
 #

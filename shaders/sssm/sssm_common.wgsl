@@ -8,7 +8,8 @@
 
 // The blur weights stepped outward from the kernel's centre (sssm's BlurWeightSteps): the taps
 // pair up about the centre and share a weight; pair k + 1's weight is pair k's times a ratio that
-// itself changes by a constant factor (a Gaussian's), so a recomputed row reads no weight table.
+// itself changes by a constant factor (a Gaussian's), so step 3's taps and recomputed rows read
+// no weight table.
 struct BlurWeightSteps {
     // Weight of the centre tap of an odd kernel.
     centre: f32,
@@ -36,7 +37,8 @@ struct SssmSettings {
     bilateral_depth: f32,
     // The sum of the blur_kernel tap weights below.
     blur_weight_total: f32,
-    // The same weights as a recurrence outward from the kernel's centre (recomputed_row).
+    // The same weights as a recurrence outward from the kernel's centre (step 3's vertical_tap
+    // and recomputed_row).
     blur_weight_steps: BlurWeightSteps,
     // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
     // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an

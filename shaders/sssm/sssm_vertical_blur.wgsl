@@ -47,8 +47,6 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // Rows failing the β test, recomputed after the reused ones.
     var failed_rows = FailedRows();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(0.0, radii.y));
-    // Selects rather than branches: every lane of a SIMD vector runs every tap anyway. A row off
-    // the screen reads the nearest on-screen texel, whose value it does not use.
     let last_texel = vec2<i32>(camera.viewport.xy) - 1;
     let column = VerticalColumn(steps, centre, radii.y, line, last_texel, point.normal);
     // The taps in pairs about the centre, weighted as recomputed_row's (settings.blur_weight_steps).
@@ -72,6 +70,8 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
             break;
         }
         let row = centre + vec2<f32>(0.0, kernel_offset(steps, u32(failed)) * radii.y);
+        // The table's weight: the pair weight the loop above gave this row, to (k + 1)² units in
+        // the last place at pair k, which a popped row no longer knows.
         let weight = tap_weight(u32(failed));
         blurred += weight * recomputed_row(rays, point, offset, own_hard, row, radii.x, m);
         total += weight;
@@ -91,7 +91,9 @@ struct VerticalColumn {
 };
 
 // Vertical tap j of weight `weight`: its row reused (added to blurred, total and reused) when the
-// β test passes, else marked failed.
+// β test passes, else marked failed. Selects rather than branches: every lane of a SIMD vector
+// runs every tap anyway. A row off the screen reads the nearest on-screen texel, whose value it
+// does not use.
 fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<function, f32>, total: ptr<function, f32>, reused: ptr<function, f32>, failed_rows: ptr<function, FailedRows>) {
     let offset = kernel_offset(column.steps, j);
     let row = column.centre + vec2<f32>(0.0, offset * column.radius_y);

@@ -137,8 +137,8 @@ pub struct SssmSettingsUniform {
     blur_weights: [[f32; 4]; 32],
 }
 
-/// The blur weights as a recurrence outward from the kernel's centre, for the loops that recompute
-/// a row (the shaders' `recomputed_row`): the taps pair up symmetrically about the centre and
+/// The blur weights as a recurrence outward from the kernel's centre, for step 3's loops (the
+/// shaders' `vertical_tap` and `recomputed_row`): the taps pair up symmetrically about the centre and
 /// share a weight, the Gaussian's ratio of one pair's weight to the next is itself a geometric
 /// sequence, so a pair costs two products instead of a table lookup per tap (on lavapipe a lookup
 /// indexed by the loop counter is a load per SIMD lane). The Gaussian's weights to (k + 1)² units
@@ -163,11 +163,12 @@ fn blur_weight_steps(settings: &SssmSettings) -> BlurWeightSteps {
     match settings.filter {
         BlurFilter::Mean => BlurWeightSteps { centre: 1.0, first_pair: 1.0, first_ratio: 1.0, ratio_step: 1.0 },
         BlurFilter::Gaussian => {
-            let taps = f64::from(settings.blur_kernel.clamp(1, 128));
+            let kernel = settings.blur_kernel.clamp(1, 128);
+            let taps = f64::from(kernel);
             let sigma = f64::from(settings.sigma.max(1e-3));
             let a = 0.5 / (sigma * sigma);
             let step = 2.0 / taps;
-            let first = f64::from(1 + settings.blur_kernel.clamp(1, 128) % 2) / taps;
+            let first = f64::from(1 + kernel % 2) / taps;
             BlurWeightSteps {
                 centre: 1.0,
                 first_pair: (-a * first * first).exp() as f32,
@@ -847,13 +848,13 @@ register_technique!(INFO);
 mod tests {
     use super::*;
 
-    /// The shaders' recurrence (`recomputed_row`, in f32 as they run it) gives each tap the
-    /// filter's weight, the Gaussian evaluated in double precision, to (k + 1)² units in the
-    /// last place at pair k from the centre (each pair's ratio carries the rounding of the ones
-    /// before it); for both parities, narrow and wide Gaussians and the mean filter. The f32 table
-    /// (`blur_weights`) is within 16(1 + e) units of it for an exponent of magnitude e: its
-    /// offsets and exponent (up to 200 at σ = 0.05) are computed in f32. Seen to fail with the ratio's step one power short, and with
-    /// the even and odd kernels' first offsets swapped.
+    /// The shaders' recurrence (`vertical_tap` and `recomputed_row`, in f32 as they run it) gives
+    /// each tap the filter's weight, the Gaussian evaluated in double precision, to (k + 1)² units
+    /// in the last place at pair k from the centre (each pair's ratio carries the rounding of the
+    /// ones before it); for both parities, narrow and wide Gaussians and the mean filter. The f32
+    /// table (`blur_weights`) is within 16(1 + e) units of it for an exponent of magnitude e: its
+    /// offsets and exponent (up to 200 at σ = 0.05) are computed in f32. Seen to fail with the
+    /// ratio's step one power short, and with the even and odd kernels' first offsets swapped.
     #[test]
     fn blur_weight_steps_follow_the_filter() {
         for filter in [BlurFilter::Gaussian, BlurFilter::Mean] {
