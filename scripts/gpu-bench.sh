@@ -19,7 +19,7 @@ height="${SSM_BENCH_HEIGHT:-1080}"
 frames="${SSM_BENCH_FRAMES:-5}"
 # Buades et al.'s Table 4, Atty et al.'s map sizes (one- and two-sided), 1–3 lights for every
 # technique, Shen et al.'s Figs. 10 and 11, Forest et al.'s Fig. 12.
-presets="${SSM_BENCH_PRESETS:-sssm-table4 sssm-passes sssm-reads pcss-taps atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
+presets="${SSM_BENCH_PRESETS:-sssm-table4 sssm-edges sssm-passes sssm-reads pcss-taps atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 
 settings=()

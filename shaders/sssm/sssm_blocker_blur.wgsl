@@ -98,8 +98,8 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         var reuse = false;
         var no_data = false;
         let visible = screen.z > 0.0 && on_screen(screen.xy);
-        if (visible) {
-            let other = textureLoad(horizontal_blocker, vec2<i32>(screen.xy), 0);
+        if (screen.z > 0.0 && readable_on_screen(screen.xy)) {
+            let other = textureLoad(horizontal_blocker, clamped_texel(screen.xy), 0);
             reads += 1u;
             no_data = other.x < 0.0;
             if (other.x >= 0.0 && abs(d - other.x) < scene_length(frame, settings.alpha)) {

@@ -280,6 +280,27 @@ fn on_screen(pixel: vec2<f32>) -> bool {
     return all(pixel >= vec2<f32>(0.0)) && all(pixel < camera.viewport.xy);
 }
 
+// Whether steps 2 and 3 read a blocker row or a blur row that falls past the screen's edges from
+// the nearest pixel on the screen, and reuse it when it passes the reuse test (α, β), as a
+// clamp-to-edge texture read would: the settings' edge_rows = clamp, the paper's border ("not
+// possible to perform the filtering operations ... in the upper and bottom borders of the screen",
+// Sec. 4.2). Otherwise (recompute) such a row is read from the depth map on this pixel's tangent
+// plane, as a failed test's is. A row costs n or m taps, so these rows are a large share of the
+// work near the borders; the horizontal blur's single taps past the edges are shadow-tested either
+// way. A constant of the pipeline.
+override CLAMP_EDGE_ROWS: bool = false;
+
+// Whether a row at pixel position `pixel` may be read from the screen (clamped_texel):
+// on the screen, or anywhere with CLAMP_EDGE_ROWS.
+fn readable_on_screen(pixel: vec2<f32>) -> bool {
+    return CLAMP_EDGE_ROWS || on_screen(pixel);
+}
+
+// The pixel on the screen nearest pixel position `pixel` (the pixel itself when on the screen).
+fn clamped_texel(pixel: vec2<f32>) -> vec2<i32> {
+    return clamp(vec2<i32>(floor(pixel)), vec2<i32>(0), vec2<i32>(camera.viewport.xy) - 1);
+}
+
 // Half-width in pixels of a blur `half_width` world units wide on a surface at `world` facing the
 // camera: the fallback where the kernel's footprint on the tangent plane cannot be found.
 fn facing_radius(world: vec3<f32>, half_width: f32) -> f32 {

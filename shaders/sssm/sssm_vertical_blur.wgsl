@@ -1,7 +1,8 @@
 // SSSM step 3 (Table 1): the vertical blur over m taps, reusing a tap pixel's horizontal result
 // when its camera depth differs from this pixel's tangent plane by less than β (Sec. 4.2: "the
 // distance is modified taking into account the normal"), else shadow-testing that row's points
-// of this pixel's tangent plane directly (which also covers taps past the screen's edges).
+// of this pixel's tangent plane directly (which also covers taps past the screen's edges, unless
+// CLAMP_EDGE_ROWS reads those from the edge).
 // Also the share of reused rows of both steps (Fig. 10). The entry points (a fragment pass, or a
 // compute pass whose workgroups share the screen column the blur reads) are in
 // sssm_vertical_blur_fragment.wgsl and sssm_vertical_blur_compute.wgsl; each defines
@@ -93,13 +94,13 @@ struct VerticalColumn {
 // Vertical tap j of weight `weight`: its row reused (added to blurred, total and reused) when the
 // β test passes, else marked failed. Selects rather than branches: every lane of a SIMD vector
 // runs every tap anyway. A row off the screen reads the nearest on-screen texel, whose value it
-// does not use.
+// uses only with CLAMP_EDGE_ROWS.
 fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<function, f32>, total: ptr<function, f32>, reused: ptr<function, f32>, failed_rows: ptr<function, FailedRows>) {
     let offset = kernel_offset(column.steps, j);
     let row = column.centre + vec2<f32>(0.0, offset * column.radius_y);
     let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), column.last_texel));
     let expected = tap_line_distance(column.line, offset);
-    let reuse = on_screen(row) && within_beta(source, expected);
+    let reuse = readable_on_screen(row) && within_beta(source, expected);
     let tap_weight_value = select(0.0, weight * bilateral_weight_of(source, expected, column.normal), reuse);
     *blurred += tap_weight_value * source.value;
     *total += tap_weight_value;

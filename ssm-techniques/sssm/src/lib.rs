@@ -74,6 +74,22 @@ pub enum BlurPasses {
     SharedRows,
 }
 
+/// Where steps 2 and 3 take the blocker rows and blur rows that fall past the screen's edges
+/// (`CLAMP_EDGE_ROWS` in `shaders/sssm/sssm_common.wgsl`). Each such row costs n or m
+/// depth-map taps when recomputed; the horizontal blur's single taps past the edges are
+/// shadow-tested either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum EdgeRows {
+    /// From the depth map, on the pixel's tangent plane, as a row that fails its reuse test: the
+    /// same result at the borders as inside the screen.
+    Recompute,
+    /// From the nearest pixel on the screen, reused when it passes the reuse test (α, β), as a
+    /// clamp-to-edge texture read would: the paper's border, where it calls filtering "not
+    /// possible" (Sec. 4.2). Cheaper, and wrong near the borders where the shadow changes past
+    /// them.
+    Clamp,
+}
+
 /// Settings of [`SeparableSoftShadowMaps`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
 pub struct SssmSettings {
@@ -110,6 +126,9 @@ pub struct SssmSettings {
     /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
     #[param(choice, default = "fragment")]
     pub blur_passes: BlurPasses,
+    /// Where blocker rows and blur rows past the screen's edges come from: recompute (the depth map on the pixel's tangent plane, as a failed reuse test's) or clamp (the nearest pixel on the screen, when it passes the reuse test: the paper's border, cheaper, wrong where the shadow changes past the edge).
+    #[param(choice, default = "recompute")]
+    pub edge_rows: EdgeRows,
     /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`) and the kernel rows that failed their reuse test per pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
@@ -343,6 +362,7 @@ impl SeparableSoftShadowMaps {
             read_counts: &read_counts,
             measure_penumbra_error: settings.penumbra_error,
             shadow_map_reads: settings.shadow_map_reads,
+            edge_rows: settings.edge_rows,
             targets: &targets,
         };
         let horizontal_blocker_layout = shared.layout("sssm_horizontal_blocker_layout", &[]);
@@ -402,6 +422,8 @@ struct Shared<'a> {
     measure_penumbra_error: bool,
     /// The settings' `shadow_map_reads` (every pass's `SHADOW_MAP_STORAGE_READS`).
     shadow_map_reads: ShadowMapReads,
+    /// The settings' `edge_rows` (every pass's `CLAMP_EDGE_ROWS`).
+    edge_rows: EdgeRows,
     targets: &'a Targets,
 }
 
@@ -410,16 +432,18 @@ impl Shared<'_> {
         create_shader_with_imports(self.setup.gpu, label, source, LOCAL_SHADERS)
     }
 
-    /// Every pass's pipeline constants: whether it counts reads and how it reads the shadow map.
-    fn constants(&self) -> [(&'static str, f64); 2] {
+    /// Every pass's pipeline constants: whether it counts reads, how it reads the shadow map and
+    /// where it takes the rows past the screen's edges.
+    fn constants(&self) -> [(&'static str, f64); 3] {
         let [count_reads] = self.read_counts.pipeline_constants();
-        [count_reads, self.shadow_map_reads.pipeline_constant()]
+        let clamp_edge_rows = ("CLAMP_EDGE_ROWS", f64::from(u8::from(self.edge_rows == EdgeRows::Clamp)));
+        [count_reads, self.shadow_map_reads.pipeline_constant(), clamp_edge_rows]
     }
 
     /// Step 2's pipeline constants: those of every pass, and whether it measures the penumbra error.
-    fn blocker_blur_constants(&self) -> [(&'static str, f64); 3] {
-        let [count_reads, reads] = self.constants();
-        [count_reads, reads, ("MEASURE_PENUMBRA_ERROR", f64::from(u8::from(self.measure_penumbra_error)))]
+    fn blocker_blur_constants(&self) -> [(&'static str, f64); 4] {
+        let [count_reads, reads, edges] = self.constants();
+        [count_reads, reads, edges, ("MEASURE_PENUMBRA_ERROR", f64::from(u8::from(self.measure_penumbra_error)))]
     }
 
     /// A layout of the shared entries and `extra`.
@@ -740,6 +764,19 @@ const PRESETS: &[ssm_core::Preset] = &[
             "sssm.blur_passes=fragment,shared_rows",
             "sssm.alpha:beta=0.1:0.1",
         ],
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "sssm-edges",
+        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges recomputed on the pixel's tangent plane (the default) or clamped to the nearest pixel on the screen (the paper's border), at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost",
+        scenes: &["leaves"],
+        varies: &[
+            "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
+            "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
+            "sssm.edge_rows=recompute,clamp",
+            "sssm.alpha:beta=0.1:0.1",
+        ],
+        size: Some(TABLE4_VIEWPORT),
         ..ssm_core::Preset::DEFAULT
     },
     ssm_core::Preset {

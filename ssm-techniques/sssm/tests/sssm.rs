@@ -302,16 +302,22 @@ fn failed_rows_are_counted_by_cause() {
 /// A named scene at an image size, with settings.
 type Case = (&'static str, Scene, (u32, u32), &'static [(&'static str, &'static str)]);
 
-/// Steps 2 and 3 as shared-row compute passes give the fragment passes' pixels: on the plant, on
-/// a tilted receiver, with and without bilateral weights and reuse, and with blurs wider than a
+/// Steps 2 and 3 as shared-row compute passes give the fragment passes' pixels: on the plant (its
+/// rows past the screen's edges recomputed or clamped), on a tilted receiver, with and without bilateral weights and reuse, and with blurs wider than a
 /// workgroup's shared segment (taps past it read the textures).
 #[test]
 fn shared_row_passes_give_the_fragment_passes_pixels() {
     let gpu = gpu();
     let mut huge_light = builtin("parallel-square").unwrap().build();
     huge_light.lights[0].half_size *= 20.0;
-    let cases: [Case; 6] = [
+    let cases: [Case; 7] = [
         ("leaves", builtin("leaves").unwrap().build(), SIZE, &[("alpha", "0.1"), ("beta", "0.1")]),
+        (
+            "leaves, clamped edge rows",
+            builtin("leaves").unwrap().build(),
+            SIZE,
+            &[("alpha", "0.1"), ("beta", "0.1"), ("edge_rows", "clamp")],
+        ),
         ("leaves 29/41", builtin("leaves").unwrap().build(), SIZE, &[("blocker_kernel", "29"), ("blur_kernel", "41")]),
         (
             "sphere-cube unweighted, no reuse",
@@ -423,9 +429,9 @@ fn the_penumbra_error_reuse_brings_in_is_zero_without_reuse_and_grows_with_alpha
 /// pixels of `small`'s edges along the axis it is cut (`along_x`: left and right; else top and
 /// bottom), `large` being `small` widened on both sides of that axis by half `small`'s size,
 /// with the same pixel size; and the number of those pixels.
-fn edge_difference(small: (&Scene, u32, u32), large: &Scene, along_x: bool) -> (f32, usize) {
+fn edge_difference(small: (&Scene, u32, u32), large: &Scene, along_x: bool, edge_rows: &str) -> (f32, usize) {
     let gpu = gpu();
-    let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05")];
+    let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05"), ("edge_rows", edge_rows)];
     let (scene, width, height) = small;
     let (large_width, large_height) = if along_x { (2 * width, height) } else { (width, 2 * height) };
     let narrow = render(&gpu, scene, &ssm_sssm::INFO, &settings, width, height).unwrap();
@@ -458,19 +464,75 @@ fn edge_difference(small: (&Scene, u32, u32), large: &Scene, along_x: bool) -> (
 #[test]
 fn the_blur_past_the_screen_edges_gives_the_pixels_of_a_larger_screen() {
     let scene = top_down_parallel_square();
-    let (across, across_pixels) = edge_difference((&scene, 32, 64), &scene, true);
-    // A landscape image a third of the ground high, and the one twice as tall.
-    let mut short = scene.clone();
-    short.camera.fov_y = 2.0 * (1.1f32 / 6.0).atan();
-    let mut tall = short.clone();
-    tall.camera.fov_y = 2.0 * (2.0 * (short.camera.fov_y * 0.5).tan()).atan();
-    let (down, down_pixels) = edge_difference((&short, 64, 32), &tall, false);
+    let (across, across_pixels) = edge_difference((&scene, 32, 64), &scene, true, "recompute");
+    let (short, tall) = short_and_tall(&scene);
+    let (down, down_pixels) = edge_difference((&short, 64, 32), &tall, false, "recompute");
     println!(
         "smaller against the larger image's middle: mean |difference| {across:.4} over {across_pixels} penumbra pixels at the left and right edges, {down:.4} over {down_pixels} at the top and bottom"
     );
     assert!(across_pixels > 100 && down_pixels > 100, "the penumbra must cross the edges: {across_pixels}, {down_pixels} pixels");
     assert!(across < 0.02, "left and right: {across}");
     assert!(down < 0.02, "top and bottom: {down}");
+}
+
+/// `scene` as a landscape image a third of the ground high, and the one twice as tall with the
+/// same pixel size.
+fn short_and_tall(scene: &Scene) -> (Scene, Scene) {
+    let mut short = scene.clone();
+    short.camera.fov_y = 2.0 * (1.1f32 / 6.0).atan();
+    let mut tall = short.clone();
+    tall.camera.fov_y = 2.0 * (2.0 * (short.camera.fov_y * 0.5).tan()).atan();
+    (short, tall)
+}
+
+/// With `edge_rows = clamp` the rows past the screen's edges are read from the nearest pixel on
+/// the screen and reused when they pass the reuse test (the paper's border, Sec. 4.2) instead of
+/// being recomputed: with thresholds that every row of a flat receiver passes, almost none of
+/// them fails any more, and the pixels near the top and bottom edges no longer match the larger
+/// screen's as the recomputed rows do (the test above); the rest of the image is unchanged.
+#[test]
+fn clamped_edge_rows_are_reused_from_the_edge_at_a_cost_in_accuracy_there() {
+    let mut scene = builtin("parallel-square").unwrap().build();
+    // A light large enough that both steps' rows reach past the screen's edges.
+    scene.lights[0].half_size *= 4.0;
+    let off_screen = |edge_rows: &str| {
+        let settings = [
+            ("blocker_kernel", "7"),
+            ("blur_kernel", "15"),
+            ("alpha", "1"),
+            ("beta", "1"),
+            ("count_reads", "true"),
+            ("edge_rows", edge_rows),
+        ];
+        let diagnostics = diagnostics_of(&ssm_sssm::INFO, &scene, &settings);
+        ["blocker", "blur"].map(|step| value(&diagnostics, &format!("sssm_{step}_rows_failed_off_screen_rows_per_pixel")))
+    };
+    let recomputed = off_screen("recompute");
+    let clamped = off_screen("clamp");
+    println!("rows failed past the edges per pixel (blocker, blur): recompute {recomputed:?}, clamp {clamped:?}");
+    for step in 0..2 {
+        assert!(recomputed[step] > 0.1, "the rows reach past the edges: {recomputed:?}");
+        assert!(clamped[step] < 0.1 * recomputed[step], "clamped rows pass the tests: {clamped:?} against {recomputed:?}");
+    }
+    let (short, tall) = short_and_tall(&top_down_parallel_square());
+    let (recompute_down, _) = edge_difference((&short, 64, 32), &tall, false, "recompute");
+    let (clamp_down, pixels) = edge_difference((&short, 64, 32), &tall, false, "clamp");
+    println!(
+        "top and bottom edges against the larger screen: recompute {recompute_down:.4}, clamp {clamp_down:.4} over {pixels} penumbra pixels"
+    );
+    assert!(clamp_down > 2.0 * recompute_down.max(0.01), "clamp {clamp_down} against recompute {recompute_down}");
+    // Where no row falls past the edges (the larger screen), the two are the same pixels; where
+    // rows do (the smaller one), they are not.
+    let gpu = gpu();
+    let settings = |edge_rows| [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05"), ("edge_rows", edge_rows)];
+    let pixels = |scene: &Scene, (width, height): (u32, u32)| {
+        ["recompute", "clamp"]
+            .map(|edge_rows| render(&gpu, scene, &ssm_sssm::INFO, &settings(edge_rows), width, height).unwrap().visibility)
+    };
+    let [recompute_tall, clamp_tall] = pixels(&tall, (64, 64));
+    assert_eq!(recompute_tall, clamp_tall, "no row reaches past the larger screen's edges");
+    let [recompute_short, clamp_short] = pixels(&short, (64, 32));
+    assert_ne!(recompute_short, clamp_short, "rows reach past the smaller screen's edges");
 }
 
 /// Step 2 hands step 3's taps one packed texel (the horizontal result, the eye distance signed by
