@@ -198,16 +198,12 @@ fn kernels_wider_than_the_screen_and_zero_penumbrae_stay_in_range() {
     // A light 20 times the occluder on a 32×24 image: blocker windows and blurs far wider than the screen.
     let mut scene = builtin("parallel-square").unwrap().build();
     scene.lights[0].half_size *= 20.0;
-    let wide = render(
-        &gpu,
-        &scene,
-        &ssm_sssm::INFO,
-        &[("blocker_kernel", "64"), ("blur_kernel", "128"), ("alpha", "0.05"), ("beta", "0.05")],
-        32,
-        24,
-    )
-    .unwrap();
-    assert!(wide.visibility.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)));
+    // Rows past the edges recomputed, and clamped to the edge (nearly every row lies past it).
+    for edge_rows in ["recompute", "clamp"] {
+        let settings = [("blocker_kernel", "64"), ("blur_kernel", "128"), ("alpha", "0.05"), ("beta", "0.05"), ("edge_rows", edge_rows)];
+        let wide = render(&gpu, &scene, &ssm_sssm::INFO, &settings, 32, 24).unwrap();
+        assert!(wide.visibility.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)), "{edge_rows}");
+    }
     // A point light: zero penumbra everywhere, so the hard value is kept.
     scene.lights[0].half_size *= 0.0;
     let hard = render(&gpu, &scene, &ssm_sssm::INFO, &[], 64, 48).unwrap();
