@@ -17,8 +17,10 @@ out="${1:-gpu-bench}"
 width="${SSM_BENCH_WIDTH:-1920}"
 height="${SSM_BENCH_HEIGHT:-1080}"
 frames="${SSM_BENCH_FRAMES:-5}"
-# Buades et al.'s Table 4, Atty et al.'s map sizes (one- and two-sided), 1–3 lights for every
-# technique, Shen et al.'s Figs. 10 and 11, Forest et al.'s Fig. 12.
+# Buades et al.'s Table 4 and SSSM's implementation choices beside PCSS (rows past the screen's
+# edges, fragment or shared-row passes, sampled or storage reads; PCSS's workgroup tiles), Atty
+# et al.'s map sizes (one- and two-sided), 1–3 lights for every technique, Shen et al.'s Figs. 10
+# and 11, Forest et al.'s Fig. 12.
 presets="${SSM_BENCH_PRESETS:-sssm-table4 sssm-edges sssm-passes sssm-reads pcss-taps atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 

@@ -97,8 +97,8 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         let screen = vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
         var reuse = false;
         var no_data = false;
-        let visible = screen.z > 0.0 && on_screen(screen.xy);
-        if (screen.z > 0.0 && readable_on_screen(screen.xy)) {
+        let visible = screen.z > 0.0 && row_read_from_screen(screen.xy);
+        if (visible) {
             let other = textureLoad(horizontal_blocker, clamped_texel(screen.xy), 0);
             reads += 1u;
             no_data = other.x < 0.0;

@@ -59,10 +59,12 @@ struct SssmSettings {
 var<private> reads: u32;
 
 // Rows of this invocation's kernel that failed their reuse test (α in step 2, β in step 3), by
-// cause, when counting: the row's pixel lies off the screen; it holds nothing the test can use
-// (step 1 computed nothing there: no surface, or trivially lit or dark; in step 3, no surface);
-// or it holds a value whose depth differs by the threshold or more. Only the last depends on α
-// and β: the first two are rows the screen cannot supply at any threshold.
+// cause, when counting: the row's pixel lies off the screen (with CLAMP_EDGE_ROWS, only a
+// blocker row behind the eye: the others are read from the edge and fail, if at all, by the
+// next two causes); it holds nothing the test can use (step 1 computed nothing there: no
+// surface, or trivially lit or dark; in step 3, no surface); or it holds a value whose depth
+// differs by the threshold or more. Only the last depends on α and β: the first two are rows the
+// screen cannot supply at any threshold.
 var<private> failed_rows_off_screen: u32;
 var<private> failed_rows_no_data: u32;
 var<private> failed_rows_depth: u32;
@@ -282,17 +284,18 @@ fn on_screen(pixel: vec2<f32>) -> bool {
 
 // Whether steps 2 and 3 read a blocker row or a blur row that falls past the screen's edges from
 // the nearest pixel on the screen, and reuse it when it passes the reuse test (α, β), as a
-// clamp-to-edge texture read would: the settings' edge_rows = clamp, the paper's border ("not
-// possible to perform the filtering operations ... in the upper and bottom borders of the screen",
-// Sec. 4.2). Otherwise (recompute) such a row is read from the depth map on this pixel's tangent
-// plane, as a failed test's is. A row costs n or m taps, so these rows are a large share of the
+// screen-space pass reading through a clamp-to-edge sampler would (the settings' edge_rows =
+// clamp). The paper only says that filtering there is "not possible" (Sec. 4.2: "in the upper
+// and bottom borders of the screen, which would need information that falls out of the
+// screen"), not how its passes read there. Otherwise (recompute) such a row is read from the
+// depth map, as a failed test's is. A row costs n or m taps, so these rows are a large share of the
 // work near the borders; the horizontal blur's single taps past the edges are shadow-tested either
 // way. A constant of the pipeline.
 override CLAMP_EDGE_ROWS: bool = false;
 
-// Whether a row at pixel position `pixel` may be read from the screen (clamped_texel):
-// on the screen, or anywhere with CLAMP_EDGE_ROWS.
-fn readable_on_screen(pixel: vec2<f32>) -> bool {
+// Whether a row at pixel position `pixel` is read from the screen (at clamped_texel): on the
+// screen, or anywhere with CLAMP_EDGE_ROWS.
+fn row_read_from_screen(pixel: vec2<f32>) -> bool {
     return CLAMP_EDGE_ROWS || on_screen(pixel);
 }
 

@@ -100,14 +100,15 @@ fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<functi
     let row = column.centre + vec2<f32>(0.0, offset * column.radius_y);
     let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), column.last_texel));
     let expected = tap_line_distance(column.line, offset);
-    let reuse = readable_on_screen(row) && within_beta(source, expected);
+    let read_from_screen = row_read_from_screen(row);
+    let reuse = read_from_screen && within_beta(source, expected);
     let tap_weight_value = select(0.0, weight * bilateral_weight_of(source, expected, column.normal), reuse);
     *blurred += tap_weight_value * source.value;
     *total += tap_weight_value;
     *reused += select(0.0, 1.0, reuse);
     mark_failed_row_if(failed_rows, j, !reuse);
     if (COUNT_READS && !reuse) {
-        count_failed_row(!on_screen(row), source.eye_distance < 0.0);
+        count_failed_row(!read_from_screen, source.eye_distance < 0.0);
     }
 }
 

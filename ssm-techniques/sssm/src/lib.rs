@@ -80,13 +80,15 @@ pub enum BlurPasses {
 /// shadow-tested either way.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
 pub enum EdgeRows {
-    /// From the depth map, on the pixel's tangent plane, as a row that fails its reuse test: the
+    /// From the depth map, as a row that fails its reuse test (a blocker row's n taps compared
+    /// with the receiver, a blur row's m taps shadow-tested on the pixel's tangent plane): the
     /// same result at the borders as inside the screen.
     Recompute,
     /// From the nearest pixel on the screen, reused when it passes the reuse test (α, β), as a
-    /// clamp-to-edge texture read would: the paper's border, where it calls filtering "not
-    /// possible" (Sec. 4.2). Cheaper, and wrong near the borders where the shadow changes past
-    /// them.
+    /// screen-space pass reading through a clamp-to-edge sampler would; a reused one counts as
+    /// reused in the reuse share (Fig. 10). The paper says filtering is "not possible" at the
+    /// borders (Sec. 4.2), not how its passes read there. Cheaper, and wrong near the borders
+    /// where the shadow changes past them.
     Clamp,
 }
 
@@ -126,10 +128,10 @@ pub struct SssmSettings {
     /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
     #[param(choice, default = "fragment")]
     pub blur_passes: BlurPasses,
-    /// Where blocker rows and blur rows past the screen's edges come from: recompute (the depth map on the pixel's tangent plane, as a failed reuse test's) or clamp (the nearest pixel on the screen, when it passes the reuse test: the paper's border, cheaper, wrong where the shadow changes past the edge).
+    /// Where blocker rows and blur rows past the screen's edges come from: recompute (the depth map, as a failed reuse test's) or clamp (the nearest pixel on the screen when it passes the reuse test, as a clamp-to-edge read would; cheaper, wrong where the shadow changes past the edge).
     #[param(choice, default = "recompute")]
     pub edge_rows: EdgeRows,
-    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`) and the kernel rows that failed their reuse test per pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`); the atomics cost time, so off when timing.
+    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`) and the kernel rows that failed their reuse test per pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`; with `edge_rows = clamp`, `off_screen` counts only blocker rows behind the eye, the others being read from the edge); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
     /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostics `sssm_penumbra_mse_texels2` over the pixels either search finds a blocker for and `sssm_penumbra_mse_all_texels2` over every pixel computed, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
@@ -768,7 +770,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-edges",
-        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges recomputed on the pixel's tangent plane (the default) or clamped to the nearest pixel on the screen (the paper's border), at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost",
+        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges recomputed from the depth map (the default) or clamped to the nearest pixel on the screen (as a clamp-to-edge read would), at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",

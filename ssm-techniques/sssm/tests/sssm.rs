@@ -306,13 +306,19 @@ fn shared_row_passes_give_the_fragment_passes_pixels() {
     let gpu = gpu();
     let mut huge_light = builtin("parallel-square").unwrap().build();
     huge_light.lights[0].half_size *= 20.0;
-    let cases: [Case; 7] = [
+    let cases: [Case; 8] = [
         ("leaves", builtin("leaves").unwrap().build(), SIZE, &[("alpha", "0.1"), ("beta", "0.1")]),
         (
             "leaves, clamped edge rows",
             builtin("leaves").unwrap().build(),
             SIZE,
             &[("alpha", "0.1"), ("beta", "0.1"), ("edge_rows", "clamp")],
+        ),
+        (
+            "huge light, clamped edge rows",
+            huge_light.clone(),
+            (96, 72),
+            &[("blocker_kernel", "32"), ("blur_kernel", "64"), ("alpha", "0.05"), ("beta", "0.05"), ("edge_rows", "clamp")],
         ),
         ("leaves 29/41", builtin("leaves").unwrap().build(), SIZE, &[("blocker_kernel", "29"), ("blur_kernel", "41")]),
         (
@@ -482,16 +488,19 @@ fn short_and_tall(scene: &Scene) -> (Scene, Scene) {
 }
 
 /// With `edge_rows = clamp` the rows past the screen's edges are read from the nearest pixel on
-/// the screen and reused when they pass the reuse test (the paper's border, Sec. 4.2) instead of
-/// being recomputed: with thresholds that every row of a flat receiver passes, almost none of
-/// them fails any more, and the pixels near the top and bottom edges no longer match the larger
-/// screen's as the recomputed rows do (the test above); the rest of the image is unchanged.
+/// the screen and reused when they pass the reuse test, as a clamp-to-edge read would, instead of
+/// being recomputed: with thresholds that every row of a flat receiver passes, nearly every row
+/// that failed past the edges is reused (not merely counted under another cause); each step's
+/// clamping changes the pixels of an image whose rows reach past its edges; the pixels near the
+/// top and bottom edges no longer match the larger screen's as the recomputed rows do (the test
+/// above); and where no row of step 3 falls past the edges and step 2 reads none from the screen,
+/// the two are the same pixels.
 #[test]
 fn clamped_edge_rows_are_reused_from_the_edge_at_a_cost_in_accuracy_there() {
     let mut scene = builtin("parallel-square").unwrap().build();
     // A light large enough that both steps' rows reach past the screen's edges.
     scene.lights[0].half_size *= 4.0;
-    let off_screen = |edge_rows: &str| {
+    let failed = |edge_rows: &str| {
         let settings = [
             ("blocker_kernel", "7"),
             ("blur_kernel", "15"),
@@ -501,14 +510,20 @@ fn clamped_edge_rows_are_reused_from_the_edge_at_a_cost_in_accuracy_there() {
             ("edge_rows", edge_rows),
         ];
         let diagnostics = diagnostics_of(&ssm_sssm::INFO, &scene, &settings);
-        ["blocker", "blur"].map(|step| value(&diagnostics, &format!("sssm_{step}_rows_failed_off_screen_rows_per_pixel")))
+        // (rows failed past the edges, rows failed by every cause), per pixel.
+        ["blocker", "blur"].map(|step| {
+            let rows = |cause: &str| value(&diagnostics, &format!("sssm_{step}_rows_failed_{cause}_rows_per_pixel"));
+            (rows("off_screen"), ["off_screen", "no_data", "depth"].map(rows).iter().sum::<f64>())
+        })
     };
-    let recomputed = off_screen("recompute");
-    let clamped = off_screen("clamp");
-    println!("rows failed past the edges per pixel (blocker, blur): recompute {recomputed:?}, clamp {clamped:?}");
+    let recomputed = failed("recompute");
+    let clamped = failed("clamp");
+    println!("rows failed per pixel (past the edges, in all) for the blocker and blur rows: recompute {recomputed:?}, clamp {clamped:?}");
     for step in 0..2 {
-        assert!(recomputed[step] > 0.1, "the rows reach past the edges: {recomputed:?}");
-        assert!(clamped[step] < 0.1 * recomputed[step], "clamped rows pass the tests: {clamped:?} against {recomputed:?}");
+        let ((recomputed_off, recomputed_all), (clamped_off, clamped_all)) = (recomputed[step], clamped[step]);
+        assert!(recomputed_off > 0.1, "the rows reach past the edges: {recomputed:?}");
+        assert!(clamped_off < 0.1 * recomputed_off, "clamped rows are read from the screen: {clamped:?} against {recomputed:?}");
+        assert!(clamped_all < recomputed_all - 0.9 * recomputed_off, "and pass the tests: {clamped:?} against {recomputed:?}");
     }
     let (short, tall) = short_and_tall(&top_down_parallel_square());
     let (recompute_down, _) = edge_difference((&short, 64, 32), &tall, false, "recompute");
@@ -517,18 +532,22 @@ fn clamped_edge_rows_are_reused_from_the_edge_at_a_cost_in_accuracy_there() {
         "top and bottom edges against the larger screen: recompute {recompute_down:.4}, clamp {clamp_down:.4} over {pixels} penumbra pixels"
     );
     assert!(clamp_down > 2.0 * recompute_down.max(0.01), "clamp {clamp_down} against recompute {recompute_down}");
-    // Where no row falls past the edges (the larger screen), the two are the same pixels; where
-    // rows do (the smaller one), they are not.
     let gpu = gpu();
-    let settings = |edge_rows| [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", "0"), ("beta", "0.05"), ("edge_rows", edge_rows)];
-    let pixels = |scene: &Scene, (width, height): (u32, u32)| {
-        ["recompute", "clamp"]
-            .map(|edge_rows| render(&gpu, scene, &ssm_sssm::INFO, &settings(edge_rows), width, height).unwrap().visibility)
+    let pixels = |scene: &Scene, (width, height): (u32, u32), (alpha, beta): (&str, &str)| {
+        ["recompute", "clamp"].map(|edge_rows| {
+            let settings = [("blocker_kernel", "7"), ("blur_kernel", "15"), ("alpha", alpha), ("beta", beta), ("edge_rows", edge_rows)];
+            render(&gpu, scene, &ssm_sssm::INFO, &settings, width, height).unwrap().visibility
+        })
     };
-    let [recompute_tall, clamp_tall] = pixels(&tall, (64, 64));
-    assert_eq!(recompute_tall, clamp_tall, "no row reaches past the larger screen's edges");
-    let [recompute_short, clamp_short] = pixels(&short, (64, 32));
-    assert_ne!(recompute_short, clamp_short, "rows reach past the smaller screen's edges");
+    // Step 2 alone, on the plant, whose leaves lie past every edge: with β = 0 step 3 reads no
+    // row from the screen.
+    let [recompute_blocker, clamp_blocker] = pixels(&builtin("leaves").unwrap().build(), SIZE, ("0.1", "0"));
+    assert_ne!(recompute_blocker, clamp_blocker, "step 2's blocker rows reach past the edges");
+    // Step 3 alone: with α = 0 step 2 reads no blocker row from the screen.
+    let [recompute_blur, clamp_blur] = pixels(&short, (64, 32), ("0", "0.05"));
+    assert_ne!(recompute_blur, clamp_blur, "step 3's rows reach past the smaller screen's edges");
+    let [recompute_tall, clamp_tall] = pixels(&tall, (64, 64), ("0", "0.05"));
+    assert_eq!(recompute_tall, clamp_tall, "no row of step 3 reaches past the larger screen's edges");
 }
 
 /// Step 2 hands step 3's taps one packed texel (the horizontal result, the eye distance signed by
