@@ -48,8 +48,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // Rows failing the β test, recomputed after the reused ones.
     var failed_rows = FailedRows();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(0.0, radii.y));
-    let last_texel = vec2<i32>(camera.viewport.xy) - 1;
-    let column = VerticalColumn(steps, centre, radii.y, line, last_texel, point.normal);
+    let column = VerticalColumn(steps, centre, radii.y, line, point.normal);
     // The taps in pairs about the centre, weighted as recomputed_row's (settings.blur_weight_steps).
     let half = m / 2u;
     let odd = m % 2u;
@@ -87,7 +86,6 @@ struct VerticalColumn {
     centre: vec2<f32>,
     radius_y: f32,
     line: TapLine,
-    last_texel: vec2<i32>,
     normal: vec3<f32>,
 };
 
@@ -98,7 +96,7 @@ struct VerticalColumn {
 fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<function, f32>, total: ptr<function, f32>, reused: ptr<function, f32>, failed_rows: ptr<function, FailedRows>) {
     let offset = kernel_offset(column.steps, j);
     let row = column.centre + vec2<f32>(0.0, offset * column.radius_y);
-    let source = vertical_source(clamp(vec2<i32>(floor(row)), vec2<i32>(0), column.last_texel));
+    let source = vertical_source(clamped_texel(row));
     let expected = tap_line_distance(column.line, offset);
     let read_from_screen = row_read_from_screen(row);
     let reuse = read_from_screen && within_beta(source, expected);
