@@ -175,6 +175,7 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
     // The taps on the screen are a run of consecutive taps (the tap's x grows with its index).
     var first_on_screen = m;
     var last_on_screen = -1;
+    let bilateral = bilateral_weights(point.normal);
     for (var j = 0u; j < m; j++) {
         let offset = kernel_offset(steps, j);
         let tap = vec2<f32>(centre.x + offset * radii.x, centre.y);
@@ -182,7 +183,7 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
             let source = horizontal_source(vec2<i32>(tap));
             var weight = tap_weight(j);
             if (settings.bilateral_depth > 0.0) {
-                weight *= bilateral_weight_of(source, tap_line_distance(line, offset), point.normal);
+                weight *= bilateral_weight_of(bilateral, source, tap_line_distance(line, offset));
             }
             blurred += weight * source.value;
             total += weight;

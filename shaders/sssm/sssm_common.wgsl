@@ -421,16 +421,29 @@ fn unpack_vertical_tap_source(packed: vec4<f32>) -> BlurSource {
     return BlurSource(packed.x, abs(packed.y), vec3<f32>(packed.zw, select(-normal_z, normal_z, packed.y > 0.0)));
 }
 
-// Bilateral weight of a blur tap landing on `source`, for the pixel seen with normal `normal`,
-// where `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
+// What the bilateral weights of one pixel's blur taps share, computed once per pixel: its normal,
+// and the reciprocal of the depth tolerance. lavapipe runs the body of a branch as masked code
+// and LLVM does not move a division out of it, so a reciprocal taken per tap inside the
+// horizontal blur's on-screen branch was a division per tap (about 5% of step 2 at 29/41).
+struct BilateralWeights {
+    normal: vec3<f32>,
+    // 1 / (bilateral_depth · the scene's diagonal); unused when bilateral_depth is 0.
+    inverse_tolerance: f32,
+};
+
+fn bilateral_weights(normal: vec3<f32>) -> BilateralWeights {
+    return BilateralWeights(normal, 1.0 / scene_length(frame, settings.bilateral_depth));
+}
+
+// Bilateral weight of a blur tap landing on `source`, for the pixel of `bilateral`, where
+// `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
 // pixel's ray (tap_line_distance): how much the surface seen there looks like this pixel's
 // tangent plane, by the difference of camera distances (the distance of the vertical pass's β
 // test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
 // not leak over edges.
-fn bilateral_weight_of(source: BlurSource, expected_distance: f32, normal: vec3<f32>) -> f32 {
-    // A product with the reciprocal, which the compiler hoists out of the tap loops.
-    let gap = (source.eye_distance - expected_distance) * (1.0 / scene_length(frame, settings.bilateral_depth));
-    let turn = max(dot(normal, source.normal), 0.0);
+fn bilateral_weight_of(bilateral: BilateralWeights, source: BlurSource, expected_distance: f32) -> f32 {
+    let gap = (source.eye_distance - expected_distance) * bilateral.inverse_tolerance;
+    let turn = max(dot(bilateral.normal, source.normal), 0.0);
     // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
     // falls to 1/2 at about 23°.
     let turn_2 = turn * turn;

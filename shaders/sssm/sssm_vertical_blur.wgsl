@@ -48,7 +48,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     // Rows failing the β test, recomputed after the reused ones.
     var failed_rows = FailedRows();
     let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(0.0, radii.y));
-    let column = VerticalColumn(steps, centre, radii.y, line, point.normal);
+    let column = VerticalColumn(steps, centre, radii.y, line, bilateral_weights(point.normal));
     // The taps in pairs about the centre, weighted as recomputed_row's (settings.blur_weight_steps).
     let half = m / 2u;
     let odd = m % 2u;
@@ -64,8 +64,11 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         pair_weight *= ratio;
         ratio *= weights.ratio_step;
     }
+    let rows = recomputed_rows(rays, point, offset, own_hard, centre.x, radii.x, m);
+    // Popped before the loop and again at the end of its body, as step 2's blocker rows: lavapipe
+    // ends a loop only when no SIMD lane is left in it, checked at the end of the body.
+    var failed = pop_failed_row(&failed_rows);
     loop {
-        let failed = pop_failed_row(&failed_rows);
         if (failed < 0) {
             break;
         }
@@ -73,8 +76,12 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         // The table's weight: the pair weight the loop above gave this row, to (k + 1)² units in
         // the last place at pair k, which a popped row no longer knows.
         let weight = tap_weight(u32(failed));
-        blurred += weight * recomputed_row(rays, point, offset, own_hard, row, radii.x, m);
+        blurred += weight * recomputed_row(rows, row.y);
         total += weight;
+        failed = pop_failed_row(&failed_rows);
+        if (failed < 0) {
+            break;
+        }
     }
     let visibility = clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
     return vec2<f32>(visibility, (own.w + reused) / (n + f32(m)));
@@ -86,7 +93,7 @@ struct VerticalColumn {
     centre: vec2<f32>,
     radius_y: f32,
     line: TapLine,
-    normal: vec3<f32>,
+    bilateral: BilateralWeights,
 };
 
 // Vertical tap j of weight `weight`: its row reused (added to blurred, total and reused) when the
@@ -100,7 +107,7 @@ fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<functi
     let expected = tap_line_distance(column.line, offset);
     let read_from_screen = row_read_from_screen(row);
     let reuse = read_from_screen && within_beta(source, expected);
-    let tap_weight_value = select(0.0, weight * bilateral_weight_of(source, expected, column.normal), reuse);
+    let tap_weight_value = select(0.0, weight * bilateral_weight_of(column.bilateral, source, expected), reuse);
     *blurred += tap_weight_value * source.value;
     *total += tap_weight_value;
     *reused += select(0.0, 1.0, reuse);
@@ -119,34 +126,20 @@ fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<functi
 // looked-up point's offset from the light's centre times den, and ray, den and H are linear in
 // the index. Each tap costs a few additions and a division instead of a ray-plane intersection
 // and a light projection (mathematically the same taps as tangent_plane_point and tap_visibility).
-fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_hard: f32, row: vec2<f32>, radius_x: f32, m: u32) -> f32 {
-    let eye = camera.position.xyz;
-    let normal = point.normal;
-    let plane_offset = dot(point.position - eye, normal);
-    // Columns: the light's u, v and normal axes, so that `v * axes` is v's light-frame components.
-    let axes = mat3x3<f32>(frame.u_axis.xyz, frame.v_axis.xyz, frame.normal.xyz);
-    let eye_light = (eye - frame.centre.xyz) * axes;
-    let lookup_light = (eye + offset - frame.centre.xyz) * axes;
-    let first_ray = rays.base + (row.x + kernel_offset(kernel_steps(m), 0u) * radius_x) * rays.per_x + row.y * rays.per_y;
-    let ray_step = (2.0 * radius_x / f32(m)) * rays.per_x;
-    let first_den = dot(first_ray, normal);
-    let den_step = dot(ray_step, normal);
-    let first_ray_light = first_ray * axes;
-    let ray_step_light = ray_step * axes;
-    let first_h = lookup_light * first_den + plane_offset * first_ray_light;
-    let h_step = lookup_light * den_step + plane_offset * ray_step_light;
+fn recomputed_row(rows: RecomputedRows, row_y: f32) -> f32 {
+    let first_ray = rows.first_ray_x + row_y * rows.per_y;
+    let first_den = dot(first_ray, rows.normal);
+    let first_ray_light = first_ray * rows.axes;
+    let first_h = rows.lookup_light * first_den + rows.plane_offset * first_ray_light;
     // The plane point's own light depth times den (the one-sided emitter's test, without the offset).
-    let first_front = eye_light.z * first_den + plane_offset * first_ray_light.z;
-    let front_step = eye_light.z * den_step + plane_offset * ray_step_light.z;
-    let half_inverse_projection = 0.5 / frame.projection.xy;
+    let first_front = rows.eye_light_z * first_den + rows.plane_offset * first_ray_light.z;
     // den and the plane point's front distance are linear in the tap index: where each has one
     // sign at both ends of the row it has that sign at every tap, and so have the plane test
     // (meets_plane below) and the light test (in_front). Where both pass at every tap, each tap
     // only compares depths: the same values as the general loop after it, which handles the rows
     // that cross the eye's or the light's plane (grazing views).
-    let last = f32(m - 1u);
-    let last_den = first_den + last * den_step;
-    let last_front = first_front + last * front_step;
+    let last_den = first_den + rows.last * rows.den_step;
+    let last_front = first_front + rows.last * rows.front_step;
     let den_kept = first_den * last_den > 0.0 && min(abs(first_den), abs(last_den)) >= 1e-12;
     let front_kept = first_front * last_front > 0.0;
     // The taps pair up about the row's centre and share a weight (settings.blur_weight_steps):
@@ -154,16 +147,16 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
     // weights follow by two products a pair rather than tap_weight's table: on lavapipe a lookup
     // indexed by the loop counter is a load per SIMD lane (dropping it saved about 5% of this
     // pass at 29/41 on leaves; the sssm README has the figures).
-    let half = m / 2u;
-    let odd = m % 2u;
+    let half = rows.half;
+    let odd = rows.odd;
     let weights = settings.blur_weight_steps;
     var row_sum = 0.0;
     var weight = weights.first_pair;
     var ratio = weights.first_ratio;
-    if (den_kept && front_kept && plane_offset * first_den > 0.0 && first_front * first_den > 0.0) {
+    if (den_kept && front_kept && rows.plane_offset * first_den > 0.0 && first_front * first_den > 0.0) {
         // With den's sign s: s·h.z <= the map's depth · s·den is h.z / den <= the map's depth.
         let den_sign = select(-1.0, 1.0, first_den > 0.0);
-        let stepped = DepthOnlyRow(den_sign * first_h, den_sign * h_step, den_sign * first_den, den_sign * den_step, half_inverse_projection);
+        let stepped = DepthOnlyRow(den_sign * first_h, den_sign * rows.h_step, den_sign * first_den, den_sign * rows.den_step, rows.half_inverse_projection);
         if (odd == 1u) {
             row_sum = weights.centre * depth_only_lit(stepped, f32(half));
         }
@@ -174,7 +167,7 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
         }
         return row_sum / settings.blur_weight_total;
     }
-    let stepped = GeneralRow(first_h, h_step, first_den, den_step, first_front, front_step, plane_offset, own_hard, half_inverse_projection);
+    let stepped = GeneralRow(first_h, rows.h_step, first_den, rows.den_step, first_front, rows.front_step, rows.plane_offset, rows.own_hard, rows.half_inverse_projection);
     if (odd == 1u) {
         row_sum = weights.centre * general_visibility(stepped, f32(half));
     }
@@ -184,6 +177,52 @@ fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_h
         ratio *= weights.ratio_step;
     }
     return row_sum / settings.blur_weight_total;
+}
+
+// What every recomputed row of a pixel shares (recomputed_rows), computed once per pixel rather
+// than per row: lavapipe runs a loop body's straight-line code for every row of every SIMD lane.
+struct RecomputedRows {
+    normal: vec3<f32>,
+    // (point - eye) · normal.
+    plane_offset: f32,
+    // Columns: the light's u, v and normal axes, so that `v * axes` is v's light-frame components.
+    axes: mat3x3<f32>,
+    // The eye's light-frame depth.
+    eye_light_z: f32,
+    // The looked-up point's eye, offset, in the light frame, relative to the light's centre.
+    lookup_light: vec3<f32>,
+    // The camera ray of a row's first tap, less its row's y · per_y.
+    first_ray_x: vec3<f32>,
+    per_y: vec3<f32>,
+    // Per tap: the ray's dot with the normal, H and the front distance.
+    den_step: f32,
+    h_step: vec3<f32>,
+    front_step: f32,
+    half_inverse_projection: vec2<f32>,
+    // The pixel's hard value, for taps whose ray misses the plane.
+    own_hard: f32,
+    // m - 1, m / 2 and m % 2.
+    last: f32,
+    half: u32,
+    odd: u32,
+};
+
+// The shared part of the recomputed rows of the pixel at `point`, its blur `radius_x` pixels
+// either side of `centre_x` over m taps.
+fn recomputed_rows(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_hard: f32, centre_x: f32, radius_x: f32, m: u32) -> RecomputedRows {
+    let eye = camera.position.xyz;
+    let normal = point.normal;
+    let plane_offset = dot(point.position - eye, normal);
+    let axes = mat3x3<f32>(frame.u_axis.xyz, frame.v_axis.xyz, frame.normal.xyz);
+    let eye_light = (eye - frame.centre.xyz) * axes;
+    let lookup_light = (eye + offset - frame.centre.xyz) * axes;
+    let first_ray_x = rays.base + (centre_x + kernel_offset(kernel_steps(m), 0u) * radius_x) * rays.per_x;
+    let ray_step = (2.0 * radius_x / f32(m)) * rays.per_x;
+    let den_step = dot(ray_step, normal);
+    let ray_step_light = ray_step * axes;
+    let h_step = lookup_light * den_step + plane_offset * ray_step_light;
+    let front_step = eye_light.z * den_step + plane_offset * ray_step_light.z;
+    return RecomputedRows(normal, plane_offset, axes, eye_light.z, lookup_light, first_ray_x, rays.per_y, den_step, h_step, front_step, 0.5 / frame.projection.xy, own_hard, f32(m - 1u), m / 2u, m % 2u);
 }
 
 // A recomputed row whose taps all lie on the plane in front of the eye and of the light, its
