@@ -65,8 +65,9 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         ratio *= weights.ratio_step;
     }
     let rows = recomputed_rows(rays, point, offset, own_hard, centre.x, radii.x, m);
-    // Popped before the loop and again at the end of its body, as step 2's blocker rows: lavapipe
-    // ends a loop only when no SIMD lane is left in it, checked at the end of the body.
+    // Popped before the loop and again at the end of its body: lavapipe ends a loop only when no
+    // SIMD lane is left in it, checked at the end of the body, so with the pop at the top a vector
+    // of pixels ran one more row, masked, after its last (about 3% of this pass at 7/15).
     var failed = pop_failed_row(&failed_rows);
     loop {
         if (failed < 0) {
@@ -118,9 +119,10 @@ fn vertical_tap(column: VerticalColumn, j: u32, weight: f32, blurred: ptr<functi
 }
 
 // A row of step 2's horizontal blur recomputed on this pixel's tangent plane with this pixel's
-// kernel: the m taps along the screen row through `row`, `radius_x` pixels either side, each the
-// hard visibility of the point of the plane seen there (`own_hard` where the camera ray misses
-// the plane). That point, offset by the pixel's lookup offset, projects into the shadow map as
+// kernel: the m taps along the screen row at pixel height `row_y`, the blur's half-width either
+// side of the pixel's column (`rows`, what the pixel's rows share), each the hard visibility of
+// the point of the plane seen there (the pixel's own hard value where the camera ray misses the
+// plane). That point, offset by the pixel's lookup offset, projects into the shadow map as
 // a projective function of the tap's index, so the taps are stepped in homogeneous coordinates:
 // with den = ray·normal, H = (eye + offset - light centre)·den + (point - eye)·normal · ray is the
 // looked-up point's offset from the light's centre times den, and ray, den and H are linear in
@@ -180,7 +182,8 @@ fn recomputed_row(rows: RecomputedRows, row_y: f32) -> f32 {
 }
 
 // What every recomputed row of a pixel shares (recomputed_rows), computed once per pixel rather
-// than per row: lavapipe runs a loop body's straight-line code for every row of every SIMD lane.
+// than in each row's setup (no change in time measured on lavapipe, whose LLVM may hoist it; it
+// keeps each row's work to what depends on the row).
 struct RecomputedRows {
     normal: vec3<f32>,
     // (point - eye) · normal.
@@ -189,7 +192,7 @@ struct RecomputedRows {
     axes: mat3x3<f32>,
     // The eye's light-frame depth.
     eye_light_z: f32,
-    // The looked-up point's eye, offset, in the light frame, relative to the light's centre.
+    // The eye plus the pixel's lookup offset, from the light's centre, in the light frame.
     lookup_light: vec3<f32>,
     // The camera ray of a row's first tap, less its row's y · per_y.
     first_ray_x: vec3<f32>,
