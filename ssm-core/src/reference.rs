@@ -1107,6 +1107,7 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     trade: None,
     debug_outputs: &[],
     uniforms: &[],
+    limits: &[],
 };
 
 crate::register_technique!(INFO);

@@ -89,6 +89,7 @@ mod tests {
         trade: None,
         debug_outputs: &[],
         uniforms: &[],
+        limits: &[],
     };
     static ALPHA_AGAIN: TechniqueInfo = TechniqueInfo {
         name: "alpha",
@@ -102,6 +103,7 @@ mod tests {
         trade: None,
         debug_outputs: &[],
         uniforms: &[],
+        limits: &[],
     };
     static BETA: TechniqueInfo = TechniqueInfo {
         name: "beta",
@@ -115,6 +117,7 @@ mod tests {
         trade: None,
         debug_outputs: &[],
         uniforms: &[],
+        limits: &[],
     };
 
     #[test]

@@ -273,6 +273,26 @@ pub struct TechniqueInfo {
     pub uniforms: &'static [UniformCheck],
     /// The images it can write besides its visibility when asked ([`ShadowTechnique::debug_outputs`]).
     pub debug_outputs: &'static [DebugOutput],
+    /// Extreme cases where its published method departs from the ground truth by more than the
+    /// extremes matrix allows every technique (`tests/extremes.rs`), each with the error it is
+    /// allowed there and the paper's reason. Empty for a technique that meets the common bound
+    /// everywhere.
+    pub limits: &'static [KnownLimit],
+}
+
+/// An extreme case where a technique's published method limits its accuracy: the extremes
+/// matrix (`tests/extremes.rs`) allows it `mean_error` there instead of the common bound, and
+/// fails when the declaration names no case of the matrix or is no longer needed (the technique
+/// meets the common bound).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KnownLimit {
+    /// The case's name in the extremes matrix (`light resting on the receiver`, say).
+    pub case: &'static str,
+    /// Largest mean absolute error against the ground truth allowed there, over the pixels a
+    /// surface covers, every light of the case.
+    pub mean_error: f32,
+    /// Why the method cannot do better there, citing the paper (section, figure or equation).
+    pub reason: &'static str,
 }
 
 impl TechniqueInfo {

@@ -623,6 +623,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: AttySettingsUniform::LAYOUT,
     }],
+    limits: &[],
 };
 
 /// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps.

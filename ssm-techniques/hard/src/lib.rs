@@ -108,6 +108,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: Some("shadow_map_size=512,1024,2048,4096"),
     debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "HardSettings", wgsl_source: SHADER, imports: &[], rust: HardSettingsUniform::LAYOUT }],
+    limits: &[],
 };
 
 register_technique!(INFO);

@@ -212,6 +212,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: Some("samples=1,4,16,64"),
     debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "MultiSmSettings", wgsl_source: SHADER, imports: &[], rust: MultiSmSettingsUniform::LAYOUT }],
+    limits: &[],
 };
 
 register_technique!(INFO);

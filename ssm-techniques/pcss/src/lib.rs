@@ -302,6 +302,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: PcssSettingsUniform::LAYOUT,
     }],
+    limits: &[],
 };
 
 register_technique!(INFO);

@@ -1137,6 +1137,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         UniformCheck { wgsl_struct: "CullSettings", wgsl_source: CULL_SHADER, imports: &[], rust: CullSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "Kernel", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: KernelRecord::LAYOUT },
     ],
+    limits: &[],
 };
 
 register_technique!(INFO);

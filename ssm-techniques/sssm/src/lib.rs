@@ -879,6 +879,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: SssmSettingsUniform::LAYOUT,
     }],
+    limits: &[],
 };
 
 register_technique!(INFO);

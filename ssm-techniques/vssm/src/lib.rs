@@ -251,6 +251,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: VssmSettingsUniform::LAYOUT,
     }],
+    limits: &[],
 };
 
 register_technique!(INFO);

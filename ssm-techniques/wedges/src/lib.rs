@@ -1055,6 +1055,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             rust: WedgesMeshUniform::LAYOUT,
         },
     ],
+    limits: &[],
 };
 
 register_technique!(INFO);

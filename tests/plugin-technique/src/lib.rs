@@ -104,6 +104,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: None,
     debug_outputs: &[],
     uniforms: &[],
+    limits: &[],
 };
 
 register_technique!(INFO);
