@@ -68,7 +68,7 @@ fn cached_results_are_identical_and_keyed_by_their_inputs() {
     let scene = builtin("parallel-square").unwrap().build();
     let truth = GroundTruth::new(&scene);
     let points: Vec<Option<SurfacePoint>> = (0..64)
-        .map(|i| Some(SurfacePoint { position: Vec3::new(i as f32 * 0.04, 0.0, 0.3), normal: Vec3::Y, footprint: None }))
+        .map(|i| Some(SurfacePoint { position: Vec3::new(i as f32 * 0.04, 0.0, 0.3), normal: Vec3::Y, footprint: None, closed: false }))
         .chain([None])
         .collect();
     let dir = std::env::temp_dir().join(format!("ssm-reference-cache-{}", std::process::id()));
@@ -97,11 +97,11 @@ fn a_point_behind_the_light_or_a_point_light_gives_exact_answers() {
     let truth = GroundTruth::new(&scene);
     let mut light = scene.lights[0];
     let mut rng = ssm_core::reference::SplitMix64::for_pixel(1, 0);
-    let behind = SurfacePoint { position: Vec3::new(0.0, 5.0, 0.0), normal: Vec3::Y, footprint: None };
+    let behind = SurfacePoint { position: Vec3::new(0.0, 5.0, 0.0), normal: Vec3::Y, footprint: None, closed: false };
     assert_eq!(truth.visibility(&light, &behind, 8, &mut rng), 0.0);
     light.half_size = Vec2::ZERO;
-    let under = SurfacePoint { position: Vec3::new(0.9, 0.0, 0.0), normal: Vec3::Y, footprint: None };
-    let beside = SurfacePoint { position: Vec3::new(1.1, 0.0, 0.0), normal: Vec3::Y, footprint: None };
+    let under = SurfacePoint { position: Vec3::new(0.9, 0.0, 0.0), normal: Vec3::Y, footprint: None, closed: false };
+    let beside = SurfacePoint { position: Vec3::new(1.1, 0.0, 0.0), normal: Vec3::Y, footprint: None, closed: false };
     assert_eq!(truth.visibility(&light, &under, 8, &mut rng), 0.0);
     assert_eq!(truth.visibility(&light, &beside, 8, &mut rng), 1.0);
 }
@@ -134,7 +134,7 @@ fn a_pixel_footprint_averages_the_visibility_over_the_pixel() {
         }
     }
     average /= (dense * dense) as f32;
-    let point = SurfacePoint { position: centre, normal: Vec3::Y, footprint: Some(footprint) };
+    let point = SurfacePoint { position: centre, normal: Vec3::Y, footprint: Some(footprint), closed: false };
     let traced: f32 =
         (0..512).map(|seed| truth.visibility(&light, &point, 32, &mut ssm_core::reference::SplitMix64::for_pixel(seed, 0))).sum::<f32>()
             / 512.0;
@@ -175,7 +175,9 @@ fn the_pyramid_shortcut_gives_what_every_ray_gives() {
                     continue;
                 }
                 covered += 1;
-                let point = SurfacePoint { position: Vec3::new(p[0], p[1], p[2]), normal: Vec3::new(n[0], n[1], n[2]), footprint: None };
+                let closed = ssm_core::GBuffer::flags(n[3]) & ssm_core::GBuffer::CLOSED != 0;
+                let point =
+                    SurfacePoint { position: Vec3::new(p[0], p[1], p[2]), normal: Vec3::new(n[0], n[1], n[2]), footprint: None, closed };
                 let fast = truth.visibility(light, &point, samples, &mut SplitMix64::for_pixel(7, index as u64));
                 let every_ray = truth.visibility_per_ray(light, &point, samples, &mut SplitMix64::for_pixel(7, index as u64));
                 if fast != every_ray {
@@ -211,4 +213,27 @@ fn per_ray_traversal_traces_the_shortcuts_image() {
     assert!(shadowed > 100, "the view must hold shadow to compare: {shadowed} pixels");
     let differing = shortcuts.visibility.iter().zip(&per_ray.visibility).filter(|(a, b)| a != b).count();
     assert_eq!(differing, 0, "{differing} of {} pixels differ between the traversals", points.len());
+}
+
+/// A closed mesh is the boundary of an opaque solid: the side the camera sees gets no light from
+/// behind its tangent plane. A light sealed inside a box resting on the ground: the ground
+/// outside and the box's outer walls read 0 exactly: every ray from them to the light crosses a
+/// wall, or leaves the seen side of a wall from behind (before the rule, the walls below the
+/// light's plane saw it through themselves).
+#[test]
+fn a_light_sealed_in_a_closed_box_lights_nothing_outside_it() {
+    let gpu = gpu();
+    let sealed = ssm_testing::scene_from_manifest(
+        "[camera]\nposition = [0.0, 5.0, 7.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[light]]\ncentre = [0.0, 0.8, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
+         [[object]]\nprimitive = \"box\"\nsize = [2.0, 1.0, 2.0]\ntranslate = [0.0, 0.5, 0.0]\nrole = \"both\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n",
+    );
+    let rendered = render(&gpu, &sealed, &ssm_core::reference::INFO, &[("samples", "4"), ("cache", "false")], 96, 72).unwrap();
+    let normals = rendered.renderer.read_normals().unwrap();
+    let covered = rendered.coverage();
+    let on_box = normals.iter().filter(|n| ssm_core::GBuffer::flags(n[3]) & ssm_core::GBuffer::CLOSED != 0).count();
+    assert!(on_box > 200, "the box must be in view: {on_box} pixels");
+    let lit = rendered.visibility.iter().zip(&covered).filter(|(v, c)| **c && **v > 0.0).count();
+    assert_eq!(lit, 0, "{lit} pixels see the sealed light");
 }

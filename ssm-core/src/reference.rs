@@ -37,7 +37,7 @@ mod traversal;
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 2;
+pub const REFERENCE_VERSION: u32 = 3;
 
 /// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
 /// more, the part is cut further or its rays traverse the BVH one by one.
@@ -265,6 +265,9 @@ impl ReferenceCache {
             match point {
                 Some(p) => {
                     hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]);
+                    if p.closed {
+                        hasher.write(&[0xfd]);
+                    }
                     // Points without a footprint hash as before, so that their cache stays valid.
                     if let Some(f) = &p.footprint {
                         hasher.write(&[0xfe]);
@@ -285,8 +288,15 @@ impl ReferenceCache {
 pub struct SurfacePoint {
     /// World position.
     pub position: Vec3,
-    /// Unit normal (either side; rays leave on the side facing each light sample).
+    /// Unit normal (either side; rays leave on the side facing each light sample, except on a
+    /// closed surface: see `closed`).
     pub normal: Vec3,
+    /// The point lies on a closed mesh ([`ssm_scene::Scene::closed_meshes`]) and `normal` points
+    /// to the side the camera sees (as the G-buffer's does). Such a surface is the boundary of an
+    /// opaque solid (or of a closed room), so light reaches the seen side only from in front of
+    /// its tangent plane: a ray leaving behind it is blocked. Without this, a wall whose far side
+    /// faces a light sealed behind it would see that light through itself.
+    pub closed: bool,
     /// The camera rays bounding the pixel, when its visibility is averaged over the pixel's
     /// footprint on the surface's tangent plane instead of taken at the point.
     pub footprint: Option<PixelFootprint>,
@@ -499,6 +509,10 @@ impl GroundTruth {
         if corners.iter().any(|c| (point.normal.dot(*c - point.position) >= 0.0) != first_side) {
             return None;
         }
+        if point.closed && !first_side {
+            // The whole light is behind the seen side of a solid's surface.
+            return Some(0.0);
+        }
         let side = if first_side { 1.0 } else { -1.0 };
         let origin = point.position + point.normal * (side * self.surface_offset);
         if light.is_point() {
@@ -628,8 +642,12 @@ impl GroundTruth {
                     }
                     None => point.position,
                 };
-                // Leave the surface on the side facing this sample, so that it does not shadow itself.
+                // Leave the surface on the side facing this sample, so that it does not shadow itself;
+                // a closed surface passes no light to its seen side from behind.
                 let side = if point.normal.dot(sample - position) >= 0.0 { 1.0 } else { -1.0 };
+                if point.closed && side < 0.0 {
+                    continue;
+                }
                 let origin = position + point.normal * (side * self.surface_offset);
                 let open = if remember { !self.blocked_remembering(origin, sample, &mut recent) } else { self.unoccluded(origin, sample) };
                 if open {
@@ -906,6 +924,7 @@ pub fn surface_points(
             (p[3] > 0.5).then(|| SurfacePoint {
                 position: Vec3::new(p[0], p[1], p[2]),
                 normal: Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y),
+                closed: crate::GBuffer::flags(n[3]) & crate::GBuffer::CLOSED != 0,
                 footprint: pixel_footprint.then(|| pixel_rays(camera, (index % width) as f32, (index / width) as f32)),
             })
         })

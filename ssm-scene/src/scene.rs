@@ -209,11 +209,12 @@ impl Scene {
     }
 
     /// Per mesh, whether it is closed ([`Adjacency::is_closed`]): every edge, on welded positions,
-    /// shared by an even number of triangles. A point on a closed mesh whose tangent plane (on
-    /// the side the camera sees) has the whole light behind it sees none of the light, when the
-    /// light is on the camera's side of the mesh (both outside a solid, or both inside a closed
-    /// room): a segment from just behind the surface to the light then crosses the mesh an odd
-    /// number of times.
+    /// shared by an even number of triangles. A closed mesh bounds an opaque solid (or a closed
+    /// room), so a point on it whose tangent plane (on the side the camera sees) has the whole
+    /// light behind it sees none of the light: when the light is on the camera's side of the mesh
+    /// (both outside a solid, or both inside a room), a segment from just behind the surface to
+    /// the light crosses the mesh an odd number of times; when it is not (a light sealed in a
+    /// box, the camera outside), the light lies beyond the surface itself.
     #[must_use]
     pub fn closed_meshes(&self) -> Vec<bool> {
         self.meshes.iter().map(|mesh| Adjacency::of(mesh).is_closed()).collect()
