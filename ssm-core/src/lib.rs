@@ -54,8 +54,8 @@ pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
-    DebugOutput, ExtraImage, KnownLimit, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
-    UniformStruct,
+    DebugOutput, ExtraImage, KnownLimit, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup,
+    UniformCheck, UniformStruct,
 };
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 

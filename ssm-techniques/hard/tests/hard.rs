@@ -1,5 +1,5 @@
-//! `hard` on the analytic case, on every built-in scene, and against its
-//! blessed reference images.
+//! `hard` on the analytic case, and on every built-in scene against its exact
+//! hard shadow (the ground truth with a point light at the light's centre).
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -29,14 +29,57 @@ fn every_builtin_scene_casts_a_shadow_on_a_lit_receiver() {
     ssm_testing::every_builtin_scene_casts_a_shadow(&gpu(), &ssm_hard::INFO, WIDTH, HEIGHT);
 }
 
-/// Every built-in scene at 128×96 against the blessed 16-bit PNGs in `tests/reference/`.
-/// Re-bless after an intended change with `SSM_BLESS=1 cargo test -p ssm-hard`, then look at
-/// the images before committing them. Lavapipe is deterministic on one machine; across Mesa
-/// versions, edge pixels may move by one: a real regression moves far more.
+/// Every built-in scene at 128×96 against its exact hard shadow: the ground truth with the light
+/// shrunk to a point at its centre (one ray per pixel, exact up to the surface offset), which is
+/// what a hard shadow map from the light's centre approximates. The map is sampled at texels, not
+/// at the pixels' points (and half a texel off the surface, the normal offset), so the two may
+/// disagree along a shadow's edge: a pixel that differs must have a pixel within two (the
+/// largest texel footprint on these scenes at this size, plus the offset) on the other side of
+/// the exact edge, or the image's border within two (an edge may run along it). At most
+/// `STRAY_SHARE` of the covered pixels may differ elsewhere: the terminator of a face the light
+/// grazes, where the map's depth slope is steepest (11 of 8,868 pixels on `contact`). This
+/// replaces blessed images, which only said that the output had not changed.
 #[test]
-fn every_builtin_scene_matches_its_reference_image() {
-    let directory = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference");
-    if let Err(failures) = ssm_testing::every_builtin_scene_matches_its_reference_image(&gpu(), &ssm_hard::INFO, &directory) {
-        panic!("{failures}");
+fn every_builtin_scene_matches_its_exact_hard_shadow_up_to_the_edges() {
+    /// Covered pixels allowed to differ from the exact hard shadow with no edge next to them.
+    const STRAY_SHARE: f32 = 0.002;
+    let (width, height) = (128u32, 96u32);
+    let gpu = gpu();
+    let mut failures = Vec::new();
+    for entry in ssm_scene::BUILTIN_SCENES {
+        let mut scene = entry.build();
+        for light in &mut scene.lights {
+            light.half_size = glam::Vec2::ZERO;
+        }
+        let exact = ssm_testing::reference(&gpu, &scene, 1, (width, height));
+        let rendered = render(&gpu, &entry.build(), &ssm_hard::INFO, &[], width, height).unwrap();
+        let covered = exact.coverage();
+        // A neighbour past the image's border is unknown: an edge may run along the border.
+        let truth = |x: i32, y: i32| {
+            let inside = (0..width as i32).contains(&x) && (0..height as i32).contains(&y);
+            inside.then(|| exact.visibility[(y as u32 * width + x as u32) as usize])
+        };
+        let (mut differing, mut stray, mut count) = (0usize, 0usize, 0usize);
+        for y in 0..height as i32 {
+            for x in 0..width as i32 {
+                let index = (y as u32 * width + x as u32) as usize;
+                if !covered[index] {
+                    continue;
+                }
+                count += 1;
+                if rendered.visibility[index] == exact.visibility[index] {
+                    continue;
+                }
+                differing += 1;
+                let on_edge = (-2..=2).any(|dy| (-2..=2).any(|dx| truth(x + dx, y + dy) != Some(exact.visibility[index])));
+                stray += usize::from(!on_edge);
+            }
+        }
+        let stray_share = stray as f32 / count.max(1) as f32;
+        println!("{}: {differing} of {count} pixels differ from the exact hard shadow, {stray} away from its edges", entry.name);
+        if stray_share > STRAY_SHARE {
+            failures.push(format!("{}: {stray} of {count} pixels differ from the exact hard shadow away from its edges", entry.name));
+        }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

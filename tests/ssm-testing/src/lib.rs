@@ -320,30 +320,3 @@ pub fn every_builtin_scene_casts_a_shadow(gpu: &GpuContext, info: &'static Techn
         assert!(lit > shadowed, "{} / {}: {lit} lit vs {shadowed} shadowed", info.name, entry.name);
     }
 }
-
-/// Renders every built-in scene with `info`'s defaults at 128×96 and compares each with the
-/// blessed 16-bit PNG `<directory>/<scene>-<technique>.png` ([`compare_with_reference`]; blesses
-/// with `SSM_BLESS=1`). Lavapipe is deterministic on one machine; across Mesa versions, edge
-/// pixels may move by one: a real regression moves far more.
-///
-/// # Errors
-/// One line per scene that differs or has no reference.
-pub fn every_builtin_scene_matches_its_reference_image(
-    gpu: &GpuContext,
-    info: &'static TechniqueInfo,
-    directory: &std::path::Path,
-) -> Result<(), String> {
-    let tolerance = ImageTolerance { mean: 0.002, pixel: 0.1, wrong_share: 0.005 };
-    let failures: Vec<String> = ssm_scene::BUILTIN_SCENES
-        .iter()
-        .filter_map(|entry| {
-            let rendered = match render(gpu, &entry.build(), info, &[], 128, 96) {
-                Ok(rendered) => rendered,
-                Err(e) => return Some(format!("{}: {e}", entry.name)),
-            };
-            let name = format!("{}-{}", entry.name, info.name);
-            compare_with_reference(directory, &name, &rendered.visibility, (128, 96), tolerance, bless_requested()).err()
-        })
-        .collect();
-    if failures.is_empty() { Ok(()) } else { Err(failures.join("\n")) }
-}
