@@ -1,11 +1,18 @@
-//! The extremes matrix: every registered technique (a new crate joins by
-//! registering) against scenes at the edges of what the techniques model.
-//! Each must return finite visibility in [0, 1] (checked on readback) or a
-//! typed error; never a panic, a hang or a NaN. Beyond that, each scene
-//! asserts only what every correct technique must satisfy, whatever its
-//! approximation: a light facing away lights nothing, an occluder behind the
-//! light casts nothing, a point light has no penumbra, an unoccluded receiver
-//! is lit.
+//! The extremes matrix: every registered technique (a new crate joins by registering) against
+//! scenes at the edges of what the techniques model, each compared with the ground truth.
+//!
+//! For every technique and every scene:
+//! - it renders, or refuses with the typed refusal this file expects of it, by name and reason
+//!   ([`EXPECTED_REFUSALS`]); the techniques of `MUST_RUN_ON_LAVAPIPE` (tests/support.rs) must run everywhere
+//!   else, and any other error fails. Visibility that is not finite or not in [0, 1] comes back from the
+//!   readback as [`Error::InvalidOutput`], which fails like any other error;
+//! - its mean absolute error against the ground truth, over the pixels a surface covers, is at
+//!   most [`COMMON_BOUND`] for every light of the scene, or the looser bound its registration
+//!   declares for that scene ([`ssm_core::KnownLimit`], with the paper's reason). A declaration
+//!   that names no scene here, or that the technique no longer needs, fails too;
+//! - what every correct technique must satisfy there holds, whatever its approximation ([`Expect`]):
+//!   a light facing away lights nothing, a point light casts no penumbra, no light leaves a
+//!   sealed box.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -13,21 +20,56 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3};
-use ssm_core::Error;
-use ssm_integration_tests::registry;
+use ssm_core::{Error, TechniqueInfo, TechniqueKind};
+use ssm_integration_tests::{missing_must_run, registry, render_or_refusal};
 use ssm_scene::{Instance, Manifest, Mesh, RectLight, Role, Scene, SceneError, builtin, primitives};
-use ssm_testing::{Rendered, at, gpu, pixel_of, render};
+use ssm_testing::{Rendered, at, gpu, pixel_of, reference, render};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;
 
-/// What must hold for every technique on a scene.
+/// Rays per axis of the ground truth. Its per-pixel error is at most 4/N where one occluder edge
+/// crosses the light and its mean over a penumbra below N^-1.5 (tests/reference.rs): 0.011 at
+/// N = 8, a ninth of [`COMMON_BOUND`].
+const REFERENCE_SAMPLES: u32 = 8;
+
+/// The mean absolute error against the ground truth that every technique must meet on every
+/// scene here unless its registration declares a looser one: the acceptance bound of the
+/// project's issue #39 for the extreme cases. A technique that inverts a shadow (lit where the
+/// truth is dark) over a tenth of the image exceeds it; a soft-shadow approximation's error
+/// (the penumbra's shape, a pixel of aliasing along each edge) stays well below it on these
+/// scenes, whose penumbrae cover a small part of the view.
+const COMMON_BOUND: f32 = 0.1;
+
+/// (technique, scene, what its refusal must say): the refusals this matrix expects, each asserted
+/// by its error's variant and a phrase of its reason. A technique that stops refusing a scene
+/// listed here fails the test, so the list stays true.
+const EXPECTED_REFUSALS: &[(&str, &str, Refusal)] = &[
+    // The light frame must widen to nearly 180° to hold an occluder 1/12000 of the scene below the
+    // light, and Atty's soft shadow map is one texture over that frame (Sec. 3.1): the receivers
+    // would cover a texel or two of it, so it refuses rather than return a one-texel shadow.
+    ("atty", "occluder almost touching the light", Refusal::Unrepresentable("receivers cover only")),
+];
+
+/// A refusal's variant and a phrase its message must contain.
+#[derive(Clone, Copy, Debug)]
+#[allow(dead_code)] // Not every variant is expected today; each says what an entry may expect.
+enum Refusal {
+    /// [`Error::Unrepresentable`] whose reason contains this.
+    Unrepresentable(&'static str),
+    /// [`Error::LimitTooLow`] whose `what` contains this.
+    LimitTooLow(&'static str),
+}
+
+/// What must hold for every technique on a scene, beyond the error bound.
 #[derive(Clone, Copy, Debug)]
 enum Expect {
-    /// Finite and in [0, 1]; nothing more can be said for every technique.
-    InRange,
-    /// Every covered pixel is 0: the light faces away from everything.
+    /// Only the error bound.
+    Bound,
+    /// Every covered pixel is exactly 0: the light faces away from everything.
     AllDark,
+    /// At most 1% of covered pixels read above 0.1: the light is sealed away from everything seen.
+    NoLightEscapes,
     /// Every covered pixel is (nearly) 1: nothing lies between the light and the receivers.
     AllLit,
     /// (Nearly) no penumbra: a point light casts none. A pixel strictly between 0 and 1 with both a
@@ -35,6 +77,17 @@ enum Expect {
     NoPenumbra,
     /// The surface seen at this world point is (nearly) in umbra: the exact visibility there is 0.
     ShadowedAt(Vec3),
+}
+
+/// One scene of the matrix.
+struct Case {
+    name: &'static str,
+    scene: Scene,
+    expect: Expect,
+}
+
+fn case(name: &'static str, scene: Scene, expect: Expect) -> Case {
+    Case { name, scene, expect }
 }
 
 fn from_manifest(name: &str, text: &str) -> Scene {
@@ -55,46 +108,44 @@ fn square_light(centre: Vec3, normal: Vec3, size: f32) -> RectLight {
     RectLight::try_facing(centre, normal, Vec3::X, Vec2::splat(size), 1.0).unwrap()
 }
 
-fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
+/// The scenes at the edges of what the techniques model.
+fn extreme_cases() -> Vec<Case> {
     let down = -Vec3::Y;
-    let mut scenes = vec![
-        ("occluder touching the receiver", builtin("contact").unwrap().build(), Expect::InRange),
+    let above = Vec3::new(0.0, 4.0, 0.0);
+    let mut cases = vec![
+        case("occluder touching the receiver", builtin("contact").unwrap().build(), Expect::Bound),
         // Atty et al., Eq. 3: the penumbra extent grows without bound as the occluder nears the light.
         // The light frame must keep it (it lies 1/12000 of the scene's size below the light), and it
         // hides the whole light from the receiver's centre: the exact visibility there is 0.
-        (
+        case(
             "occluder almost touching the light",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 3.999),
+            parallel_square_with(square_light(above, down, 1.0), 3.999),
             Expect::ShadowedAt(Vec3::ZERO),
         ),
-        ("occluder in the light's plane", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 4.0), Expect::InRange),
-        ("point light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 0.0), 2.0), Expect::NoPenumbra),
-        (
-            "light far larger than the occluder",
-            parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 50.0), 2.0),
-            Expect::InRange,
-        ),
-        ("tiny light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1e-4), 2.0), Expect::InRange),
-        (
+        case("occluder in the light's plane", parallel_square_with(square_light(above, down, 1.0), 4.0), Expect::Bound),
+        case("point light", parallel_square_with(square_light(above, down, 0.0), 2.0), Expect::NoPenumbra),
+        case("light far larger than the occluder", parallel_square_with(square_light(above, down, 50.0), 2.0), Expect::Bound),
+        case("tiny light", parallel_square_with(square_light(above, down, 1e-4), 2.0), Expect::NoPenumbra),
+        case(
             "grazing light",
             parallel_square_with(square_light(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), 1.0), 2.0),
-            Expect::InRange,
+            Expect::Bound,
         ),
-        (
+        case(
             "light facing away from everything",
             parallel_square_with(square_light(Vec3::new(0.0, -1.0, 0.0), down, 1.0), 2.0),
             Expect::AllDark,
         ),
-        ("occluder behind the light", parallel_square_with(square_light(Vec3::new(0.0, 4.0, 0.0), down, 1.0), 5.0), Expect::AllLit),
+        case("occluder behind the light", parallel_square_with(square_light(above, down, 1.0), 5.0), Expect::AllLit),
     ];
 
     // Far to the side, just below the light's plane: past the frame's widest angle (MAX_HALF_ANGLE_TANGENT), so outside every map.
     let mut scene = builtin("parallel-square").unwrap().build();
     let occluder = scene.instances.iter_mut().find(|i| i.role == Role::Occluder).unwrap();
     occluder.transform = Mat4::from_translation(Vec3::new(30.0, 3.99, 0.0));
-    scenes.push(("occluder outside the light frustum", scene, Expect::InRange));
+    cases.push(case("occluder outside the light frustum", scene, Expect::AllLit));
 
-    scenes.push((
+    cases.push(case(
         "no occluder at all",
         from_manifest(
             "no-occluder",
@@ -124,7 +175,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
         transform: Mat4::from_translation(Vec3::new(1.0, 1.0, 1.0)),
         role: Role::Occluder,
     });
-    scenes.push(("degenerate triangles", scene, Expect::InRange));
+    cases.push(case("degenerate triangles", scene, Expect::Bound));
 
     // The same analytic scene at very small and very large scales: depth ranges of 1e-3 and 1e3.
     for (name, scale) in [("scene a thousandth the size", 1e-3f32), ("scene a thousand times the size", 1e3)] {
@@ -138,7 +189,7 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
         scene.camera.position *= scale;
         scene.camera.near *= scale;
         scene.camera.far *= scale;
-        scenes.push((name, scene, Expect::InRange));
+        cases.push(case(name, scene, Expect::ShadowedAt(Vec3::ZERO)));
     }
 
     // The coarsest closed mesh the sphere generator makes (3 segments, 2 rings: a triangular bipyramid), resting on the ground.
@@ -150,10 +201,10 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
         transform: Mat4::from_translation(Vec3::new(-1.5, 0.6, 0.5)),
         role: Role::Both,
     });
-    scenes.push(("coarsest closed mesh", scene, Expect::InRange));
+    cases.push(case("coarsest closed mesh", scene, Expect::Bound));
 
     // Three lights of different position, size and intensity, one of them a point light: every
-    // light's visibility is checked on readback.
+    // light's visibility is compared with the ground truth.
     let mut scene = builtin("sphere-cube").unwrap().build();
     let base = scene.lights[0];
     scene.lights = vec![
@@ -162,20 +213,112 @@ fn extreme_scenes() -> Vec<(&'static str, Scene, Expect)> {
             .unwrap(),
         RectLight::try_facing(base.centre + Vec3::new(-2.0, 0.0, 2.0), Vec3::new(0.3, -1.0, -0.4), Vec3::X, Vec2::ZERO, 2.0).unwrap(),
     ];
-    scenes.push(("three lights", scene, Expect::InRange));
-    scenes
+    cases.push(case("three lights", scene, Expect::Bound));
+
+    // Interiors: a closed room (its walls, floor and ceiling one box, seen from inside) with the
+    // light under its ceiling and a block of furniture on its floor.
+    cases.push(case(
+        "light inside a closed room",
+        from_manifest(
+            "room",
+            "[camera]\nposition = [-2.5, 1.6, 2.5]\ntarget = [0.5, 0.3, -0.5]\n\
+             [[light]]\ncentre = [0.3, 2.7, -0.2]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.8, 0.6]\n\
+             [[object]]\nprimitive = \"box\"\nsize = [8.0, 3.0, 8.0]\ntranslate = [0.0, 1.5, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [1.0, 0.8, 1.0]\ntranslate = [0.5, 0.4, -0.5]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    // A light sealed inside a closed box that rests on the ground, the camera outside: the ground
+    // outside and the box's walls see none of it.
+    cases.push(case(
+        "light sealed inside a box",
+        from_manifest(
+            "sealed",
+            "[camera]\nposition = [0.0, 5.0, 7.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[light]]\ncentre = [0.0, 0.8, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
+             [[object]]\nprimitive = \"box\"\nsize = [2.0, 1.0, 2.0]\ntranslate = [0.0, 0.5, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n",
+        ),
+        Expect::NoLightEscapes,
+    ));
+    // A light a thousandth of the floor's size above it, facing it, with a block beside it: the
+    // floor sees the light at grazing angles everywhere but under it.
+    cases.push(case(
+        "light resting on the receiver",
+        from_manifest(
+            "resting",
+            "[camera]\nposition = [0.0, 4.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[light]]\ncentre = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.0, 1.0]\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.4, 0.4, 0.4]\ntranslate = [1.5, 0.2, 0.0]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    // Thin bars under a light a hundredth of their spacing: hard shadows a few pixels wide.
+    let bars: String = (0..9)
+        .map(|k| {
+            format!(
+                "[[object]]\nprimitive = \"box\"\nsize = [5.0, 0.03, 0.08]\ntranslate = [0.0, 1.0, {}]\nrole = \"occluder\"\n",
+                -2.0 + 0.5 * k as f32
+            )
+        })
+        .collect();
+    cases.push(case(
+        "thin bars under a near-point light",
+        from_manifest(
+            "bars",
+            &format!(
+                "[camera]\nposition = [0.0, 4.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                 [[light]]\ncentre = [0.3, 3.0, 0.2]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.005, 0.005]\n\
+                 [[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrole = \"receiver\"\n{bars}"
+            ),
+        ),
+        Expect::Bound,
+    ));
+    // A wall lit from far to its side, the light's normal 8.5 degrees off the wall's plane, a block
+    // on the wall casting a long shadow along it.
+    cases.push(case(
+        "wall lit at grazing angles",
+        from_manifest(
+            "grazing-wall",
+            "[camera]\nposition = [4.0, 2.0, 6.0]\ntarget = [0.0, 1.5, 0.0]\n\
+             [[light]]\ncentre = [-6.0, 1.5, 1.0]\nnormal = [1.0, 0.0, -0.15]\nsize = [0.6, 0.6]\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [8.0, 3.0]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 1.5, 0.0]\nrole = \"receiver\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.3, 0.3, 0.5]\ntranslate = [-1.0, 1.5, 0.25]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    // An occluder quad lying in the receiver's plane (it shadows nothing), and a block above.
+    cases.push(case(
+        "coplanar occluder and receiver",
+        from_manifest(
+            "coplanar",
+            "[camera]\nposition = [0.0, 4.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[light]]\ncentre = [0.5, 3.0, 0.0]\nnormal = [-0.2, -1.0, 0.0]\nsize = [1.0, 1.0]\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [8.0, 8.0]\nrole = \"receiver\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\nrole = \"occluder\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.5, 0.5, 0.5]\ntranslate = [-1.5, 1.0, 1.0]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    cases
 }
 
-fn check(technique: &str, (scene_name, scene): (&str, &Scene), expect: Expect, rendered: &Rendered) {
+/// Checks `expect` on light 0's image; panics naming the technique and scene.
+fn check_expectation(technique: &str, (case_name, scene): (&str, &Scene), expect: Expect, rendered: &Rendered) {
     let covered = rendered.covered_visibility();
-    assert!(!covered.is_empty(), "{scene_name}: the camera sees nothing");
+    assert!(!covered.is_empty(), "{case_name}: the camera sees nothing");
     let share = |keep: &dyn Fn(f32) -> bool| covered.iter().filter(|v| keep(**v)).count() as f32 / covered.len() as f32;
     match expect {
-        Expect::InRange => {}
-        Expect::AllDark => assert!(covered.iter().all(|v| *v == 0.0), "{technique} / {scene_name}: lit pixels behind the light"),
+        Expect::Bound => {}
+        Expect::AllDark => assert!(covered.iter().all(|v| *v == 0.0), "{technique} / {case_name}: lit pixels behind the light"),
+        Expect::NoLightEscapes => {
+            let lit = share(&|v| v > 0.1);
+            assert!(lit <= 0.01, "{technique} / {case_name}: {:.1}% of pixels read above 0.1", lit * 100.0);
+        }
         Expect::AllLit => {
             let dark = share(&|v| v < 0.95);
-            assert!(dark < 0.01, "{technique} / {scene_name}: {:.1}% of pixels read below 0.95", dark * 100.0);
+            assert!(dark < 0.01, "{technique} / {case_name}: {:.1}% of pixels read below 0.95", dark * 100.0);
         }
         Expect::NoPenumbra => {
             let (width, height) = (WIDTH as i32, HEIGHT as i32);
@@ -195,44 +338,124 @@ fn check(technique: &str, (scene_name, scene): (&str, &Scene), expect: Expect, r
                 }
             }
             let share = penumbra as f32 / covered.len() as f32;
-            assert!(share < 0.01, "{technique} / {scene_name}: {:.1}% of pixels in a penumbra", share * 100.0);
+            assert!(share < 0.01, "{technique} / {case_name}: {:.1}% of pixels in a penumbra", share * 100.0);
         }
         Expect::ShadowedAt(world) => {
             let value = at(rendered, pixel_of(scene, WIDTH, HEIGHT, world));
-            assert!(value < 0.1, "{technique} / {scene_name}: visibility {value} at {world}, where the exact value is 0");
+            assert!(value < 0.1, "{technique} / {case_name}: visibility {value} at {world}, where the exact value is 0");
         }
     }
 }
 
+/// Mean |a − b| over the covered pixels.
+fn mean_error(a: &[f32], b: &[f32], covered: &[bool]) -> f32 {
+    let (sum, count) = a
+        .iter()
+        .zip(b)
+        .zip(covered)
+        .filter(|(_, c)| **c)
+        .fold((0.0f64, 0usize), |(sum, count), ((a, b), _)| (sum + f64::from((a - b).abs()), count + 1));
+    (sum / count.max(1) as f64) as f32
+}
+
+/// The bound `info` must meet on `case_name`: its declared limit there, else the common one.
+fn bound_of(info: &TechniqueInfo, case_name: &str) -> (f32, Option<&'static str>) {
+    info.limits.iter().find(|limit| limit.case == case_name).map_or((COMMON_BOUND, None), |limit| (limit.mean_error, Some(limit.reason)))
+}
+
+/// A refusal `error` of `technique` on `case_name` is expected, by variant and reason.
+fn refusal_expected(technique: &str, case_name: &str, error: &Error) -> bool {
+    EXPECTED_REFUSALS.iter().any(|(name, scene, refusal)| {
+        *name == technique
+            && *scene == case_name
+            && match (refusal, error) {
+                (Refusal::Unrepresentable(phrase), Error::Unrepresentable { reason, .. }) => reason.contains(phrase),
+                (Refusal::LimitTooLow(phrase), Error::LimitTooLow { what, .. }) => what.contains(phrase),
+                _ => false,
+            }
+    })
+}
+
 #[test]
-fn every_technique_survives_every_extreme() {
+fn every_technique_is_near_the_ground_truth_on_every_extreme() {
     let gpu = gpu();
     let registry = registry();
+    let cases = extreme_cases();
+    let names: Vec<&str> = cases.iter().map(|c| c.name).collect();
     let mut failures = Vec::new();
-    let mut runs = 0;
-    for (scene_name, scene, expect) in extreme_scenes() {
-        for info in registry.iter() {
-            match render(&gpu, &scene, info, &[], WIDTH, HEIGHT) {
-                Ok(rendered) => {
-                    runs += 1;
-                    if let Err(panic) =
-                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| check(info.name, (scene_name, &scene), expect, &rendered)))
-                    {
-                        failures.push(
-                            panic
-                                .downcast_ref::<String>()
-                                .cloned()
-                                .unwrap_or_else(|| format!("{} / {scene_name}: check failed", info.name)),
-                        );
-                    }
-                }
-                // A clear refusal is allowed; a wrong or broken output is not.
-                Err(Error::MissingFeatures { .. } | Error::LimitTooLow { .. } | Error::Unrepresentable { .. }) => {}
-                Err(e) => failures.push(format!("{} / {scene_name}: {e}", info.name)),
+
+    for name in missing_must_run() {
+        failures.push(format!("{name} must run here but is not registered"));
+    }
+    for info in registry.iter() {
+        for limit in info.limits {
+            if !names.contains(&limit.case) {
+                failures.push(format!("{} declares a limit for `{}`, which is no case of the matrix", info.name, limit.case));
             }
         }
     }
-    assert!(runs >= 2 * 15, "only {runs} technique/scene pairs ran");
+
+    let mut report = Vec::new();
+    for case in &cases {
+        let truth = reference(&gpu, &case.scene, REFERENCE_SAMPLES, (WIDTH, HEIGHT));
+        let covered = truth.coverage();
+        let truth_images: Vec<Vec<f32>> =
+            (0..case.scene.lights.len()).map(|light| truth.renderer.read_visibility(light, "reference").unwrap()).collect();
+        for info in registry.iter() {
+            if info.kind == TechniqueKind::GroundTruth {
+                // The ground truth is what the others are measured against.
+                continue;
+            }
+            let rendered = match render(&gpu, &case.scene, info, &[], WIDTH, HEIGHT) {
+                Err(e) if refusal_expected(info.name, case.name, &e) => {
+                    println!("{} / {}: refused as expected: {e}", info.name, case.name);
+                    continue;
+                }
+                result => match render_or_refusal(info.name, case.name, result) {
+                    Ok(Some(rendered)) => rendered,
+                    Ok(None) => continue,
+                    Err(message) => {
+                        failures.push(message);
+                        continue;
+                    }
+                },
+            };
+            if EXPECTED_REFUSALS.iter().any(|(name, scene, _)| *name == info.name && *scene == case.name) {
+                failures.push(format!("{} / {}: renders, but this test expects a refusal: update EXPECTED_REFUSALS", info.name, case.name));
+            }
+            // The largest error over the scene's lights.
+            let mut worst = 0.0f32;
+            for (light, truth_image) in truth_images.iter().enumerate() {
+                let image = rendered.renderer.read_visibility(light, info.name);
+                match image {
+                    Ok(image) => worst = worst.max(mean_error(&image, truth_image, &covered)),
+                    Err(e) => failures.push(format!("{} / {} / light {light}: {e}", info.name, case.name)),
+                }
+            }
+            let (bound, reason) = bound_of(info, case.name);
+            report.push(format!("{:>12} {:>7.4} (bound {bound}) {}", info.name, worst, case.name));
+            if worst > bound {
+                failures.push(format!(
+                    "{} / {}: mean |error| {worst:.4} against the ground truth, above {bound}{}",
+                    info.name,
+                    case.name,
+                    reason.map_or(String::new(), |r| format!(" (its declared limit: {r})"))
+                ));
+            } else if reason.is_some() && worst <= COMMON_BOUND {
+                failures.push(format!(
+                    "{} / {}: mean |error| {worst:.4} meets the common bound {COMMON_BOUND}: remove its declared limit",
+                    info.name, case.name
+                ));
+            }
+            let name = info.name;
+            if let Err(panic) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                check_expectation(name, (case.name, &case.scene), case.expect, &rendered);
+            })) {
+                failures.push(panic.downcast_ref::<String>().cloned().unwrap_or_else(|| format!("{name} / {}: check failed", case.name)));
+            }
+        }
+    }
+    println!("mean |error| against the ground truth ({WIDTH}x{HEIGHT}, {REFERENCE_SAMPLES}² rays):\n{}", report.join("\n"));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -4,13 +4,13 @@
 //! intensity equals the visibility of the same scene lit by light k alone.
 //! Guards against per-light state that one light's work overwrites before
 //! another's is used (an upload recorded once for the whole frame, say).
+//! Every technique of `MUST_RUN_ON_LAVAPIPE` (tests/support.rs) must run.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use glam::{Vec2, Vec3};
-use ssm_core::Error;
-use ssm_integration_tests::registry;
+use ssm_integration_tests::{MUST_RUN_ON_LAVAPIPE, missing_must_run, registry, render_or_refusal};
 use ssm_scene::{RectLight, Scene, builtin};
 use ssm_testing::{gpu, render};
 
@@ -41,15 +41,18 @@ fn each_light_of_three_equals_that_light_alone_for_every_technique() {
     let gpu = gpu();
     let lights = three_lights();
     let all = scene_with(lights.clone());
-    let mut failures = Vec::new();
+    let mut failures: Vec<String> = missing_must_run().iter().map(|name| format!("{name} must run here but is not registered")).collect();
     let mut checked = 0;
     for info in registry().iter() {
         // The ground truth with few rays and no cache: deterministic per pixel, and quick.
         let settings: &[(&str, &str)] = if info.name == "reference" { &[("samples", "4"), ("cache", "false")] } else { &[] };
-        let together = match render(&gpu, &all, info, settings, WIDTH, HEIGHT) {
-            Ok(rendered) => rendered,
-            Err(Error::MissingFeatures { .. } | Error::LimitTooLow { .. }) => continue,
-            Err(e) => panic!("{}: {e}", info.name),
+        let together = match render_or_refusal(info.name, "three lights", render(&gpu, &all, info, settings, WIDTH, HEIGHT)) {
+            Ok(Some(rendered)) => rendered,
+            Ok(None) => continue,
+            Err(message) => {
+                failures.push(message);
+                continue;
+            }
         };
         let mut alone_images = Vec::new();
         for (k, light) in lights.iter().enumerate() {
@@ -73,7 +76,8 @@ fn each_light_of_three_equals_that_light_alone_for_every_technique() {
         }
         checked += 1;
     }
-    assert!(checked >= 6, "only {checked} techniques ran");
+    // Every must-run technique and the ground truth.
+    assert!(checked > MUST_RUN_ON_LAVAPIPE.len(), "only {checked} techniques ran");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
