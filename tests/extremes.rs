@@ -229,17 +229,46 @@ fn extreme_cases() -> Vec<Case> {
         Expect::Bound,
     ));
     // A light sealed inside a closed box that rests on the ground, the camera outside: the ground
-    // outside and the box's walls see none of it.
+    // outside and the box's walls see none of it, also where the ground runs to the horizon, past
+    // the widest view a light frame takes (MAX_HALF_ANGLE_TANGENT).
     cases.push(case(
         "light sealed inside a box",
         from_manifest(
             "sealed",
-            "[camera]\nposition = [0.0, 5.0, 7.0]\ntarget = [0.0, 0.0, 0.0]\n\
+            "[camera]\nposition = [0.0, 3.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
              [[light]]\ncentre = [0.0, 0.8, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
              [[object]]\nprimitive = \"box\"\nsize = [2.0, 1.0, 2.0]\ntranslate = [0.0, 0.5, 0.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n",
+             [[object]]\nprimitive = \"plane\"\nsize = [80.0, 80.0]\nrole = \"receiver\"\n",
         ),
         Expect::NoLightEscapes,
+    ));
+    // The same light enclosed by five separate quads on the ground (open surfaces, so no closed
+    // mesh seals it and each technique's own maps must keep the light in): the ground outside
+    // reads 0; the walls' outer sides, sheets lit from either side, read lit.
+    let wall = |size: [f32; 2], rotate: [f32; 3], translate: [f32; 3]| {
+        format!(
+            "[[object]]\nprimitive = \"plane\"\nsize = {size:?}\nrotate_degrees = {rotate:?}\ntranslate = {translate:?}\nrole = \"both\"\n"
+        )
+    };
+    let walls = [
+        wall([2.0, 2.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        wall([2.0, 1.0], [90.0, 0.0, 0.0], [0.0, 0.5, 1.0]),
+        wall([2.0, 1.0], [90.0, 0.0, 0.0], [0.0, 0.5, -1.0]),
+        wall([1.0, 2.0], [0.0, 0.0, 90.0], [1.0, 0.5, 0.0]),
+        wall([1.0, 2.0], [0.0, 0.0, 90.0], [-1.0, 0.5, 0.0]),
+    ]
+    .concat();
+    cases.push(case(
+        "light inside a box of separate walls",
+        from_manifest(
+            "walls",
+            &format!(
+                "[camera]\nposition = [1.0, 4.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                 [[light]]\ncentre = [0.1, 0.8, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
+                 [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n{walls}"
+            ),
+        ),
+        Expect::Bound,
     ));
     // A light a thousandth of the floor's size above it, facing it, with a block beside it: the
     // floor sees the light at grazing angles everywhere but under it.

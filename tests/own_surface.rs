@@ -74,3 +74,29 @@ fn open_surfaces_are_not_marked_closed() {
     assert!(covered > 1000);
     assert!(normals.iter().all(|n| GBuffer::flags(n[3]) & GBuffer::CLOSED == 0), "an open surface was marked closed");
 }
+
+/// A light sealed in a closed box, seen from outside, reaches nothing the camera sees (every
+/// technique's pixels read 0, `LightFrame::sealed`); with the camera moved into the box
+/// (`Renderer::set_camera`), the floor inside is lit again.
+#[test]
+fn a_sealed_light_follows_the_camera_in_and_out_of_its_box() {
+    let gpu = gpu();
+    let scene = ssm_testing::scene_from_manifest(
+        "[camera]\nposition = [0.0, 3.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[light]]\ncentre = [0.0, 1.5, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
+         [[object]]\nprimitive = \"box\"\nsize = [4.0, 2.0, 4.0]\ntranslate = [0.0, 1.0, 0.0]\nrole = \"both\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [40.0, 40.0]\nrole = \"receiver\"\n",
+    );
+    let hard = registry().get("hard").unwrap();
+    let mut outside = render(&gpu, &scene, hard, &[], SIZE.0, SIZE.1).unwrap();
+    assert!(outside.renderer.scene.light_frames[0].sealed);
+    let covered = outside.covered_visibility();
+    assert!(covered.len() > 1000 && covered.iter().all(|v| *v == 0.0), "some of {} pixels see the sealed light", covered.len());
+    let inside = ssm_scene::Camera { position: glam::Vec3::new(1.5, 1.2, 1.5), target: glam::Vec3::new(-1.0, 0.0, -1.0), ..scene.camera };
+    outside.renderer.set_camera(&inside).unwrap();
+    assert!(!outside.renderer.scene.light_frames[0].sealed);
+    let mut technique = outside.renderer.create_technique(hard, &hard.default_params()).unwrap();
+    outside.renderer.render(technique.as_mut(), hard.name).unwrap();
+    let lit = outside.renderer.read_visibility(0, hard.name).unwrap().iter().filter(|v| **v == 1.0).count();
+    assert!(lit > 1000, "only {lit} pixels lit inside the box");
+}

@@ -18,7 +18,9 @@ struct LightFrame {
     normal: vec4<f32>,
     // x, y: tangents of the frustum's half angles along u and v; z: near; w: far.
     projection: vec4<f32>,
-    // x: the diagonal of the scene's bounding box, the scale of scene-relative settings; y, z, w: unused.
+    // x: the diagonal of the scene's bounding box, the scale of scene-relative settings; y: 1 when
+    // a closed mesh separates the whole light from the camera (ssm-core's LightFrame::sealed);
+    // z, w: unused.
     scene: vec4<f32>,
     // xyz: the light's linear RGB colour (the composite shading's; visibility ignores it); w: unused.
     colour: vec4<f32>,
@@ -58,6 +60,12 @@ fn light_half_extent_uv(frame: LightFrame, depth: f32, receiver_depth: f32) -> v
 // nothing behind its plane).
 fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
     return light_depth(frame, world) > 0.0;
+}
+
+// True when a closed mesh separates the whole light from the camera: nothing seen receives any of
+// it (LightFrame::sealed in ssm-core).
+fn light_sealed(frame: LightFrame) -> bool {
+    return frame.scene.y > 0.5;
 }
 
 // True when the whole light lies strictly behind the plane through `world` with normal `normal`

@@ -54,15 +54,23 @@ fn screen_point_at(texel: vec2<i32>) -> ScreenPoint {
 // covers the pixel; 0 behind the light's plane (the emitter is one-sided); 0 on
 // a closed mesh where the whole light is behind the surface's tangent plane
 // (the unlit side of a solid: every ray to the light goes through it, as the
-// ground truth finds); -1 where the technique must compute it.
+// ground truth finds); 0 everywhere when a closed mesh seals the light from the
+// camera (a light in a closed box seen from outside: an engine culls it, and a
+// frame's maps could not show it where the box's walls meet the ground, nor
+// past the frame's widest angle); -1 where the technique must compute it.
 fn trivial_visibility(point: ScreenPoint) -> f32 {
     if (!point.covered) {
         return 1.0;
     }
-    if (!in_front_of_light(frame, point.position) || hidden_by_own_surface(point)) {
+    if (unlit_by_rule(point)) {
         return 0.0;
     }
     return -1.0;
+}
+
+// A covered point that the shared rules of trivial_visibility say receives none of the light.
+fn unlit_by_rule(point: ScreenPoint) -> bool {
+    return light_sealed(frame) || !in_front_of_light(frame, point.position) || hidden_by_own_surface(point);
 }
 
 // True on a closed mesh where the whole light (of `frame`) is behind the surface's tangent plane.

@@ -31,8 +31,8 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     var lit = 1.0;
     if (point.covered) {
         // This sample's frame is a point light: behind a closed surface's tangent plane, the
-        // surface itself hides it.
-        if (!in_front_of_light(frame, point.position) || hidden_by_own_surface(point)) {
+        // surface itself hides it (and the other shared rules, screen_pass.wgsl).
+        if (unlit_by_rule(point)) {
             lit = 0.0;
         } else {
             let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);

@@ -107,6 +107,8 @@ pub struct GpuScene {
     pub light_buffers: Vec<wgpu::Buffer>,
     /// One bind group per light (layout [`GpuScene::uniform_layout`]).
     pub light_bind_groups: Vec<wgpu::BindGroup>,
+    /// Per mesh of the scene, whether it is closed ([`ssm_scene::Scene::closed_meshes`]).
+    pub closed_meshes: Vec<bool>,
     /// Output width in pixels.
     pub width: u32,
     /// Output height in pixels.
@@ -187,7 +189,10 @@ impl GpuScene {
         let light_frames: Vec<LightFrame> = scene
             .lights
             .iter()
-            .map(|light| LightFrame::fit_to_geometry(light, &bounds, &receivers, &casting_points, &triangle_corners))
+            .map(|light| LightFrame {
+                sealed: scene.separates_light_from(&closed, light, scene.camera.position),
+                ..LightFrame::fit_to_geometry(light, &bounds, &receivers, &casting_points, &triangle_corners)
+            })
             .collect();
         let light_buffers: Vec<wgpu::Buffer> = light_frames
             .iter()
@@ -196,7 +201,8 @@ impl GpuScene {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(&format!("light_frame_uniform_{index}")),
                     contents: bytemuck::bytes_of(&LightFrameUniform::from(frame)),
-                    usage: wgpu::BufferUsages::UNIFORM,
+                    // COPY_DST: whether the light is sealed from the camera changes with the camera.
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 })
             })
             .collect();
@@ -220,6 +226,7 @@ impl GpuScene {
             light_frames,
             light_buffers,
             light_bind_groups,
+            closed_meshes: closed,
             width,
             height,
         }
@@ -263,13 +270,20 @@ impl GpuScene {
         self.light_frames.len()
     }
 
-    /// Points the camera elsewhere: recomputes [`GpuScene::camera`] and
-    /// writes its buffer on `queue` (the light frames do not depend on the
-    /// camera). The G-buffer must be rendered again afterwards
-    /// ([`Renderer::set_camera`](crate::Renderer::set_camera) does both).
-    pub fn set_camera(&mut self, queue: &wgpu::Queue, camera: &ssm_scene::Camera) {
-        self.camera = camera_uniform(camera, self.width, self.height);
+    /// Points the camera at `scene`'s camera: recomputes [`GpuScene::camera`] and whether each
+    /// light is sealed from it ([`LightFrame::sealed`], the frames' only part that depends on
+    /// the camera), and writes their buffers on `queue`. The G-buffer must be rendered again
+    /// afterwards ([`Renderer::set_camera`](crate::Renderer::set_camera) does both).
+    pub fn set_camera(&mut self, queue: &wgpu::Queue, scene: &Scene) {
+        self.camera = camera_uniform(&scene.camera, self.width, self.height);
         queue.write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&self.camera));
+        for (frame, buffer) in self.light_frames.iter_mut().zip(&self.light_buffers) {
+            let sealed = scene.separates_light_from(&self.closed_meshes, &frame.light, scene.camera.position);
+            if sealed != frame.sealed {
+                frame.sealed = sealed;
+                queue.write_buffer(buffer, 0, bytemuck::bytes_of(&LightFrameUniform::from(&*frame)));
+            }
+        }
     }
 }
 

@@ -40,6 +40,15 @@ pub struct LightFrame {
     /// Length of the diagonal of the scene's bounding box: the scale that
     /// scene-relative settings (biases, thresholds) are fractions of.
     pub scene_diagonal: f32,
+    /// A closed mesh separates the whole light from the camera
+    /// ([`ssm_scene::Scene::separates_light_from`]): nothing the camera sees receives any of
+    /// it, and every pixel reads 0 (`trivial_visibility` in `shaders/common/screen_pass.wgsl`),
+    /// as an engine culls a light sealed away from the viewer. A frame's maps could not show it
+    /// everywhere: past the frame's widest angle ([`MAX_HALF_ANGLE_TANGENT`]) there is no
+    /// texel, and where the box's wall meets the ground outside, the floor inside is at the same
+    /// depth and a filter's taps find it lit. Set by [`GpuScene`](crate::GpuScene), which knows
+    /// the camera; false from the `fit` functions.
+    pub sealed: bool,
 }
 
 impl LightFrame {
@@ -132,7 +141,7 @@ impl LightFrame {
         // nearly constant relative to depth, so a near plane a million times closer than the far
         // one still orders surfaces at the far end correctly. Depth tests use `Greater` for nearest.
         let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, far, near);
-        Self { light: *light, view, projection, tan_half, near, far, scene_diagonal: bounds.size().length() }
+        Self { light: *light, view, projection, tan_half, near, far, scene_diagonal: bounds.size().length(), sealed: false }
     }
 
     /// Size in texels, along the map's two axes, of the part of a `map_size`²
@@ -272,7 +281,8 @@ pub struct LightFrameUniform {
     pub normal: [f32; 4],
     /// tan half u, tan half v, near, far.
     pub projection: [f32; 4],
-    /// The scene's bounding-box diagonal; y, z, w unused.
+    /// The scene's bounding-box diagonal; y: 1 when the light is sealed from the camera
+    /// ([`LightFrame::sealed`]), else 0; z, w unused.
     pub scene: [f32; 4],
     /// The light's linear RGB colour; w unused.
     pub colour: [f32; 4],
@@ -289,7 +299,7 @@ impl From<&LightFrame> for LightFrameUniform {
             v_axis: light.v_axis.extend(light.half_size.y).to_array(),
             normal: light.normal().extend(light.area()).to_array(),
             projection: [frame.tan_half.x, frame.tan_half.y, frame.near, frame.far],
-            scene: [frame.scene_diagonal, 0.0, 0.0, 0.0],
+            scene: [frame.scene_diagonal, if frame.sealed { 1.0 } else { 0.0 }, 0.0, 0.0],
             colour: light.colour.extend(0.0).to_array(),
         }
     }

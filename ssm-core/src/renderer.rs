@@ -227,7 +227,7 @@ impl Renderer {
     pub fn set_camera(&mut self, camera: &ssm_scene::Camera) -> Result<()> {
         camera.validate(std::path::Path::new("<camera>"))?;
         std::sync::Arc::make_mut(&mut self.cpu_scene).camera = *camera;
-        self.scene.set_camera(&self.gpu.queue, camera);
+        self.scene.set_camera(&self.gpu.queue, &self.cpu_scene);
         if let Some(gbuffer) = &self.shared.gbuffer {
             self.timer.reset();
             self.shared_timings = render_gbuffer(&self.gpu, gbuffer, &self.scene, &mut self.timer)?;

@@ -219,6 +219,65 @@ impl Scene {
     pub fn closed_meshes(&self) -> Vec<bool> {
         self.meshes.iter().map(|mesh| Adjacency::of(mesh).is_closed()).collect()
     }
+
+    /// True when one placed closed mesh (`closed`: [`Scene::closed_meshes`]) separates the
+    /// whole of `light` from `eye`: the light sealed in a box seen from outside, or a camera
+    /// inside a closed room whose light is outside it. An opaque closed surface then stands
+    /// between the eye's side and every point of the light, so nothing the eye can see receives
+    /// any of it, however wide the light's view would have to be to show that (a single
+    /// perspective frustum from the light covers less than its hemisphere).
+    ///
+    /// Each segment from `eye` to the light's centre and corners is tested against each closed
+    /// instance whose bounds hold one of its ends: an odd number of crossings separates them.
+    /// A segment through an edge or a vertex may miscount, so each is also taken from two eyes
+    /// nudged by a ten-thousandth of the scene's size, and two of the three must agree.
+    #[must_use]
+    pub fn separates_light_from(&self, closed: &[bool], light: &RectLight, eye: Vec3) -> bool {
+        let light_points: Vec<Vec3> = if light.is_point() {
+            vec![light.centre]
+        } else {
+            vec![light.centre, light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)]
+        };
+        let nudge = self.bounds().size().length().max(f32::MIN_POSITIVE) * 1e-4;
+        let eyes = [eye, eye + Vec3::new(0.71, 0.53, 0.47) * nudge, eye + Vec3::new(-0.37, 0.83, -0.41) * nudge];
+        self.instances.iter().filter(|i| closed.get(i.mesh).copied().unwrap_or(false)).any(|instance| {
+            let Some(mesh) = self.meshes.get(instance.mesh) else { return false };
+            let mut bounds = Aabb::EMPTY;
+            for &p in &mesh.positions {
+                bounds.extend(instance.transform.transform_point3(p));
+            }
+            let inside = |p: Vec3| p.cmpge(bounds.min - nudge).all() && p.cmple(bounds.max + nudge).all();
+            light_points.iter().all(|&target| {
+                // An odd count needs one end inside the mesh, so inside its bounds.
+                (inside(eye) || inside(target))
+                    && eyes.iter().filter(|&&from| segment_crossings(mesh, instance.transform, from, target) % 2 == 1).count() >= 2
+            })
+        })
+    }
+}
+
+/// How many triangles of `mesh` placed by `transform` the segment from `from` to `to` crosses
+/// strictly inside (Möller and Trumbore).
+fn segment_crossings(mesh: &Mesh, transform: Mat4, from: Vec3, to: Vec3) -> usize {
+    let direction = to - from;
+    mesh.triangles()
+        .filter(|t| {
+            let [a, b, c] = t.map(|k| transform.transform_point3(mesh.positions[k as usize]));
+            let (edge1, edge2) = (b - a, c - a);
+            let p = direction.cross(edge2);
+            let determinant = edge1.dot(p);
+            if determinant.abs() <= f32::EPSILON * edge1.length() * edge2.length() * direction.length() {
+                return false;
+            }
+            let inverse = 1.0 / determinant;
+            let offset = from - a;
+            let u = offset.dot(p) * inverse;
+            let q = offset.cross(edge1);
+            let v = direction.dot(q) * inverse;
+            let t = edge2.dot(q) * inverse;
+            u > 0.0 && v > 0.0 && u + v < 1.0 && t > 0.0 && t < 1.0
+        })
+        .count()
 }
 
 /// The matrix that carries normals of an object with this transform (inverse transpose).
@@ -272,5 +331,42 @@ mod tests {
             )
             .is_err()
         );
+    }
+
+    /// A 2-unit box (closed) placed at `centre`, and an open quad, lit by `light`.
+    fn boxed(centre: Vec3, light: RectLight) -> Scene {
+        let mut scene = crate::builtin("parallel-square").unwrap_or_else(|e| panic!("{e}")).build();
+        scene.meshes = vec![crate::primitives::cuboid("box", Vec3::splat(2.0)), crate::primitives::plane("quad", glam::Vec2::splat(2.0))];
+        scene.instances = vec![
+            Instance { name: "box".into(), mesh: 0, transform: Mat4::from_translation(centre), role: Role::Both },
+            Instance { name: "quad".into(), mesh: 1, transform: Mat4::from_translation(Vec3::new(0.0, 5.0, 0.0)), role: Role::Both },
+        ];
+        scene.lights = vec![light];
+        scene
+    }
+
+    #[test]
+    fn a_closed_mesh_separates_a_light_inside_it_from_an_eye_outside() {
+        let light = |centre: Vec3, size: f32| {
+            RectLight::try_facing(centre, -Vec3::Y, Vec3::X, glam::Vec2::splat(size), 1.0).unwrap_or_else(|| panic!("light"))
+        };
+        let inside = light(Vec3::new(0.1, 0.5, -0.2), 0.5);
+        let scene = boxed(Vec3::ZERO, inside);
+        let closed = scene.closed_meshes();
+        assert_eq!(closed, vec![true, false]);
+        let outside_eye = Vec3::new(0.0, 3.0, 6.0);
+        assert!(scene.separates_light_from(&closed, &inside, outside_eye), "sealed light, eye outside");
+        assert!(!scene.separates_light_from(&closed, &inside, Vec3::new(0.5, -0.5, 0.5)), "eye in the same box");
+        // The eye looking straight down the box's edge and through a vertex: the nudged eyes decide.
+        assert!(scene.separates_light_from(&closed, &light(Vec3::ZERO, 0.0), Vec3::splat(5.0)), "through a vertex");
+        let above = light(Vec3::new(0.0, 4.0, 0.0), 0.5);
+        assert!(!scene.separates_light_from(&closed, &above, outside_eye), "light and eye outside");
+        // An eye inside the box and the light outside it: separated too.
+        assert!(scene.separates_light_from(&closed, &above, Vec3::new(0.3, 0.2, 0.1)), "eye sealed in");
+        // A light straddling a wall is not sealed: part of it is outside.
+        let straddling = light(Vec3::new(1.0, 0.5, 0.0), 0.5);
+        assert!(!scene.separates_light_from(&closed, &straddling, outside_eye), "straddling light");
+        // An open quad separates nothing.
+        assert!(!scene.separates_light_from(&closed, &light(Vec3::new(0.0, 6.0, 0.0), 0.5), Vec3::new(0.0, 4.0, 0.0)), "open quad");
     }
 }

@@ -65,7 +65,7 @@ pub fn stratum_centres(per_axis: u32) -> Vec<Vec2> {
 pub struct MultiShadowMaps {
     depth_map: LightDepthMap,
     /// Per light, per sample: the frame of a point light at the sample.
-    sample_frames: Vec<Vec<wgpu::BindGroup>>,
+    sample_frames: Vec<Vec<SampleFrame>>,
     accumulate: wgpu::ComputePipeline,
     gbuffer_bind_group: wgpu::BindGroup,
     /// Per light: the group binding the shadow map, the settings and that light's target.
@@ -132,8 +132,16 @@ impl MultiShadowMaps {
     }
 }
 
-/// Per light, per stratum: the light frame of a point light at the stratum's centre.
-fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<wgpu::BindGroup>> {
+/// The light frame of a point light at one stratum's centre, its uniform buffer and bind group.
+struct SampleFrame {
+    frame: LightFrame,
+    buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+/// Per light, per stratum: the light frame of a point light at the stratum's centre, sealed
+/// from the camera when the whole light is ([`LightFrame::sealed`]: every stratum is then too).
+fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<SampleFrame>> {
     let device = &setup.gpu.device;
     let bounds = setup.scene.bounds;
     setup
@@ -148,14 +156,23 @@ fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<wgpu::Bin
                 .map(|(k, s)| {
                     let light = frame.light;
                     let point_light = RectLight { centre: light.point(s.x, s.y), half_size: Vec2::ZERO, ..light };
-                    let uniform = LightFrameUniform::from(&LightFrame::fit(&point_light, &bounds));
-                    let buffer = uniform_buffer(device, &format!("multi_sm_sample_frame_{light_index}_{k}"), &uniform);
-                    bind_group(
+                    let sample = LightFrame { sealed: frame.sealed, ..LightFrame::fit(&point_light, &bounds) };
+                    let buffer = wgpu::util::DeviceExt::create_buffer_init(
+                        device,
+                        &wgpu::util::BufferInitDescriptor {
+                            label: Some(&format!("multi_sm_sample_frame_{light_index}_{k}")),
+                            contents: bytemuck::bytes_of(&LightFrameUniform::from(&sample)),
+                            // COPY_DST: the camera may move across the closed mesh that seals the light.
+                            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                        },
+                    );
+                    let bind_group = bind_group(
                         device,
                         &format!("multi_sm_sample_frame_bind_group_{light_index}_{k}"),
                         setup.gpu.uniform_layout(),
                         &[buffer.as_entire_binding()],
-                    )
+                    );
+                    SampleFrame { frame: sample, buffer, bind_group }
                 })
                 .collect()
         })
@@ -166,14 +183,19 @@ impl ShadowTechnique for MultiShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
         let no_light = || Error::Technique { technique: NAME.into(), message: format!("no light {light}") };
         let own_group = self.own_groups.get(light).ok_or_else(no_light)?;
-        let frames = self.sample_frames.get(light).ok_or_else(no_light)?;
+        let frames = self.sample_frames.get_mut(light).ok_or_else(no_light)?;
+        let sealed = frame.scene.light_frames.get(light).ok_or_else(no_light)?.sealed;
+        for sample in frames.iter_mut().filter(|sample| sample.frame.sealed != sealed) {
+            sample.frame.sealed = sealed;
+            frame.gpu.queue.write_buffer(&sample.buffer, 0, bytemuck::bytes_of(&LightFrameUniform::from(&sample.frame)));
+        }
         // The sum starts at 0, not at the framework's 1.
         drop(frame.render_pass("multi_sm_clear", &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))], None));
-        for sample_frame in frames {
-            self.depth_map.encode_with(frame, sample_frame);
+        for sample in frames.iter() {
+            self.depth_map.encode_with(frame, &sample.bind_group);
             let mut pass = frame.compute_pass("multi_sm_accumulate");
             pass.set_pipeline(&self.accumulate);
-            pass.set_bind_group(0, sample_frame, &[]);
+            pass.set_bind_group(0, &sample.bind_group, &[]);
             pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
             pass.set_bind_group(2, own_group, &[]);
             pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
