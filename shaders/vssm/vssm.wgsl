@@ -13,6 +13,11 @@
 // occluders at several depths, and the bound says lit) is to subdivide the kernel: each region
 // here is cut into `subdivision`² equal sub-regions, each answered on its own, their blockers
 // weighted by their blocker fractions and their fractions lit averaged.
+// What this adds to the published method, each for a failure the README's "What differs" shows:
+// each sub-region is compared with the receiver's tangent plane where it lies (not with the
+// point's depth), texels with no surface are counted apart (lit, at no depth), the search is
+// confined to the map, retried over smaller regions when it finds nothing, and repeated over the
+// region its own estimate implies.
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
@@ -24,16 +29,10 @@ struct VssmSettings {
     // Sub-regions per axis of each region (1: plain VSM).
     subdivision: u32,
     // Smallest variance the bound uses, in z² units (z = depth / far): keeps it finite on a flat
-    // region, where it is 0, and absorbs the table's rounding.
+    // region, where it is 0, and absorbs the rounding of the table's sums to f32.
     min_variance: f32,
     // Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
-    // The depth bias the map's texels carry, world units: the receiver's own texels hold its depth
-    // plus this, and Chebyshev's bound is tight (two depths, the upper one at t) only with t there.
-    constant_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
 };
 
 @group(2) @binding(0) var moment_table: texture_2d<u32>;
@@ -50,85 +49,123 @@ fn table_at(i: i32, j: i32) -> vec4<u32> {
     return textureLoad(moment_table, vec2<i32>(min(i, last), min(j, last)), 0);
 }
 
-// The table at one x and the four y a sub-region needs (Y0 − 1, Y0, Y1 − 1, Y1).
+// The table at one x, X, differenced along y (128-bit, exact) for a row of sub-regions whose
+// y edges fall in texel rows Y0 and Y1: the sums over [0, X] of the whole rows Y0 ≤ y < Y1
+// (`band`), of row Y0 and of row Y1. Neighbouring sub-regions share a column's differences.
 struct TableColumn {
-    y0_before: vec4<u32>,
-    y0: vec4<u32>,
-    y1_before: vec4<u32>,
-    y1: vec4<u32>,
+    band: vec4<u32>,
+    first_row: vec4<u32>,
+    last_row: vec4<u32>,
 };
 
 fn table_column(x: i32, y0: i32, y1: i32) -> TableColumn {
-    return TableColumn(table_at(x, y0 - 1), table_at(x, y0), table_at(x, y1 - 1), table_at(x, y1));
+    let y0_before = table_at(x, y0 - 1);
+    let y1_before = table_at(x, y1 - 1);
+    return TableColumn(
+        subtract_sums(y1_before, y0_before),
+        subtract_sums(table_at(x, y0), y0_before),
+        subtract_sums(table_at(x, y1), y1_before),
+    );
 }
 
-// The exact sum of a rectangle of texels whose table corners are `low_low` … `high_high`
-// (the table at its two x below and two y below, exclusive, and at its far corner, inclusive).
-fn rect_sum(low_low: vec4<u32>, high_low: vec4<u32>, low_high: vec4<u32>, high_high: vec4<u32>) -> vec2<f32> {
-    return sums_to_float(add_sums(subtract_sums(high_high, low_high), subtract_sums(low_low, high_low)));
-}
-
-// The moments' sums over the region [low, high) of the map (texels, inside the map), with
-// fractional edges: each texel weighted by its area in the region (a texel is a quad of
-// constant depth). Exact: with X0 = ⌊low.x⌋, X1 = ⌊high.x⌋ and a, b their fractions,
+// The sums (Σz², Σz, area with a surface) over the region [low, high) of the map (texels, inside
+// the map), with fractional edges: each texel weighted by its area in the region (a texel is a
+// quad of constant depth). Exact: with X0 = ⌊low.x⌋, X1 = ⌊high.x⌋ and a, b their fractions,
 // Σ w_i c_i = Σ_{X0 ≤ i < X1} c_i − a c_X0 + b c_X1 along each axis, every sum an integer
-// difference of table entries. The columns hold the table at x = X0 − 1, X0, X1 − 1, X1.
-fn weighted_sums(c0: TableColumn, c1: TableColumn, c2: TableColumn, c3: TableColumn, f_low: vec2<f32>, f_high: vec2<f32>) -> vec2<f32> {
+// difference of table entries, rounded to f32 only then. The columns hold the table at
+// x = X0 − 1, X0, X1 − 1, X1.
+fn weighted_sums(c0: TableColumn, c1: TableColumn, c2: TableColumn, c3: TableColumn, f_low: vec2<f32>, f_high: vec2<f32>) -> vec3<f32> {
     // Per axis: the whole texels, the first (weight −a) and the last (weight +b).
-    let inner = rect_sum(c0.y0_before, c2.y0_before, c0.y1_before, c2.y1_before);
-    let column_first = rect_sum(c0.y0_before, c1.y0_before, c0.y1_before, c1.y1_before);
-    let column_last = rect_sum(c2.y0_before, c3.y0_before, c2.y1_before, c3.y1_before);
-    let row_first = rect_sum(c0.y0_before, c2.y0_before, c0.y0, c2.y0);
-    let row_last = rect_sum(c0.y1_before, c2.y1_before, c0.y1, c2.y1);
-    let texel_first_first = rect_sum(c0.y0_before, c1.y0_before, c0.y0, c1.y0);
-    let texel_last_first = rect_sum(c2.y0_before, c3.y0_before, c2.y0, c3.y0);
-    let texel_first_last = rect_sum(c0.y1_before, c1.y1_before, c0.y1, c1.y1);
-    let texel_last_last = rect_sum(c2.y1_before, c3.y1_before, c2.y1, c3.y1);
+    let inner = sums_to_float(subtract_sums(c2.band, c0.band));
+    let column_first = sums_to_float(subtract_sums(c1.band, c0.band));
+    let column_last = sums_to_float(subtract_sums(c3.band, c2.band));
+    let row_first = sums_to_float(subtract_sums(c2.first_row, c0.first_row));
+    let row_last = sums_to_float(subtract_sums(c2.last_row, c0.last_row));
+    let texel_first_first = sums_to_float(subtract_sums(c1.first_row, c0.first_row));
+    let texel_last_first = sums_to_float(subtract_sums(c3.first_row, c2.first_row));
+    let texel_first_last = sums_to_float(subtract_sums(c1.last_row, c0.last_row));
+    let texel_last_last = sums_to_float(subtract_sums(c3.last_row, c2.last_row));
     let along_x = inner - f_low.x * column_first + f_high.x * column_last;
     let first_row = row_first - f_low.x * texel_first_first + f_high.x * texel_last_first;
     let last_row = row_last - f_low.x * texel_first_last + f_high.x * texel_last_last;
     return along_x - f_low.y * first_row + f_high.y * last_row;
 }
 
-// Chebyshev's answers over a k×k grid of equal sub-regions of [low, high) (texels): Σ of the
-// sub-regions' lit fractions, Σ of their blocker fractions, and Σ of blocker fraction × average
-// blocker depth, for a receiver at depth t (z units). Along a row of sub-regions, neighbours
-// share the table's columns at their common boundary: 8(k + 1) reads a row. A sub-region's part
-// outside the map counts as empty texels, at the far plane (z = z² = 1), as a tap outside the
-// map finds no surface.
-fn region_grid(low: vec2<f32>, high: vec2<f32>, k: u32, t: f32) -> vec3<f32> {
-    let step = (high - low) / f32(k);
-    let whole_area = max(step.x * step.y, 1e-12);
+// What region_grid answers for a region.
+struct RegionAnswer {
+    // Σ over the sub-regions of their lit fractions, of their blocker fractions and of blocker
+    // fraction × average blocker depth (z units).
+    lit: f32,
+    blockers: f32,
+    blocker_depths: f32,
+    // The number of sub-regions.
+    count: f32,
+};
+
+// Chebyshev's answers over a grid of equal sub-regions of [low, high) (texels), `k` per axis at
+// most and none narrower than a texel: a texel holds one depth for its whole square, so a window
+// of less than a texel sees its texel's depth, up to half a texel's depth change away from the
+// surface's depth at the window, where a window of a texel or more averages the texels to the
+// surface's depth at its centre (a box of one texel over texel centres is their bilinear
+// interpolation).
+// Each sub-region is compared with the receiver's tangent plane where it lies (`receiver`,
+// receiver_depth_near), not with the point's depth: a sub-region off the point holds the
+// receiver's own texels at that plane's depth, and a receiver that the light sees at a slant
+// would otherwise shadow itself in the sub-regions nearer the light (with k = 2 each holds them
+// spread evenly over h g either side of t − h g, g the depth change a texel and h the
+// sub-region's half side, and Chebyshev's bound calls three quarters of them blockers, whatever
+// the slope g).
+// The part of a sub-region with no surface (empty texels, or outside the map) is lit and enters
+// no moment: an empty texel is at no depth, and one counted at the far plane, beyond the
+// receiver, loosens the bound and breaks the blocker estimate (which takes the non-blockers at t).
+// Along a row of sub-regions, neighbours share the table's columns at their common boundary:
+// 8(k + 1) reads a row.
+fn region_grid(low: vec2<f32>, high: vec2<f32>, k: u32, receiver: TapPlane, far: f32) -> RegionAnswer {
     let size = settings.size;
-    var result = vec3<f32>(0.0);
-    for (var c = 0u; c < k; c++) {
+    let counts = clamp(vec2<u32>(floor(high - low)), vec2<u32>(1u), vec2<u32>(k));
+    let step = (high - low) / vec2<f32>(counts);
+    let whole_area = max(step.x * step.y, 1e-12);
+    var result = RegionAnswer(0.0, 0.0, 0.0, f32(counts.x * counts.y));
+    for (var c = 0u; c < counts.y; c++) {
         let y_low = clamp(low.y + f32(c) * step.y, 0.0, size);
         let y_high = clamp(low.y + f32(c + 1u) * step.y, 0.0, size);
+        let y_centre = low.y + (f32(c) + 0.5) * step.y;
         let y0 = i32(floor(y_low));
         let y1 = i32(floor(y_high));
         var x_low = clamp(low.x, 0.0, size);
         var column_before_low = table_column(i32(floor(x_low)) - 1, y0, y1);
         var column_low = table_column(i32(floor(x_low)), y0, y1);
-        for (var i = 0u; i < k; i++) {
+        for (var i = 0u; i < counts.x; i++) {
             let x_high = clamp(low.x + f32(i + 1u) * step.x, 0.0, size);
             let whole_x_high = i32(floor(x_high));
             let column_before_high = table_column(whole_x_high - 1, y0, y1);
             let column_high = table_column(whole_x_high, y0, y1);
             let inside_area = (x_high - x_low) * (y_high - y_low);
-            var means = vec2<f32>(1.0);
+            var surface_share = 0.0;
+            var p = vec2<f32>(1.0, 0.0);
+            var t = 1.0;
             if (inside_area > 0.0) {
                 let f_low = vec2<f32>(x_low - floor(x_low), y_low - floor(y_low));
                 let f_high = vec2<f32>(x_high - floor(x_high), y_high - floor(y_high));
                 let inside = weighted_sums(column_before_low, column_low, column_before_high, column_high, f_low, f_high);
-                means = (inside + vec2<f32>(whole_area - inside_area)) / whole_area;
+                let surface_area = min(inside.z, inside_area);
+                surface_share = min(surface_area / whole_area, 1.0);
+                if (surface_area > 1e-6) {
+                    let centre = vec2<f32>(low.x + (f32(i) + 0.5) * step.x, y_centre) / size;
+                    t = receiver_depth_near(receiver, centre, (1.0 - surface_share) * (0.5 * step + 0.5) / size) / far;
+                    p = lit_fraction(inside.yx / surface_area, t);
+                }
             }
-            let p = lit_fraction(means, t);
-            result.x += p.x;
-            if (p.x < 1.0) {
-                // This sub-region's z_occ, kept between the light and the receiver.
-                let occluder = clamp((p.y - p.x * t) / (1.0 - p.x), 0.0, t);
-                result.y += 1.0 - p.x;
-                result.z += (1.0 - p.x) * occluder;
+            let blocker = surface_share * (1.0 - p.x);
+            result.lit += 1.0 - blocker;
+            // This sub-region's z_occ, from its surfaces. Negative when the spread of depths is
+            // too wide for two depths with the upper one at t (σ² > μ (t − μ): surfaces beyond
+            // the receiver, not blockers, make the variance): it then says nothing of the
+            // blockers' depth, and such a sub-region would drag the average to the light.
+            let occluder = (p.y - p.x * t) / max(1.0 - p.x, 1e-12);
+            if (blocker > 0.0 && occluder >= 0.0) {
+                result.blockers += blocker;
+                result.blocker_depths += blocker * min(occluder, t);
             }
             x_low = x_high;
             column_before_low = column_before_high;
@@ -138,8 +175,36 @@ fn region_grid(low: vec2<f32>, high: vec2<f32>, k: u32, t: f32) -> vec3<f32> {
     return result;
 }
 
+// The nearest depth of the receiver's tangent plane along the rays through uv ± reach (shadow-map
+// coordinates; along a line the plane's depth is monotonic, so the nearest is at a corner), or
+// its fallback where none of them meets it. With reach 0, the depth at uv. A sub-region whose
+// surfaces cover only part of it (its share s) may hold them off its centre: their area's
+// centroid lies within (1 − s) of half the sub-region of it, their texels' centres within half a
+// texel more, and the plane's depth at the centre would make the receiver's own texels nearer the
+// light blockers; the nearest depth within that reach makes none of them one.
+fn receiver_depth_near(receiver: TapPlane, uv: vec2<f32>, reach: vec2<f32>) -> f32 {
+    var nearest = 3.0e38;
+    for (var corner = 0u; corner < 4u; corner++) {
+        let sign = vec2<f32>(f32(corner & 1u), f32(corner >> 1u)) * 2.0 - 1.0;
+        let at = uv + sign * reach;
+        let denominator = receiver.coefficients.x + receiver.coefficients.y * at.x + receiver.coefficients.z * at.y;
+        let depth = receiver.numerator / denominator;
+        if (abs(denominator) >= 1e-6 && depth > 0.0) {
+            nearest = min(nearest, depth);
+        }
+    }
+    return select(nearest, receiver.fallback, nearest >= 3.0e38);
+}
+
 // Most sub-regions per axis (the setting's range).
 const MAX_SUBDIVISION: u32 = 8u;
+// Each retry of a blocker search that found nothing covers this share of the last one's side.
+const SEARCH_SHRINK: f32 = 0.25;
+// Enough retries to shrink the whole map (a half side of 1) to a texel of the largest map
+// (0.5 / 4096 = 2^-13, and 4^7 > 2^13).
+const MAX_RETRIES: u32 = 7u;
+// Blocker searches over the region the last one's estimate implies (PCSS's filter region at that depth).
+const SEARCH_REFINEMENTS: u32 = 2u;
 
 // Chebyshev's bound on the fraction of the region's texels at or beyond depth t (z units), and
 // the region's mean: (p, μ). p = 1 where t ≤ μ.
@@ -153,6 +218,24 @@ fn lit_fraction(means: vec2<f32>, t: f32) -> vec2<f32> {
     return vec2<f32>(variance / (variance + difference * difference), mean);
 }
 
+// The average blocker depth (world units) over the part inside the map of the region uv ± extent,
+// or 0 where it holds no blocker. Nothing outside the map blocks (the light frame holds every
+// occluder between the light and a receiver), and the search counts only what is in it.
+fn blocker_search(uvd: vec3<f32>, extent: vec2<f32>, k: u32, receiver: TapPlane, far: f32) -> f32 {
+    let size = vec2<f32>(settings.size);
+    let low = clamp((uvd.xy - extent) * size, vec2<f32>(0.0), size);
+    let high = clamp((uvd.xy + extent) * size, vec2<f32>(0.0), size);
+    if (any(high <= low)) {
+        return 0.0;
+    }
+    let answer = region_grid(low, high, k, receiver, far);
+    if (answer.blockers <= 1e-6 * answer.count) {
+        return 0.0;
+    }
+    // Blockers at the light itself: keep the depth positive, which says "found".
+    return max(answer.blocker_depths / answer.blockers * far, 1e-30);
+}
+
 @fragment
 fn vssm_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
@@ -163,23 +246,40 @@ fn vssm_filter(in: FullscreenVertex) -> @location(0) f32 {
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
     let far = frame.projection.w;
-    // The depth the receiver's own texels hold (its depth plus the map's bias): non-blockers lie
-    // there, so that is where the bound's threshold belongs (Sec. 3's z_unocc = t).
-    let t = (uvd.z + settings.constant_bias) / far;
+    // What each sub-region is compared with: the receiver's tangent plane (the point's own depth
+    // where a ray misses it).
+    let receiver = tap_plane(frame, lookup, point.normal, uvd.z);
     let k = clamp(settings.subdivision, 1u, MAX_SUBDIVISION);
     // A region is never narrower than one texel: a point light's filter is the texel under the point.
     let least = vec2<f32>(0.5 / settings.size);
 
-    // 1. Blocker search.
-    let search = max(light_half_extent_uv(frame, frame.projection.z, uvd.z), least);
-    let blockers = region_grid((uvd.xy - search) * settings.size, (uvd.xy + search) * settings.size, k, t);
-    if (blockers.y <= 1e-6) {
+    // 1. Blocker search over the light's back-projection through the near plane (at most the whole
+    // map). Where the frame's near plane is at the light (walls beside it: a room, a box around
+    // it; a floor running up to its plane) that is most of the map, and a small blocker among
+    // surfaces spread over many depths (a floor the light sees at a slant) leaves the bound saying
+    // lit: the search is retried over regions a quarter the side each time, down to a texel,
+    // each one plain VSM query (it looks for a blocker near the point, not for their layout).
+    var search = clamp(light_half_extent_uv(frame, frame.projection.z, uvd.z), least, vec2<f32>(1.0));
+    var blocker_depth = blocker_search(uvd, search, k, receiver, far);
+    for (var retry = 0u; retry < MAX_RETRIES && blocker_depth <= 0.0 && any(search > least); retry++) {
+        search = max(search * SEARCH_SHRINK, least);
+        blocker_depth = blocker_search(uvd, search, 1u, receiver, far);
+    }
+    // The region at the near plane is PCSS's bound over every blocker depth, and its average is
+    // pulled towards the light by surfaces in it that cannot block the point (a wall's far parts):
+    // the search is repeated over the region that its estimate implies, never a larger one.
+    for (var refinement = 0u; refinement < SEARCH_REFINEMENTS && blocker_depth > 0.0; refinement++) {
+        search = min(max(light_half_extent_uv(frame, blocker_depth, uvd.z), least), search);
+        blocker_depth = blocker_search(uvd, search, k, receiver, far);
+    }
+    if (blocker_depth <= 0.0) {
         return 1.0;
     }
-    let blocker_depth = blockers.z / blockers.y * far;
 
-    // 2. Penumbra extent, 3. the fraction lit over it.
-    let extent = max(light_half_extent_uv(frame, blocker_depth, uvd.z), least);
-    let lit = region_grid((uvd.xy - extent) * settings.size, (uvd.xy + extent) * settings.size, k, t).x;
-    return clamp(lit / f32(k * k), 0.0, 1.0);
+    // 2. Penumbra extent (within the last search region, as PCSS's is within its search), 3. the
+    // fraction lit over it.
+    let extent = min(max(light_half_extent_uv(frame, blocker_depth, uvd.z), least), search);
+    let size = vec2<f32>(settings.size);
+    let lit = region_grid((uvd.xy - extent) * size, (uvd.xy + extent) * size, k, receiver, far);
+    return clamp(lit.lit / lit.count, 0.0, 1.0);
 }

@@ -1,10 +1,11 @@
 // VSSM (Yang, Dong, Feng, Seidel and Kautz 2010, Variance Soft Shadow Mapping): the summed-area
 // table of the shadow map's first two moments, z and z² (Donnelly and Lauritzen 2006), of the
-// depth normalised by the light frame's far plane. Each moment is a fixed-point number (z·2^32)
-// summed in 64 bits (two u32 words, with carry), so that a region's sum, the difference of four
-// table entries, is exact whatever the region's size or place: a floating-point table loses the
-// variance of small regions far from its origin to cancellation. Two passes, one thread per row
-// (prefix sums along x) then one per column (along y).
+// depth normalised by the light frame's far plane, and of the count of texels with a surface.
+// Each texel's three numbers are fixed-point fields of one 128-bit integer (vssm_common.wgsl),
+// summed with carry, so that a region's sums, the difference of four table entries, are exact
+// whatever the region's size or place: a floating-point table loses the variance of small regions
+// far from its origin to cancellation. Two passes, one thread per row (prefix sums along x) then
+// one per column (along y).
 
 // #import common/light_frame.wgsl
 // #import vssm/vssm_common.wgsl
@@ -26,7 +27,7 @@ fn vssm_sat_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     var sums = vec4<u32>(0u);
     for (var x = 0u; x < size.x; x++) {
         let texel = vec2<u32>(x, id.x);
-        sums = add_moments(sums, fixed_moments(textureLoad(depth_map, texel, 0).x, frame.projection.w));
+        sums = add_sums(sums, texel_value(textureLoad(depth_map, texel, 0).x, frame.projection.w));
         textureStore(row_sums_out, texel, sums);
     }
 }

@@ -5,8 +5,11 @@
 //! constant time by the shadow map's first two moments (Donnelly and Lauritzen 2006, variance
 //! shadow maps) read from their summed-area table: the average blocker depth from Chebyshev's
 //! one-tailed bound on the fraction of non-blockers, the fraction lit from the same bound; the
-//! kernel subdivided into sub-regions to avoid VSM's incorrectly lit pixels. Passes: the depth
-//! map, the table (rows, then columns, exact 64-bit fixed-point sums), the filter.
+//! kernel subdivided into sub-regions to avoid VSM's incorrectly lit pixels. Each sub-region is
+//! compared with the receiver's tangent plane where it lies, texels with no surface are counted
+//! apart, and the blocker search is kept to the map, retried over smaller regions and refined
+//! (README: "What differs"). Passes: the depth map, the table (rows, then columns: exact 128-bit
+//! fixed-point sums of the two moments and of the texels with a surface), the filter.
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
@@ -31,11 +34,12 @@ const FILTER_SHADER: &str = include_str!("../../../shaders/vssm/vssm.wgsl");
 /// WGSL files the VSSM shaders import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
 
-/// The table's texel format: the two moments' 64-bit sums as four 32-bit words.
+/// The table's texel format: one 128-bit integer of three fixed-point sums (Σz², Σz, the texels with a surface) as four 32-bit words.
 const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 
-/// Largest shadow map whose table the 64-bit sums hold exactly (4096² texels of moments below
-/// 2^32 sum to below 2^56) and that fits a device's textures.
+/// Largest shadow map whose table the 128-bit sums hold exactly (4096² = 2^24 texels of moments
+/// below 2^27 sum to below 2^51, each field's width; shaders/vssm/vssm_common.wgsl) and that fits
+/// a device's textures.
 const MAX_SIZE: u32 = 4096;
 
 /// Settings of [`VarianceSoftShadowMaps`]: its parameters.
@@ -45,23 +49,23 @@ pub struct VssmSettings {
     #[param(default = 1024, min = 16, max = 4096)]
     pub shadow_map_size: u32,
     /// Sub-regions per axis of the blocker search's and the filter's regions (1: each region one VSM query; the paper subdivides the kernel against incorrectly lit pixels).
-    #[param(default = 2, min = 1, max = 8)]
+    #[param(default = 4, min = 1, max = 8)]
     pub subdivision: u32,
     /// Smallest variance Chebyshev's bound uses, in units of (depth / far)².
     #[param(default = 1e-7, min = 0.0, max = 0.01)]
     pub min_variance: f32,
-    /// Depth bias added to every texel, as a fraction of the scene's bounding-box diagonal (the receiver's depth is compared with its own texels' depth, bias included).
-    #[param(default = 1e-3, min = 0.0, max = 0.1)]
-    pub constant_bias: f32,
     /// Lookup point moved off the surface along its normal, in shadow-map texels; 0 by default: the bound is continuous in depth, so there is no acne to push away from, and the offset would put the receiver nearer the light than its own texels, where the bound is loose.
     #[param(default = 0.0, min = 0.0, max = 8.0)]
     pub normal_offset: f32,
 }
 
 impl VssmSettings {
-    /// The depth map's bias (no slope bias: the bound needs the texels' true depths).
+    /// The depth map's bias: none. Chebyshev's bound needs the texels' true depths, and the
+    /// receiver is compared with its own tangent plane's depth, where its texels lie: a bias would
+    /// only move the texels off it (or, added to the receiver's depth too, shift every depth alike
+    /// and change nothing).
     fn bias(&self) -> ShadowMapBias {
-        ShadowMapBias { constant_bias: self.constant_bias, slope_bias: 0.0, normal_offset: self.normal_offset }
+        ShadowMapBias { constant_bias: 0.0, slope_bias: 0.0, normal_offset: self.normal_offset }
     }
 }
 
@@ -73,24 +77,16 @@ pub struct VssmSettingsUniform {
     subdivision: u32,
     min_variance: f32,
     normal_offset: f32,
-    constant_bias: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
 }
 
 impl VssmSettingsUniform {
-    /// The uniform of `settings` in a scene whose bounding box's diagonal is `diagonal`.
-    fn new(settings: &VssmSettings, diagonal: f32) -> Self {
+    /// The uniform of `settings`.
+    fn new(settings: &VssmSettings) -> Self {
         Self {
             size: settings.shadow_map_size as f32,
             subdivision: settings.subdivision,
             min_variance: settings.min_variance,
             normal_offset: settings.normal_offset,
-            constant_bias: settings.constant_bias * diagonal,
-            _pad0: 0.0,
-            _pad1: 0.0,
-            _pad2: 0.0,
         }
     }
 }
@@ -170,8 +166,7 @@ impl VarianceSoftShadowMaps {
             &filter_layout,
             &[
                 wgpu::BindingResource::TextureView(&table),
-                uniform_buffer(device, "vssm_settings_uniform", &VssmSettingsUniform::new(&settings, setup.scene.bounds.size().length()))
-                    .as_entire_binding(),
+                uniform_buffer(device, "vssm_settings_uniform", &VssmSettingsUniform::new(&settings)).as_entire_binding(),
                 wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
             ],
         );
