@@ -11,8 +11,10 @@
 // estimated as eps = (A_f / B_f) (A_s / B_s) beta, beta the area of the
 // rectangles' intersection, and A_f <- A_f + A_s - eps, B_f <- B_f u B_s.
 // With blending=none the areas are summed (Akenine-Möller and Assarsson).
-// The final buffer is a storage buffer of full-precision floats: per pixel
-// the four areas, then the four rectangles.
+// The final buffer is in storage buffers of full-precision floats, one vec4
+// per pixel each: the four areas, and one buffer per radial part's rectangle
+// (so that each binding stays under the storage binding limit at 3840 x 2160:
+// AllocationPlan in ssm-techniques/wedges/src/plan.rs).
 
 // #import common/screen_pass.wgsl
 // #import wedges/wedges_common.wgsl
@@ -25,13 +27,14 @@
 @group(2) @binding(5) var silhouette_inner01: texture_2d<f32>;
 @group(2) @binding(6) var silhouette_inner23: texture_2d<f32>;
 @group(2) @binding(7) var silhouette_shaded: texture_2d<f32>;
-@group(2) @binding(8) var<storage, read_write> final_buffer: array<vec4<f32>>;
+@group(2) @binding(8) var<storage, read_write> final_areas: array<vec4<f32>>;
 @group(2) @binding(9) var<uniform> settings: WedgesSettings;
 @group(2) @binding(10) var umbra_mask: texture_2d<f32>;
 @group(2) @binding(11) var<storage, read_write> fragment_counts: array<u32>;
-
-// vec4s per pixel in the final buffer: areas, then one rectangle per radial part.
-const FINAL_STRIDE: u32 = 5u;
+@group(2) @binding(12) var<storage, read_write> final_rectangles0: array<vec4<f32>>;
+@group(2) @binding(13) var<storage, read_write> final_rectangles1: array<vec4<f32>>;
+@group(2) @binding(14) var<storage, read_write> final_rectangles2: array<vec4<f32>>;
+@group(2) @binding(15) var<storage, read_write> final_rectangles3: array<vec4<f32>>;
 // Blending modes.
 const BLENDING_NONE: u32 = 0u;
 
@@ -66,6 +69,41 @@ fn fill(area: f32, rect: vec4<f32>) -> f32 {
     return min(area / bound, 1.0);
 }
 
+// Radial part `part`'s stored rectangle at `pixel` in the final buffer.
+fn final_rectangle(part: u32, pixel: u32) -> vec4<f32> {
+    switch (part) {
+        case 0u: {
+            return final_rectangles0[pixel];
+        }
+        case 1u: {
+            return final_rectangles1[pixel];
+        }
+        case 2u: {
+            return final_rectangles2[pixel];
+        }
+        default: {
+            return final_rectangles3[pixel];
+        }
+    }
+}
+
+fn store_final_rectangle(part: u32, pixel: u32, stored: vec4<f32>) {
+    switch (part) {
+        case 0u: {
+            final_rectangles0[pixel] = stored;
+        }
+        case 1u: {
+            final_rectangles1[pixel] = stored;
+        }
+        case 2u: {
+            final_rectangles2[pixel] = stored;
+        }
+        default: {
+            final_rectangles3[pixel] = stored;
+        }
+    }
+}
+
 fn blend(texel: vec2<i32>, umbra: bool) {
     let area = textureLoad(silhouette_area, texel, 0);
     let inner01 = textureLoad(silhouette_inner01, texel, 0);
@@ -80,8 +118,8 @@ fn blend(texel: vec2<i32>, umbra: bool) {
         textureLoad(silhouette_rect3, texel, 0),
     );
     var maxima = array<vec2<f32>, 4>(inner01.xy, inner01.zw, inner23.xy, inner23.zw);
-    let base = (u32(texel.y) * u32(textureDimensions(silhouette_area).x) + u32(texel.x)) * FINAL_STRIDE;
-    var final_area = final_buffer[base];
+    let pixel = u32(texel.y) * u32(textureDimensions(silhouette_area).x) + u32(texel.x);
+    var final_area = final_areas[pixel];
     let umbra_area = select(0.0, 1.0, umbra);
     for (var i = 0u; i < 4u; i += 1u) {
         let silhouette = clamp(umbra_area + area[i], 0.0, 1.0);
@@ -103,19 +141,19 @@ fn blend(texel: vec2<i32>, umbra: bool) {
             // No rectangle was recorded for occlusion that exists: assume the whole part.
             bound = vec4<f32>(0.0, 1.0, 0.0, 1.0);
         }
-        let final_bound = decode(final_buffer[base + 1u + i]);
+        let final_bound = decode(final_rectangle(i, pixel));
         if (final_area[i] <= 0.0) {
             final_area[i] = silhouette;
-            final_buffer[base + 1u + i] = encode(bound);
+            store_final_rectangle(i, pixel, encode(bound));
             continue;
         }
         // Sec. 3.2: the overlap, weighted by how much of each rectangle is occluded.
         let beta = rect_area(rect_intersection(final_bound, bound));
         let epsilon = fill(final_area[i], final_bound) * fill(silhouette, bound) * beta;
         final_area[i] = clamp(final_area[i] + silhouette - epsilon, 0.0, 1.0);
-        final_buffer[base + 1u + i] = encode(rect_union(final_bound, bound));
+        store_final_rectangle(i, pixel, encode(rect_union(final_bound, bound)));
     }
-    final_buffer[base] = final_area;
+    final_areas[pixel] = final_area;
 }
 
 // One thread per pixel (dispatched only for buffers that hold anything).
@@ -147,7 +185,6 @@ fn wedges_resolve(in: FullscreenVertex) -> @location(0) f32 {
     if (trivial >= 0.0) {
         return trivial;
     }
-    let base = (u32(point.texel.y) * u32(textureDimensions(silhouette_area).x) + u32(point.texel.x)) * FINAL_STRIDE;
-    let occluded = final_buffer[base];
+    let occluded = final_areas[u32(point.texel.y) * u32(textureDimensions(silhouette_area).x) + u32(point.texel.x)];
     return 1.0 - clamp(dot(occluded, vec4<f32>(0.25)), 0.0, 1.0);
 }

@@ -23,9 +23,13 @@ const DRAW_ARGUMENTS: u32 = 8u;
 // u32s of indirect arguments per group: draws of the sides, caps and wedges, and the blend's dispatch.
 const GROUP_ARGUMENTS: u32 = 16u;
 
-// Face flag: the face's connected component is not a closed, consistently
-// wound manifold, so its faces are two-sided (each faces the light).
-const FACE_TWO_SIDED: u32 = 1u;
+// Face.component of a face whose connected component is not a closed,
+// consistently wound manifold: its faces are two-sided (each faces the light).
+const TWO_SIDED_COMPONENT: u32 = 0xffffffffu;
+// Fixed-point units of a closed component's winding number around the light's
+// centre (the solid angle it subtends, summed over its faces with i32
+// atomics): one full turn, 4 pi steradians, is 2^24 units.
+const WINDING_TURN: f32 = 16777216.0;
 // Face state bits, computed per frame from the light's centre.
 const STATE_PARTICIPATES: u32 = 1u;
 const STATE_REVERSED: u32 = 2u;
@@ -75,7 +79,8 @@ struct Face {
     v0: u32,
     v1: u32,
     v2: u32,
-    flags: u32,
+    // Index of the face's closed component (into the winding numbers), or TWO_SIDED_COMPONENT.
+    component: u32,
 };
 
 // One edge incidence: `v0 -> v1` is the edge as `face_a` winds it; `face_b`,
@@ -131,14 +136,30 @@ struct Counters {
     cap_cursor: array<atomic<u32>, 64>,
     edge_offset: array<u32, 64>,
     cap_offset: array<u32, 64>,
+    // Per buffer, a bound on any point's stencil count: one per region of a convex closed
+    // component (a ray enters or leaves it once), one per face of any other.
+    stencil_levels: array<atomic<u32>, 64>,
 };
-
-// The light's centre.
-fn light_centre(frame: LightFrame) -> vec3<f32> {
-    return frame.centre.xyz;
-}
 
 // A point at infinity in the direction from the light's centre through `p`, in clip space.
 fn clip_at_infinity(view_proj: mat4x4<f32>, frame: LightFrame, p: vec3<f32>) -> vec4<f32> {
     return view_proj * vec4<f32>(p - frame.centre.xyz, 0.0);
+}
+
+// The camera depth (NDC) by which wedges_depth_copy moves the G-buffer's depth at a point
+// `position` with normal `normal` (turned towards the camera): `depth_bias` towards the side of
+// the surface facing the light's centre (towards the camera when the centre is on its side).
+fn volume_depth_offset(frame: LightFrame, depth_bias: f32, position: vec3<f32>, normal: vec3<f32>) -> f32 {
+    return select(depth_bias, -depth_bias, dot(normal, frame.centre.xyz - position) >= 0.0);
+}
+
+// The point whose depth the shadow volumes' stencil test judges at the pixel showing
+// `position`: `position` moved along the view ray from `eye` until its NDC depth has moved by
+// `offset`. Along the ray eye + s (position - eye), clip z and w are affine in s with w = 0 at
+// the eye, so NDC depth is z_eye / (s w) + const, and moving it by `offset` gives
+// 1 / s = 1 + offset w / z_eye (z_eye is never 0 for a perspective projection).
+fn volume_test_point(view_proj: mat4x4<f32>, eye: vec3<f32>, position: vec3<f32>, offset: f32) -> vec3<f32> {
+    let z_eye = (view_proj * vec4<f32>(eye, 1.0)).z;
+    let w = (view_proj * vec4<f32>(position, 1.0)).w;
+    return eye + (position - eye) / (1.0 + offset * w / z_eye);
 }

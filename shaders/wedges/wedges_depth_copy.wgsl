@@ -29,6 +29,5 @@ fn wedges_depth_copy(in: FullscreenVertex) -> @builtin(frag_depth) f32 {
     // The G-buffer's normal is turned towards the camera: the light's side is the camera's when
     // the light's centre is in front of it too.
     let normal = textureLoad(gbuffer_normal, texel, 0).xyz;
-    let camera_side = dot(normal, frame.centre.xyz - position.xyz) >= 0.0;
-    return clamp(depth + select(settings.depth_bias, -settings.depth_bias, camera_side), 0.0, 1.0);
+    return clamp(depth + volume_depth_offset(frame, settings.depth_bias, position.xyz, normal), 0.0, 1.0);
 }

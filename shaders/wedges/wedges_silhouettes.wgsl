@@ -1,7 +1,10 @@
 // Silhouettes from the light's centre, every frame, on the GPU (Forest et
 // al., Sec. 4.1, with the half-edge connectivity replaced by compute passes):
 //
-// 1. classify each face: turned towards the light's centre or not;
+// 0. find, for each closed component, whether the light's centre is inside it
+//    (its winding number around the centre);
+// 1. classify each face: whether it bounds the shadow volume (turned towards
+//    the light's centre, or away from it in a closed component around it);
 // 2. label silhouette regions: connected sets of faces turned to the light,
 //    joined across the edges whose shadow-volume sides cancel (hook and
 //    pointer-jumping rounds until nothing changes; each region is bounded by
@@ -29,6 +32,11 @@
 @group(1) @binding(9) var<storage, read_write> counters: Counters;
 @group(1) @binding(10) var<storage, read_write> half_edges: array<WedgeRecord>;
 @group(1) @binding(11) var<storage, read_write> caps: array<u32>;
+// Per closed component, its winding number around the light's centre in units of WINDING_TURN
+// (cleared before the pass).
+@group(1) @binding(12) var<storage, read_write> winding: array<atomic<i32>>;
+// Per closed component, 1 when every edge of it is convex (CastingMesh::closed_convex).
+@group(1) @binding(13) var<storage, read> component_convex: array<u32>;
 
 // The indirect arguments: two dispatches (hook over records, jump over faces), then per group
 // four draws. Bound only in the passes that write them.
@@ -55,6 +63,7 @@ fn wedges_reset() {
         atomicStore(&counters.cap_cursor[g], 0u);
         counters.edge_offset[g] = 0u;
         counters.cap_offset[g] = 0u;
+        atomicStore(&counters.stencil_levels[g], 0u);
     }
     indirect[0] = workgroups(mesh.record_count);
     indirect[1] = 1u;
@@ -77,11 +86,51 @@ fn faces_light(f: u32) -> bool {
     return dot(normal, frame.centre.xyz - p0) > 0.0;
 }
 
-// Step 1. Faces of closed components take part when they face the light (the
-// classic volume of the lit faces; its far cap is their projection to infinity).
-// Faces of open or non-manifold components are two-sided: every face takes
-// part, turned to face the light (STATE_REVERSED when its winding faces away),
-// so the volume is the union of every face's prism, whatever the mesh.
+// Step 0: the solid angle face f of a closed component subtends at the light's
+// centre, signed (positive when its winding faces away from the centre; Van
+// Oosterom and Strackee 1983), added to its component's winding number. A
+// closed, outward-wound component sums to one turn around a centre inside it
+// and to zero around one outside (minus one turn if it is wound inwards).
+@compute @workgroup_size(256)
+fn wedges_winding(@builtin(global_invocation_id) id: vec3<u32>) {
+    let f = id.x;
+    if (f >= mesh.face_count) {
+        return;
+    }
+    let face = faces[f];
+    if (face.component == TWO_SIDED_COMPONENT) {
+        return;
+    }
+    let c = frame.centre.xyz;
+    let a = positions[face.v0].xyz - c;
+    let b = positions[face.v1].xyz - c;
+    let d = positions[face.v2].xyz - c;
+    let la = length(a);
+    let lb = length(b);
+    let ld = length(d);
+    let numerator = dot(a, cross(b, d));
+    let denominator = la * lb * ld + dot(a, b) * ld + dot(a, d) * lb + dot(b, d) * la;
+    // A face seen edge-on subtends nothing (and atan2(0, 0) is not defined).
+    let solid_angle = select(2.0 * atan2(numerator, denominator), 0.0, numerator == 0.0);
+    // 4 pi steradians are WINDING_TURN units: a face's share is below half a turn, and
+    // rounding errs by half a unit per face, far from the half turn the test below draws the line at.
+    atomicAdd(&winding[face.component], i32(round(solid_angle * (WINDING_TURN / (4.0 * 3.14159265358979)))));
+}
+
+// Step 1. A ray from the light's centre first crosses a closed component where
+// it enters it, through a face turned towards the centre, when the centre is
+// outside it, but where it leaves it, through a face turned away, when the
+// centre is inside it (a closed room, a light sealed in a box). The faces of
+// that first crossing take part: their prisms (each face as the near cap, its
+// projection to infinity as the far cap, the silhouette edges as the sides)
+// hold every point whose segment to the centre crosses the component, so the
+// volume is closed even where no face is turned towards the light and there is
+// no silhouette (Sec. 3, 4.1; the classic volume of the lit faces when the
+// light is outside). Faces turned away take part turned to face the light
+// (STATE_REVERSED), which keeps every silhouette half-edge's orientation and
+// the caps' winding. Faces of open or non-manifold components are two-sided:
+// every face takes part, turned to face the light, so the volume is the union
+// of every face's prism, whatever the mesh.
 @compute @workgroup_size(256)
 fn wedges_classify_faces(@builtin(global_invocation_id) id: vec3<u32>) {
     let f = id.x;
@@ -89,12 +138,16 @@ fn wedges_classify_faces(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let lit = faces_light(f);
-    let two_sided = (faces[f].flags & FACE_TWO_SIDED) != 0u;
+    let component = faces[f].component;
     var state = 0u;
-    if (two_sided) {
+    if (component == TWO_SIDED_COMPONENT) {
         state = STATE_PARTICIPATES | select(STATE_REVERSED, 0u, lit);
-    } else if (lit) {
-        state = STATE_PARTICIPATES;
+    } else {
+        // Half a turn separates the winding numbers 0 (outside) and 1 (inside).
+        let centre_inside = f32(atomicLoad(&winding[component])) > 0.5 * WINDING_TURN;
+        if (lit != centre_inside) {
+            state = STATE_PARTICIPATES | select(0u, STATE_REVERSED, centre_inside);
+        }
     }
     face_state[f] = state;
     atomicStore(&labels[f], select(NO_FACE, f, (state & STATE_PARTICIPATES) != 0u));
@@ -311,14 +364,22 @@ fn wedges_count_edges(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Step 4a: count the cap faces of each silhouette buffer.
+// Step 4a: count the cap faces of each silhouette buffer, and bound its stencil count: a point's
+// count is the number of the buffer's face prisms holding it, but a convex closed component's
+// prisms (one region) hold a point at most once.
 @compute @workgroup_size(256)
 fn wedges_count_caps(@builtin(global_invocation_id) id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count || !participates(face_state[f])) {
         return;
     }
-    atomicAdd(&counters.cap_count[group_of(f)], 1u);
+    let g = group_of(f);
+    atomicAdd(&counters.cap_count[g], 1u);
+    let component = faces[f].component;
+    let convex = component != TWO_SIDED_COMPONENT && component_convex[component] != 0u;
+    if (!convex || atomicLoad(&labels[f]) == f) {
+        atomicAdd(&counters.stencil_levels[g], 1u);
+    }
 }
 
 // Step 4b: each buffer's place in the lists, and its draws' arguments.

@@ -2,7 +2,8 @@
 // 4.2-4.3): every silhouette half-edge's wedge is drawn as its convex
 // polyhedron (the edge, the two tangent planes, the two side planes, the far
 // plane), back faces only, so that each pixel whose view ray crosses it runs
-// one fragment. The fragment takes the G-buffer's point p and
+// one fragment. The fragment takes the point p the stencil test judged (the
+// G-buffer's point moved by the depth copy's bias along the view ray) and
 //
 // 1. finds its half-wedge by the split plane (the shadow-volume side through
 //    the light's centre): inner, towards the umbra, or outer (Fig. 8), and
@@ -42,16 +43,16 @@
 @group(3) @binding(0) var gbuffer_position: texture_2d<f32>;
 @group(3) @binding(1) var gbuffer_normal: texture_2d<f32>;
 
-// Fragment kinds: a fallback wedge drawn as a screen rectangle (no bounding planes); a
-// fallback pyramid (four bounding planes, all tested).
-const KIND_FALLBACK: u32 = 2u;
+// Fragment kind of a fallback pyramid: its four bounding planes are all tested. Every other
+// wedge is kind 0: a proper wedge tests its half's three planes, and a fallback wedge drawn as a
+// screen rectangle keeps NO_PLANE for all four, so the same tests reject nothing.
 const KIND_PYRAMID: u32 = 4u;
 
 struct WedgeVarying {
     @builtin(position) clip: vec4<f32>,
     // The half-edge.
     @location(0) @interpolate(flat) index: u32,
-    // KIND_FALLBACK, or 0.
+    // KIND_PYRAMID, or 0.
     @location(1) @interpolate(flat) kind: u32,
     // Bounding planes (unit normal, offset), inside where dot(normal, p) >= offset: the
     // inner and outer tangent planes, and the side planes at a' and b'.
@@ -140,7 +141,6 @@ fn wedges_wedge_vertex(@builtin(vertex_index) vertex: u32) -> WedgeVarying {
         return out;
     }
     if ((flags & WEDGE_FALLBACK) != 0u) {
-        out.kind = KIND_FALLBACK;
         // The screen-space bounding box of the fallback hull: the clipped edge and the far rectangle.
         if (triangle < 2u) {
             let hull = array<vec3<f32>, 6>(
@@ -317,7 +317,12 @@ fn wedges_wedge_fragment(in: WedgeVarying) -> WedgeTargets {
     if (position.w < 0.5) {
         discard;
     }
-    let p = position.xyz;
+    // The point the stencil test judged the umbra at (the G-buffer's point moved by the depth
+    // copy's bias along the view ray): the umbra, the half-wedge and the integration must all be
+    // of one point. Otherwise, on a receiver within the bias of a shadow-volume side, the umbra
+    // and the half-wedge disagree, and the sum is off by up to half the light.
+    let offset = volume_depth_offset(frame, settings.depth_bias, position.xyz, textureLoad(gbuffer_normal, texel, 0).xyz);
+    let p = volume_test_point(camera.view_proj, camera.position.xyz, position.xyz, offset);
     let record = half_edges[in.index];
     let a = record.a.xyz;
     let b = record.b.xyz;

@@ -5,9 +5,12 @@
 //!
 //! Per light and frame, entirely on the GPU:
 //!
-//! 1. **Silhouettes** (`wedges_silhouettes`, compute): faces are classified
-//!    from the light's centre, connected into *silhouette regions* (faces
-//!    turned to the light, joined across the edges whose volume sides cancel;
+//! 1. **Silhouettes** (`wedges_silhouettes`, compute): each closed
+//!    component's winding number around the light's centre tells whether the
+//!    centre is inside it; faces are classified from the centre (those a ray
+//!    from it crosses first take part: turned towards it, or away from it in
+//!    a closed component around it), connected into *silhouette regions* (the
+//!    faces that take part, joined across the edges whose volume sides cancel;
 //!    each region is bounded by its silhouette loops), ranked, and given
 //!    round-robin to `silhouette_buffers` groups; each group's silhouette
 //!    half-edges, with their penumbra wedges, and cap faces are written into
@@ -15,8 +18,9 @@
 //! 2. Per group: **shadow volumes** (`wedges_shadow_volumes`): z-fail
 //!    (Carmack's reverse) into the technique's Depth24PlusStencil8 target,
 //!    whose depth is the G-buffer's (`wedges_depth_copy`), caps included;
-//!    **wedges** (`wedges_wedges`): each half-edge's inner and outer
-//!    half-wedge, Lengyel's bounding-plane rejection, the local near plane,
+//!    **wedges** (`wedges_wedges`), at the point the stencil judged (the
+//!    G-buffer's moved by the depth copy's bias): each half-edge's inner and
+//!    outer half-wedge, Lengyel's bounding-plane rejection, the local near plane,
 //!    and per radial part of the light the occluded area integrated exactly
 //!    from the centre, its bounding rectangle, the inner edges' maximum X and
 //!    Y (Sec. 3.1, 4.2, 4.3); **blend** (`wedges_blend`): the group's buffer
@@ -24,9 +28,13 @@
 //!    ε = (A_f/B_f)(A_s/B_s)β (Sec. 3.2).
 //! 3. **Resolve** (`wedges_resolve`): visibility = 1 − occluded share.
 //!
-//! No CPU work per frame depends on the triangle count.
+//! No CPU work per frame depends on the triangle count. Everything is sized
+//! and checked against the device's limits before anything is allocated
+//! ([`AllocationPlan`]). `blending=none silhouette_buffers=1` is the plain
+//! penumbra wedges of Akenine-Möller and Assarsson, the paper's baseline.
 
 mod mesh;
+mod plan;
 pub mod scenes;
 
 use bytemuck::{Pod, Zeroable};
@@ -41,7 +49,8 @@ use ssm_core::{
 };
 use wgpu::util::DeviceExt;
 
-pub use mesh::{CastingMesh, EdgeRecord, FACE_TWO_SIDED, MeshReport, NO_FACE};
+pub use mesh::{CastingMesh, EdgeRecord, MeshReport, NO_FACE, TWO_SIDED_COMPONENT};
+pub use plan::{AllocationPlan, FINAL_BINDING_BYTES_PER_PIXEL, PlannedBuffer, STORAGE_BUFFERS_PER_STAGE};
 
 /// The registered name.
 pub const NAME: &str = "wedges";
@@ -80,17 +89,25 @@ const SILHOUETTE_BYTES: u32 = 7 * 16 + 4;
 pub const WEDGE_RECORD_BYTES: u64 = 96;
 /// Threads per compute workgroup (`WORKGROUP`).
 const WORKGROUP: u32 = 256;
-/// u32s of the counters (`Counters`): eight scalars and six arrays of [`MAX_SILHOUETTE_BUFFERS`].
-const COUNTER_WORDS: u64 = 8 + 6 * MAX_SILHOUETTE_BUFFERS as u64;
+/// u32s of the counters (`Counters`): eight scalars and seven arrays of [`MAX_SILHOUETTE_BUFFERS`].
+const COUNTER_WORDS: u64 = 8 + 7 * MAX_SILHOUETTE_BUFFERS as u64;
+/// The u32 where `Counters.stencil_levels` starts: after the eight scalars and six arrays.
+const STENCIL_LEVELS_WORD: usize = 8 + 6 * MAX_SILHOUETTE_BUFFERS as usize;
+/// Stencil levels: the count is 8 bits, wrapping (a point in 256 volumes of one buffer reads 0).
+const STENCIL_LEVELS: u32 = 256;
 /// u32s of the indirect arguments: two dispatches, then per group four draws.
 const INDIRECT_WORDS: u64 = 8 + 16 * MAX_SILHOUETTE_BUFFERS as u64;
-/// vec4s per pixel of the final buffer (`FINAL_STRIDE`): areas and four rectangles.
-const FINAL_STRIDE: u64 = 5;
+/// Radial parts of the light (Sec. 3.1, Fig. 6): the final buffer has one rectangle buffer per part.
+const RADIAL_PARTS: usize = 4;
 
-/// How the silhouettes' occlusions combine.
+/// How the silhouette buffers' occlusions combine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
 pub enum Blending {
-    /// Summed, each clamped to the light: the plain penumbra-wedges algorithm (Forest et al., Fig. 1(a), 2(a)).
+    /// Summed. Within a buffer every silhouette is summed, as the plain penumbra wedges sum (one
+    /// stencil test, every wedge's area added or subtracted); the buffers, each clamped to the
+    /// light, are then added. With `silhouette_buffers = 1` this is Akenine-Möller and
+    /// Assarsson's plain penumbra wedges, the paper's baseline (Forest et al., Figs. 1(a), 2(a));
+    /// with more buffers it is a per-buffer sum, not a published method.
     None,
     /// Forest et al.'s blending of overlapping penumbrae (Sec. 3.2).
     Forest,
@@ -99,10 +116,10 @@ pub enum Blending {
 /// Settings of [`PenumbraWedges`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
 pub struct WedgesSettings {
-    /// How overlapping silhouettes' occlusions combine: none (summed, the plain penumbra wedges) or forest (Sec. 3.2).
+    /// How the silhouette buffers' occlusions combine: none (summed; with silhouette_buffers=1 the plain penumbra wedges of Akenine-Möller and Assarsson, the paper's baseline; with more, each buffer clamped, then added) or forest (Forest et al.'s blending, Sec. 3.2).
     #[param(choice, default = "forest")]
     pub blending: Blending,
-    /// Silhouette buffers: the silhouette regions, ranked by their first face, go round-robin to this many buffers, each one shadow-volume, wedge and blend pass; regions sharing a buffer are summed (the paper: one buffer per silhouette).
+    /// Silhouette buffers: the silhouette regions, ranked by their first face, go round-robin to this many buffers, each one shadow-volume, wedge and blend pass; regions sharing a buffer are summed (the paper: one buffer per silhouette; 1 with blending=none: the plain penumbra wedges).
     #[param(default = 16, min = 1, max = MAX_SILHOUETTE_BUFFERS)]
     pub silhouette_buffers: u32,
 }
@@ -126,7 +143,8 @@ const NEAR_FRACTION: f32 = 1e-6;
 /// Slack of the bounding-plane rejection, a fraction of the scene's diagonal (it only lets more fragments through).
 const PLANE_TOLERANCE: f32 = 1e-5;
 /// Camera depth (NDC) the G-buffer's depth is moved by, to the surface's side facing the light, for the volumes: 16 units of 2^-24.
-const DEPTH_BIAS: f32 = 16.0 / 16_777_216.0;
+/// The wedges integrate at the point so moved along the view ray, where the stencil judged the umbra.
+pub const DEPTH_BIAS: f32 = 16.0 / 16_777_216.0;
 
 impl From<&WedgesSettings> for WedgesSettingsUniform {
     fn from(settings: &WedgesSettings) -> Self {
@@ -226,6 +244,7 @@ fn storage_entry(binding: u32, read_only: bool, visibility: wgpu::ShaderStages) 
 /// The compute passes that find the silhouettes and fill the draw lists.
 struct SilhouettePasses {
     reset: wgpu::ComputePipeline,
+    winding: wgpu::ComputePipeline,
     classify_faces: wgpu::ComputePipeline,
     hook: wgpu::ComputePipeline,
     jump: wgpu::ComputePipeline,
@@ -254,6 +273,8 @@ struct MeshPasses {
     wedge_pipeline: wgpu::RenderPipeline,
     counters: wgpu::Buffer,
     half_edges: wgpu::Buffer,
+    /// Per closed component, its winding number around the light's centre (cleared per light).
+    winding: wgpu::Buffer,
     report: MeshReport,
 }
 
@@ -272,7 +293,11 @@ pub struct PenumbraWedges {
     blend_group: wgpu::BindGroup,
     gbuffer_group: wgpu::BindGroup,
     resolve: ScreenPass,
-    final_buffer: wgpu::Buffer,
+    /// The final buffer (Sec. 3.2): per pixel, the four radial parts' occluded areas ...
+    final_areas: wgpu::Buffer,
+    /// ... and each part's bounding rectangle, one buffer per part (16 bytes per pixel each, so
+    /// that every binding stays under the storage binding limit: [`AllocationPlan`]).
+    final_rectangles: [wgpu::Buffer; RADIAL_PARTS],
     fragment_counts: wgpu::Buffer,
     passes_issued: u32,
     pixels: u64,
@@ -282,20 +307,26 @@ impl PenumbraWedges {
     /// Prepares the casting mesh (once: welding, records, the two-sided rule), uploads it, and builds every pipeline.
     ///
     /// # Errors
-    /// A parameter or GPU error; [`Error::LimitTooLow`] when the device cannot hold the silhouette
-    /// buffer's eight float targets or the worst-case silhouette list.
+    /// A parameter or GPU error; [`Error::LimitTooLow`], before anything is allocated, when the
+    /// device's limits cannot hold what [`AllocationPlan`] sizes for this view and mesh.
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = WedgesSettings::from_params(setup.params)?;
         let gpu = setup.gpu;
         let device = &gpu.device;
-        check_limits(gpu)?;
         let (width, height) = (setup.scene.width, setup.scene.height);
         let pixels = u64::from(width) * u64::from(height);
-        let settings_buffer = uniform_buffer(device, "wedges_settings_uniform", &WedgesSettingsUniform::from(&settings));
         let gbuffer = setup.shared.gbuffer(NAME)?;
+        // Everything is sized first and checked against the device's limits, before any allocation.
+        let casting = CastingMesh::prepare(setup.shared.adjacency(NAME)?);
+        let casting = (!casting.faces.is_empty()).then_some(casting);
+        AllocationPlan::new(width, height, casting.as_ref()).check(&device.limits())?;
+        let settings_buffer = uniform_buffer(device, "wedges_settings_uniform", &WedgesSettingsUniform::from(&settings));
 
         let indirect = storage(device, "wedges_indirect_arguments", INDIRECT_WORDS * 4, wgpu::BufferUsages::INDIRECT);
-        let final_buffer = storage(device, "wedges_final_buffer", pixels * FINAL_STRIDE * 16, wgpu::BufferUsages::COPY_DST);
+        let final_size = pixels * FINAL_BINDING_BYTES_PER_PIXEL;
+        let final_areas = storage(device, "wedges_final_areas", final_size, wgpu::BufferUsages::COPY_DST);
+        let final_rectangles =
+            [0, 1, 2, 3].map(|part| storage(device, &format!("wedges_final_rectangles_{part}"), final_size, wgpu::BufferUsages::COPY_DST));
         let fragment_counts =
             storage(device, "wedges_fragment_counts", pixels * 4, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC);
 
@@ -314,10 +345,11 @@ impl PenumbraWedges {
         let umbra_mask_view = labelled_view(&umbra_mask, "wedges_umbra_mask");
         let blend_layout = blend_layout(device);
         let mut blend_resources: Vec<wgpu::BindingResource<'_>> = silhouette_views.iter().map(wgpu::BindingResource::TextureView).collect();
-        blend_resources.push(final_buffer.as_entire_binding());
+        blend_resources.push(final_areas.as_entire_binding());
         blend_resources.push(settings_buffer.as_entire_binding());
         blend_resources.push(wgpu::BindingResource::TextureView(&umbra_mask_view));
         blend_resources.push(fragment_counts.as_entire_binding());
+        blend_resources.extend(final_rectangles.iter().map(wgpu::Buffer::as_entire_binding));
         let blend_group = bind_group(device, "wedges_blend_bind_group", &blend_layout, &blend_resources);
         let blend_module = create_shader_with_imports(gpu, "wedges_blend_shader", BLEND_SHADER, LOCAL_SHADERS)?;
         let blend_pipeline = compute_pipeline(
@@ -339,13 +371,12 @@ impl PenumbraWedges {
             &[],
         )?;
 
-        let adjacency = setup.shared.adjacency(NAME)?;
-        let casting = CastingMesh::prepare(adjacency);
-        let mesh = if casting.faces.is_empty() {
-            None
-        } else {
-            let uniform = WedgesMeshUniform::new(&casting, (width, height), &setup.scene.bounds);
-            Some(MeshPasses::new(setup, &casting, uniform, (&settings_buffer, &indirect))?)
+        let mesh = match &casting {
+            Some(casting) => {
+                let uniform = WedgesMeshUniform::new(casting, (width, height), &setup.scene.bounds);
+                Some(MeshPasses::new(setup, casting, uniform, (&settings_buffer, &indirect))?)
+            }
+            None => None,
         };
         Ok(Self {
             settings,
@@ -361,7 +392,8 @@ impl PenumbraWedges {
             blend_group,
             gbuffer_group: gbuffer.bind_group.clone(),
             resolve,
-            final_buffer,
+            final_areas,
+            final_rectangles,
             fragment_counts,
             passes_issued: 0,
             pixels,
@@ -373,23 +405,6 @@ impl PenumbraWedges {
     pub fn mesh_report(&self) -> Option<MeshReport> {
         self.mesh.as_ref().map(|m| m.report)
     }
-}
-
-/// The silhouette buffer's eight targets must fit one pass.
-fn check_limits(gpu: &GpuContext) -> Result<()> {
-    let limits = gpu.device.limits();
-    let bytes = SILHOUETTE_BYTES;
-    if limits.max_color_attachments < SILHOUETTE_TARGETS as u32 || limits.max_color_attachment_bytes_per_sample < bytes {
-        return Err(Error::LimitTooLow {
-            technique: NAME.into(),
-            what: format!("{SILHOUETTE_TARGETS} float colour targets ({bytes} bytes per sample) for the silhouette buffer"),
-            allowed: format!(
-                "{} targets and {} bytes per sample",
-                limits.max_color_attachments, limits.max_color_attachment_bytes_per_sample
-            ),
-        });
-    }
-    Ok(())
 }
 
 fn depth_copy(
@@ -468,10 +483,12 @@ fn depth_copy(
 
 fn blend_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..SILHOUETTE_TARGETS as u32).map(texture_entry).collect();
-    entries.push(storage_entry(SILHOUETTE_TARGETS as u32, false, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE));
-    entries.push(uniform_entry(SILHOUETTE_TARGETS as u32 + 1));
-    entries.push(texture_entry(SILHOUETTE_TARGETS as u32 + 2));
-    entries.push(storage_entry(SILHOUETTE_TARGETS as u32 + 3, false, wgpu::ShaderStages::COMPUTE));
+    let areas = SILHOUETTE_TARGETS as u32;
+    entries.push(storage_entry(areas, false, wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE));
+    entries.push(uniform_entry(areas + 1));
+    entries.push(texture_entry(areas + 2));
+    entries.push(storage_entry(areas + 3, false, wgpu::ShaderStages::COMPUTE));
+    entries.extend((0..RADIAL_PARTS as u32).map(|part| storage_entry(areas + 4 + part, false, wgpu::ShaderStages::COMPUTE)));
     bind_group_layout(device, "wedges_blend_layout", &entries)
 }
 
@@ -525,19 +542,6 @@ impl MeshPasses {
         let device = &gpu.device;
         let face_count = u64::from(uniform.face_count);
         let half_edge_bytes = u64::from(casting.half_edge_capacity) * WEDGE_RECORD_BYTES;
-        let allowed = device.limits().max_storage_buffer_binding_size;
-        if half_edge_bytes > allowed {
-            return Err(Error::LimitTooLow {
-                technique: NAME.into(),
-                what: format!(
-                    "a silhouette list of {} MiB for the worst case of {} half-edges ({} casting triangles)",
-                    half_edge_bytes >> 20,
-                    casting.half_edge_capacity,
-                    casting.faces.len()
-                ),
-                allowed: format!("storage bindings of {} MiB", allowed >> 20),
-            });
-        }
         let mesh_uniform = uniform_buffer(device, "wedges_mesh_uniform", &uniform);
         let positions = storage_init(device, "wedges_positions", &casting.positions, wgpu::BufferUsages::empty());
         let faces = storage_init(device, "wedges_faces", &casting.faces, wgpu::BufferUsages::empty());
@@ -549,11 +553,15 @@ impl MeshPasses {
         let counters = storage(device, "wedges_counters", COUNTER_WORDS * 4, wgpu::BufferUsages::COPY_SRC);
         let half_edges = storage(device, "wedges_half_edges", half_edge_bytes, wgpu::BufferUsages::COPY_SRC);
         let caps = storage(device, "wedges_cap_faces", face_count * 4, wgpu::BufferUsages::empty());
+        let winding =
+            storage(device, "wedges_component_winding", casting.report.closed_components() as u64 * 4, wgpu::BufferUsages::COPY_DST);
+        let component_convex = storage_init(device, "wedges_component_convex", &casting.closed_convex, wgpu::BufferUsages::empty());
 
         let compute = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![uniform_entry(0), uniform_entry(1)];
         entries.extend((2..5).map(|b| storage_entry(b, true, compute)));
-        entries.extend((5..12).map(|b| storage_entry(b, false, compute)));
+        entries.extend((5..13).map(|b| storage_entry(b, false, compute)));
+        entries.push(storage_entry(13, true, compute));
         let mesh_layout = bind_group_layout(device, "wedges_silhouettes_layout", &entries);
         let mesh_group = bind_group(
             device,
@@ -572,6 +580,8 @@ impl MeshPasses {
                 counters.as_entire_binding(),
                 half_edges.as_entire_binding(),
                 caps.as_entire_binding(),
+                winding.as_entire_binding(),
+                component_convex.as_entire_binding(),
             ],
         );
         let indirect_layout = bind_group_layout(device, "wedges_indirect_layout", &[storage_entry(0, false, compute)]);
@@ -585,6 +595,7 @@ impl MeshPasses {
         };
         let silhouettes = SilhouettePasses {
             reset: pipeline("wedges_reset", &writes_arguments),
+            winding: pipeline("wedges_winding", &plain),
             classify_faces: pipeline("wedges_classify_faces", &plain),
             hook: pipeline("wedges_hook", &plain),
             jump: pipeline("wedges_jump", &plain),
@@ -643,6 +654,7 @@ impl MeshPasses {
             wedge_pipeline,
             counters,
             half_edges,
+            winding,
             report: casting.report,
         })
     }
@@ -751,6 +763,7 @@ impl MeshPasses {
     /// Every dispatch of the silhouette step, in one timed compute pass.
     fn encode_silhouettes(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup, indirect: &wgpu::Buffer) {
         let s = &self.silhouettes;
+        frame.clear_buffer("wedges_component_winding_clear", &self.winding, 0, None);
         let mut pass = frame.compute_pass("wedges_silhouettes");
         pass.set_bind_group(0, light_frame, &[]);
         pass.set_bind_group(1, &s.mesh_group, &[]);
@@ -760,6 +773,8 @@ impl MeshPasses {
             pass.dispatch_workgroups(1, 1, 1);
         };
         single(&mut pass, &s.reset);
+        pass.set_pipeline(&s.winding);
+        pass.dispatch_workgroups(self.face_workgroups, 1, 1);
         pass.set_pipeline(&s.classify_faces);
         pass.dispatch_workgroups(self.face_workgroups, 1, 1);
         for _ in 0..MAX_LABEL_ROUNDS {
@@ -815,7 +830,10 @@ impl ShadowTechnique for PenumbraWedges {
             pass.draw(0..3, 0..1);
             self.passes_issued += 1;
         }
-        frame.clear_buffer("wedges_final_clear", &self.final_buffer, 0, None);
+        frame.clear_buffer("wedges_final_areas_clear", &self.final_areas, 0, None);
+        for rectangles in &self.final_rectangles {
+            frame.clear_buffer("wedges_final_rectangles_clear", rectangles, 0, None);
+        }
         frame.clear_buffer("wedges_fragment_counts_clear", &self.fragment_counts, 0, None);
         if let Some(mesh) = &self.mesh {
             for group in 0..self.settings.silhouette_buffers.clamp(1, MAX_SILHOUETTE_BUFFERS) {
@@ -839,7 +857,16 @@ impl ShadowTechnique for PenumbraWedges {
             out.push(("silhouette_regions".to_owned(), f64::from(word(&counters, 2))));
             out.push(("cap_faces".to_owned(), f64::from(word(&counters, 4))));
             out.push(("fallback_wedges".to_owned(), f64::from(word(&counters, 5))));
-            out.push(("label_rounds".to_owned(), f64::from(word(&counters, 1))));
+            let rounds = word(&counters, 1);
+            out.push(("label_rounds".to_owned(), f64::from(rounds)));
+            // Every recorded round linked labels: the last may not have been the last needed, and
+            // a region left split has silhouette edges (and wedges) inside it.
+            out.push(("label_rounds_capped".to_owned(), f64::from(u8::from(rounds >= MAX_LABEL_ROUNDS))));
+            // A bound on any point's stencil count (`Counters.stencil_levels`); past 255 the 8-bit
+            // count may wrap to 0 (lit).
+            let levels = (0..MAX_SILHOUETTE_BUFFERS as usize).map(|g| word(&counters, STENCIL_LEVELS_WORD + g)).max().unwrap_or(0);
+            out.push(("stencil_levels_bound".to_owned(), f64::from(levels)));
+            out.push(("stencil_may_wrap".to_owned(), f64::from(u8::from(levels >= STENCIL_LEVELS))));
             out.push(("silhouette_buffers_used".to_owned(), f64::from(word(&counters, 6))));
             if let Some(loops) = silhouette_loops(gpu, &mesh.half_edges, half_edges) {
                 out.push(("silhouette_loops".to_owned(), loops as f64));
@@ -999,9 +1026,9 @@ pub const FIG25_SCENES: &[&str] = &[
 const PRESETS: &[Preset] = &[
     Preset {
         name: "wedges-fig1",
-        summary: "Forest et al., Figs. 1 and 2: plain penumbra wedges (blending=none) against the blending (forest), on sphere-cube; read mean_signed_error in sweep.csv (negative: over-darkened)",
+        summary: "Forest et al., Figs. 1 and 2: the plain penumbra wedges (blending=none, one silhouette buffer) against the blending (forest, 16 buffers), on sphere-cube; read mae_penumbra and mean_signed_error in sweep.csv",
         scenes: &["sphere-cube"],
-        varies: &["wedges.blending=none,forest"],
+        varies: &["wedges.blending:silhouette_buffers=none:1,forest:16"],
         ..Preset::DEFAULT
     },
     Preset {
@@ -1014,9 +1041,9 @@ const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "wedges-fig12",
-        summary: "Forest et al., Fig. 12: frame time of none and forest; one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles)",
+        summary: "Forest et al., Fig. 12: frame time of the plain penumbra wedges (blending=none, one silhouette buffer) and of the blending (forest, 16 buffers); one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles)",
         scenes: FIG12_SCENES,
-        varies: &["wedges.blending=none,forest"],
+        varies: &["wedges.blending:silhouette_buffers=none:1,forest:16"],
         y_axis: "time",
         ..Preset::DEFAULT
     },
@@ -1032,7 +1059,7 @@ const PRESETS: &[Preset] = &[
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
-    summary: "penumbra wedges (soft shadow volumes) with GPU silhouettes and z-fail umbra; blending=forest blends overlapping penumbrae",
+    summary: "penumbra wedges (soft shadow volumes) with GPU silhouettes and z-fail umbra; blending=forest blends overlapping penumbrae, blending=none silhouette_buffers=1 is the plain penumbra wedges",
     paper: "Forest, Barthe and Paulin 2006, Realistic soft shadows by penumbra-wedges blending (Graphics Hardware); Akenine-Möller and Assarsson 2002; Assarsson and Akenine-Möller 2003",
     kind: TechniqueKind::Realtime,
     params: WedgesSettings::PARAMS,

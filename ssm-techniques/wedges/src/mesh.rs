@@ -13,6 +13,18 @@
 //! is exactly the number of prisms (or closed volumes) a point is in, so no
 //! input leaks light; a two-sided closed surface would be counted twice in
 //! the penumbra, which is why closed components stay one-sided.
+//!
+//! **A closed component around the light.** Which faces of a closed component
+//! bound its volume depends on which side of it the light is, so that is
+//! decided on the GPU every frame from the component's winding number around
+//! the light's centre (`wedges_winding`); each face therefore carries its
+//! closed component's index.
+//!
+//! **Convex closed components.** A closed component whose every edge is
+//! convex bounds a convex solid (when it does not cross itself), which a ray
+//! from the light enters or leaves once: it adds at most one to a point's
+//! stencil count, whatever its face count. That bounds the count
+//! (`stencil_levels_bound`) far more tightly than the faces do.
 
 use std::collections::HashMap;
 
@@ -21,8 +33,9 @@ use ssm_scene::Adjacency;
 /// No second face: [`EdgeRecord::face_b`] of an incidence recorded alone.
 pub const NO_FACE: u32 = u32::MAX;
 
-/// Face flag (`faces[f].flags`): the face's component is two-sided.
-pub const FACE_TWO_SIDED: u32 = 1;
+/// The component of a face whose connected component is two-sided (`faces[f][3]`; a closed
+/// component's faces hold its index there instead).
+pub const TWO_SIDED_COMPONENT: u32 = u32::MAX;
 
 /// One edge incidence as `shaders/wedges/wedges_common.wgsl` reads it (`EdgeRecord`):
 /// `v0 -> v1` as `face_a` winds it; `face_b`, when not [`NO_FACE`], winds it `v1 -> v0`.
@@ -56,6 +69,16 @@ pub struct MeshReport {
     pub components: usize,
     /// Components treated as two-sided (the rule above).
     pub two_sided_components: usize,
+    /// Closed components whose every edge is convex.
+    pub convex_components: usize,
+}
+
+impl MeshReport {
+    /// Closed components: the winding numbers computed per light and frame.
+    #[must_use]
+    pub fn closed_components(&self) -> usize {
+        self.components - self.two_sided_components
+    }
 }
 
 /// The casting mesh, ready to upload.
@@ -63,10 +86,13 @@ pub struct MeshReport {
 pub struct CastingMesh {
     /// Welded world-space positions (w = 1).
     pub positions: Vec<[f32; 4]>,
-    /// Per face: three welded vertex ids and flags ([`FACE_TWO_SIDED`]).
+    /// Per face: three welded vertex ids, and the index of its closed component (0 to
+    /// [`MeshReport::closed_components`] − 1, in order of first face), or [`TWO_SIDED_COMPONENT`].
     pub faces: Vec<[u32; 4]>,
     /// Edge incidences: paired where the edge is manifold and consistently wound, else one per face.
     pub records: Vec<EdgeRecord>,
+    /// Per closed component (by its index in `faces`): 1 when every edge of it is convex, else 0.
+    pub closed_convex: Vec<u32>,
     /// The most silhouette half-edges one frame can emit: two per paired record, one per single.
     pub half_edge_capacity: u32,
     /// What was found.
@@ -166,22 +192,56 @@ impl CastingMesh {
         let mut two_sided_roots: Vec<u32> = irregular_faces.iter().map(|f| components.find(*f)).collect();
         two_sided_roots.sort_unstable();
         two_sided_roots.dedup();
-        let mut roots: Vec<u32> = (0..face_count as u32).map(|f| components.find(f)).collect();
-        let faces = adjacency
+        // Closed components numbered densely in order of their first face.
+        let mut closed_index: HashMap<u32, u32> = HashMap::new();
+        let faces: Vec<[u32; 4]> = adjacency
             .triangles
             .iter()
-            .zip(&roots)
-            .map(|(t, root)| {
-                let flags = if two_sided_roots.binary_search(root).is_ok() { FACE_TWO_SIDED } else { 0 };
-                [t[0], t[1], t[2], flags]
+            .enumerate()
+            .map(|(face, t)| {
+                let root = components.find(face as u32);
+                let component = if two_sided_roots.binary_search(&root).is_ok() {
+                    TWO_SIDED_COMPONENT
+                } else {
+                    let next = closed_index.len() as u32;
+                    *closed_index.entry(root).or_insert(next)
+                };
+                [t[0], t[1], t[2], component]
             })
             .collect();
-        roots.sort_unstable();
-        roots.dedup();
-        report.components = roots.len();
         report.two_sided_components = two_sided_roots.len();
-        Self { positions, faces, records, half_edge_capacity: u32::try_from(half_edge_capacity).unwrap_or(u32::MAX), report }
+        report.components = closed_index.len() + two_sided_roots.len();
+        let closed_convex = convex_components(adjacency, &faces, &records, closed_index.len());
+        report.convex_components = closed_convex.iter().filter(|c| **c == 1).count();
+        Self { positions, faces, records, closed_convex, half_edge_capacity: u32::try_from(half_edge_capacity).unwrap_or(u32::MAX), report }
     }
+}
+
+/// Per closed component: 1 when every one of its (paired) edges is convex, that is when each face's
+/// third corner lies on or behind the other face's plane, within a rounding of its size.
+fn convex_components(adjacency: &Adjacency, faces: &[[u32; 4]], records: &[EdgeRecord], closed: usize) -> Vec<u32> {
+    let mut convex = vec![1u32; closed];
+    let position = |v: u32| adjacency.welded_positions[v as usize];
+    let third = |face: &[u32; 4], a: u32, b: u32| face[..3].iter().copied().find(|v| *v != a && *v != b);
+    for record in records {
+        let (Some(face_a), Some(face_b)) = (faces.get(record.face_a as usize), faces.get(record.face_b as usize)) else { continue };
+        let component = face_a[3];
+        if component == TWO_SIDED_COMPONENT {
+            continue;
+        }
+        let (Some(opposite_a), Some(opposite_b)) = (third(face_a, record.v0, record.v1), third(face_b, record.v0, record.v1)) else {
+            continue;
+        };
+        let (p0, p1, pa) = (position(record.v0), position(record.v1), position(opposite_a));
+        // face_a winds v0 -> v1 -> opposite_a: its outward normal.
+        let normal = (p1 - p0).cross(pa - p0);
+        let q = position(opposite_b) - p0;
+        let size = (p1 - p0).length().max((pa - p0).length()).max(q.length());
+        if normal.dot(q) > 1e-5 * normal.length() * size {
+            convex[component as usize] = 0;
+        }
+    }
+    convex
 }
 
 #[cfg(test)]
@@ -204,7 +264,7 @@ mod tests {
         assert_eq!(ball.report.two_sided_components, 0);
         assert_eq!(ball.report.components, 1);
         assert!(ball.records.iter().all(|r| r.face_b != NO_FACE));
-        assert!(ball.faces.iter().all(|f| f[3] == 0));
+        assert!(ball.faces.iter().all(|f| f[3] == 0), "one closed component, index 0");
         assert_eq!(ball.records.len() * 3, ball.faces.len() * 3 * 3 / 2, "E = 3F/2");
         let cube = prepared(&cuboid("c", Vec3::ONE));
         assert_eq!((cube.report.components, cube.report.two_sided_components), (1, 0));
@@ -214,7 +274,7 @@ mod tests {
     fn an_open_mesh_is_two_sided() {
         let quad = prepared(&plane("p", Vec2::ONE));
         assert_eq!((quad.report.open_edges, quad.report.two_sided_components), (4, 1));
-        assert!(quad.faces.iter().all(|f| f[3] == FACE_TWO_SIDED));
+        assert!(quad.faces.iter().all(|f| f[3] == TWO_SIDED_COMPONENT));
         // The diagonal is paired, the four borders are single.
         assert_eq!(quad.records.iter().filter(|r| r.face_b == NO_FACE).count(), 4);
         assert_eq!(quad.half_edge_capacity, 2 + 4);
@@ -243,7 +303,47 @@ mod tests {
         indices.extend(quad.indices.iter().map(|i| i + offset));
         let both = prepared(&Mesh::with_generated_normals("both", positions, indices));
         assert_eq!((both.report.components, both.report.two_sided_components), (2, 1));
-        assert_eq!(both.faces.iter().filter(|f| f[3] == FACE_TWO_SIDED).count(), 2);
+        assert_eq!(both.faces.iter().filter(|f| f[3] == TWO_SIDED_COMPONENT).count(), 2);
+        assert!(both.faces.iter().filter(|f| f[3] != TWO_SIDED_COMPONENT).all(|f| f[3] == 0));
+        assert_eq!(both.report.closed_components(), 1);
+    }
+
+    #[test]
+    fn closed_components_are_numbered_densely_in_order_of_their_first_face() {
+        // A quad (two-sided), then two cubes: the cubes are closed components 0 and 1.
+        let parts = [plane("p", Vec2::ONE), cuboid("a", Vec3::ONE), cuboid("b", Vec3::ONE)];
+        let (mut positions, mut indices) = (Vec::new(), Vec::new());
+        for (k, part) in parts.iter().enumerate() {
+            let offset = positions.len() as u32;
+            positions.extend(part.positions.iter().map(|p| *p + Vec3::new(3.0 * k as f32, 0.0, 0.0)));
+            indices.extend(part.indices.iter().map(|i| i + offset));
+        }
+        let mesh = prepared(&Mesh::with_generated_normals("three", positions, indices));
+        let components: Vec<u32> = mesh.faces.iter().map(|f| f[3]).collect();
+        assert_eq!(components[..2], [TWO_SIDED_COMPONENT; 2]);
+        assert!(components[2..14].iter().all(|c| *c == 0) && components[14..].iter().all(|c| *c == 1), "{components:?}");
+        assert_eq!(mesh.report.closed_components(), 2);
+    }
+
+    #[test]
+    fn spheres_and_boxes_are_convex_an_l_shaped_prism_is_not() {
+        assert_eq!(prepared(&sphere("s", 1.0, 12, 6)).closed_convex, vec![1]);
+        assert_eq!(prepared(&cuboid("c", Vec3::ONE)).closed_convex, vec![1]);
+        // An L-shaped prism: one re-entrant edge.
+        let outline = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)];
+        let mut positions: Vec<Vec3> = outline.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
+        positions.extend(outline.iter().map(|&(x, z)| Vec3::new(x, 1.0, z)));
+        // Bottom and top fans from corner 0, then the walls.
+        let mut indices = vec![0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5];
+        indices.extend([6, 8, 7, 6, 9, 8, 6, 10, 9, 6, 11, 10]);
+        for k in 0..6u32 {
+            let n = (k + 1) % 6;
+            indices.extend([k, n + 6, n, k, k + 6, n + 6]);
+        }
+        let l = prepared(&Mesh::with_generated_normals("l", positions, indices));
+        assert_eq!((l.report.components, l.report.two_sided_components), (1, 0), "{:?}", l.report);
+        assert_eq!(l.closed_convex, vec![0]);
+        assert_eq!(l.report.convex_components, 0);
     }
 
     #[test]
