@@ -20,6 +20,10 @@ struct TileSettings {
 @group(2) @binding(2) var<storage, read> kernels: array<Kernel>;
 // Per pixel: (Σ c·o, Σ c).
 @group(2) @binding(3) var<storage, read_write> accumulated: array<vec2<f32>>;
+// Per pixel: 1 once its filter was decimated in some tile (cleared per light).
+@group(2) @binding(4) var<storage, read_write> decimated: array<u32>;
+// COUNTER_* of pvsm_common.wgsl (the resolve pass adds the decimated and uncovered pixels).
+@group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
 
@@ -27,29 +31,38 @@ struct TileSettings {
 // standing for a k×k block (the fixed-resolution mode and huge lights).
 const MAX_TEXELS_PER_AXIS: f32 = 96.0;
 
-// Σ c·o and Σ c of the filter (u, v_height) centred on `centre` (shadow-map coordinates) over this
-// tile, for a receiver at light depth `depth` with tangent plane (`position`, `normal`). With
-// settings.predicted_stride, a tile finer than the pixel's predicted texel size `predicted` (a
-// neighbour in the tile needed more) is read at every k-th texel, k the ratio: the prediction says
-// that many texels suffice, and a pixel's cost stays about ρ² whatever the tile's resolution.
-fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec2<f32> {
+// Smallest half-axis of a filter, in texels of the tile (see integrate).
+const MIN_HALF_TEXELS: f32 = 1e-3;
+
+// (Σ c·o, Σ c, decimated) of the filter (u, v_height) centred on `centre` (shadow-map
+// coordinates) over this tile (decimated: 1 when the filter spans more than MAX_TEXELS_PER_AXIS
+// texels and is read at every k-th), for a receiver at light depth `depth` with tangent plane
+// (`position`, `normal`). With settings.predicted_stride, a tile finer than the pixel's predicted
+// texel size `predicted` (a neighbour in the tile needed more) is read at every k-th texel, k the
+// ratio: the prediction says that many texels suffice, and a pixel's cost stays about ρ² whatever
+// the tile's resolution.
+fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec3<f32> {
     let extent = tile.uv_max - tile.uv_min;
     let scale = tile.size / extent;
-    // The filter in the tile's texel units, never narrower than one texel: a filter of zero size
-    // (no penumbra, and antialiasing off so that no pixel footprint widens it) is the hard shadow
-    // test of the texel under the point, not an empty integral.
+    // The filter in the tile's texel units. A filter narrower than a texel weighs the texels under
+    // it by area (Eq. 2), which tends to the texel under the point as it shrinks: the hard shadow
+    // test. Its half-axes are floored at MIN_HALF_TEXELS only so that a filter of zero size (a
+    // point light with antialiasing off) is that test, not an empty integral; a floor of half a
+    // texel made it a one-texel box centred on the point, which blurs a hard edge over a texel.
+    // Point samples (classic PCF) need a texel centre inside: a filter at least one texel wide.
+    let floor_half = select(MIN_HALF_TEXELS, 0.5, settings.point_samples != 0u);
     let c = (centre - tile.uv_min) * scale;
-    let ux = max(abs(u.x) * scale.x, 0.5);
+    let ux = max(abs(u.x) * scale.x, floor_half);
     let uy = select(u.y, -u.y, u.x < 0.0) * scale.y;
-    let vy = max(v_height * scale.y, 0.5);
+    let vy = max(v_height * scale.y, floor_half);
     let x_low = max(c.x - ux, 0.0);
     let x_high = min(c.x + ux, tile.size.x);
     let reach_y = abs(uy) + vy;
     if (x_low >= x_high || c.y + reach_y <= 0.0 || c.y - reach_y >= tile.size.y) {
-        return vec2<f32>(0.0);
+        return vec3<f32>(0.0);
     }
-    let stride = select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u);
-    let step = max(max(vec2<f32>(1.0), stride), ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
+    let stride = max(vec2<f32>(1.0), select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u));
+    let step = max(stride, ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
     let slope = select(0.0, uy / ux, ux > 1e-6);
     // What each texel is compared with (the settings' receiver model), prepared once.
     let receiver = receiver_tap_plane(frame, position, normal, depth, settings.receiver_plane != 0u);
@@ -98,7 +111,7 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
     }
     // In shadow-map coordinates, not texels: tiles of different resolutions merge by true area.
     let texel_area = 1.0 / (scale.x * scale.y);
-    return vec2<f32>(visible, covered) * texel_area;
+    return vec3<f32>(vec2<f32>(visible, covered) * texel_area, select(0.0, 1.0, any(step > stride)));
 }
 
 @compute @workgroup_size(8, 8)
@@ -114,20 +127,29 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let point = screen_point_at(vec2<i32>(id.xy));
     // The normal offset, in this tile's texels at the pixel's depth (a coarser predicted texel would
-    // move the point past nearby occluders), within the kernel's bound.
-    let tile_texel = (tile.uv_max - tile.uv_min) / tile.size;
-    let world_texel = 2.0 * kernel.depth * max(frame.projection.x * tile_texel.x, frame.projection.y * tile_texel.y);
+    // move the point past nearby occluders), within the kernel's bound. A tile's texels can be far
+    // longer along one axis than the other (Eq. 5 per axis). Compared with the receiver's tangent
+    // plane, a texel's depth differs from the plane's only by the surface's curvature, and the
+    // finer side is offset enough; an offset of the longer side moved the lookup across narrow
+    // penumbrae along the finer axis (thin bars' shadows shifted by half their width). Compared with
+    // the receiver's own depth, the longer side's slope needs the longer side's offset.
+    let tile_texel = 2.0 * kernel.depth * frame.projection.xy * (tile.uv_max - tile.uv_min) / tile.size;
+    let world_texel = select(max(tile_texel.x, tile_texel.y), min(tile_texel.x, tile_texel.y), settings.receiver_plane != 0u);
     let offset = min(settings.normal_offset * world_texel, kernel.offset);
     let k = max(settings.supersampling, 1u);
     if (k == 1u) {
         let lookup = offset_point(point.position, point.normal, offset);
         let uvd = light_uv_depth(frame, lookup);
-        accumulated[index] += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, lookup, point.normal, kernel.texel);
+        let sums = integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, lookup, point.normal, kernel.texel);
+        accumulated[index] += sums.xy;
+        if (sums.z > 0.0) {
+            decimated[index] = 1u;
+        }
         return;
     }
     // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
     // each filtered on its own; their sums add up, as their filters have the same area.
-    var sum = vec2<f32>(0.0);
+    var sum = vec3<f32>(0.0);
     for (var j = 0u; j < k; j++) {
         for (var i = 0u; i < k; i++) {
             let pixel = vec2<f32>(id.xy) + (vec2<f32>(f32(i), f32(j)) + 0.5) / f32(k);
@@ -140,7 +162,10 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
             sum += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, sub_lookup, point.normal, kernel.texel);
         }
     }
-    accumulated[index] += sum;
+    accumulated[index] += sum.xy;
+    if (sum.z > 0.0) {
+        decimated[index] = 1u;
+    }
 }
 
 // The final visibility (Sec. 5.2's merge: V = Σ V·A / Σ A) into the framework's target.
@@ -159,8 +184,16 @@ fn pvsm_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         value = 0.0;
     } else if (kernel.flags == KERNEL_ACTIVE) {
         let sums = accumulated[index];
-        // No tile under the filter at all cannot happen with a complete tiling; lit is the safe reading.
+        // No tile under the filter. Every grid cell a filter can read asks for a tile, so this is a
+        // lookup point that the normal offset moved into a cell no pixel asked for, or one outside
+        // the light frame. Read as lit, and counted (pvsm_uncovered_pixels).
         value = select(1.0, clamp(sums.x / sums.y, 0.0, 1.0), sums.y > 0.0);
+        if (sums.y <= 0.0) {
+            atomicAdd(&counters[COUNTER_UNCOVERED], 1u);
+        }
+        if (decimated[index] != 0u) {
+            atomicAdd(&counters[COUNTER_DECIMATED], 1u);
+        }
     }
     textureStore(visibility, vec2<i32>(id.xy), vec4<f32>(value));
 }

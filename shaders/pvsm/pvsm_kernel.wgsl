@@ -6,7 +6,8 @@
 //   coordinates;
 // - the pixel's footprint φ warped onto the map through the receiver's tangent plane, and the
 //   anti-aliased filter h = M(φ) ⊗ s_α (the appendix's Gaussian convolution);
-// - the screen sizes n0, n1 of h along the map's axes (Eq. 4), the predicted texel sizes (Eq. 5),
+// - the screen sizes n0, n1 of h along the map's axes (Eq. 4), the predicted texel sizes (Eq. 5;
+//   without antialiasing also bounded for a point sample, pvsm_common.wgsl's predicted_texels),
 //   and the resolution they ask of every tile-grid cell the filter reads (the grid keeps the
 //   finest: the maximum of texels per unit, by atomicMax on the float's bits).
 
@@ -16,8 +17,8 @@
 @group(2) @binding(3) var<storage, read_write> kernels: array<Kernel>;
 // Per grid cell, the finest resolution needed along u then v, as f32 bits (0: none).
 @group(2) @binding(4) var<storage, read_write> grid: array<atomic<u32>>;
-// [pixels with a filter, fully lit pixels]
-@group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, 2>;
+// COUNTER_* of pvsm_common.wgsl.
+@group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
 
 // How much the pixel's tangent plane's depth changes over `half_texel` (shadow-map coordinates)
 // along both axes: the receiver's own depth spread within a texel of that size.
@@ -90,7 +91,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     // light. The frame's near plane would be looser, and unbounded where the frame fit clips the
     // scene's box at the light's plane (near ≈ 0: the whole map, then read at its 1×1 level). 2%
     // nearer, as the frame's own near plane, so that a pixel whose light only grazes an occluder's
-    // edge still finds it (parallel-square's penumbra error rises from 0.018 to 0.021 without it).
+    // edge still finds it (the parallel-square test's penumbra error rises from 0.0175 to 0.0197
+    // without it).
     let nearest = textureLoad(low_res_map, vec2<i32>(0), i32(levels - 1u)).x;
     let search = light_half_extent_uv(frame, clamp(0.98 * nearest, frame.projection.z, d), d);
     let n = max(settings.blocker_kernel, 1u);
@@ -171,7 +173,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         // The conservative map guarantees no occluder was missed: fully lit (Sec. 5.2).
         kernel.flags = KERNEL_LIT;
         kernels[index] = kernel;
-        atomicAdd(&counters[1], 1u);
+        atomicAdd(&counters[COUNTER_LIT], 1u);
         return;
     }
     // With prediction = fixed the pixel is still filtered (the single map decides), with no penumbra
@@ -202,21 +204,16 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         kernel.v_height = soft_filter.y;
     }
 
-    // Eq. 4: h's extents along the map's axes, in the pixel's own parametrisation (units of half a
-    // pixel per half axis: the full size in pixels).
-    let determinant = u_phi.x * v_phi.y - v_phi.x * u_phi.y;
+    // Eqs. 4 and 5 (pvsm_common.wgsl's predicted_texels): the texel size each axis needs.
     var texel_size = vec2<f32>(1.0 / settings.fixed_size);
     if (settings.prediction != 3u) {
-        var screen = vec2<f32>(1.0);
-        if (abs(determinant) > 1e-20) {
-            let inverse = mat2x2<f32>(v_phi.y, -u_phi.y, -v_phi.x, u_phi.x) * (1.0 / determinant);
-            screen = vec2<f32>(length(inverse * vec2<f32>(h.x, 0.0)), length(inverse * vec2<f32>(0.0, h.z)));
-        }
-        // Eq. 5: the texel size each axis needs, from the texels ρ says the filter must span.
-        let needed = vec2<f32>(texels_needed(settings.prediction, screen.x), texels_needed(settings.prediction, screen.y));
+        // Without antialiasing, one pixel's size at the point, in shadow-map coordinates at its depth.
+        let pixel_texel = pixel_world_size(point.position, pixel) / (2.0 * d * frame.projection.xy * settings.hard_texels);
+        let pixel_uv = select(vec2<f32>(0.0), pixel_texel, settings.antialiasing == 0u);
+        let predicted = predicted_texels(settings.prediction, h, soft_filter, u_phi, v_phi, pixel_uv);
         // No tile is coarser than MIN_TILE_SIZE texels over the whole map: a larger texel (a light
         // hidden by an occluder at its plane) would push the normal offset past the light.
-        texel_size = clamp(2.0 * vec2<f32>(h.x, h.z) / needed, vec2<f32>(1e-7), vec2<f32>(1.0 / MIN_TILE_SIZE));
+        texel_size = clamp(predicted.zw, vec2<f32>(1e-7), vec2<f32>(1.0 / MIN_TILE_SIZE));
         let resolution = 1.0 / texel_size;
         // Every grid cell the filter (and the pixel's footprint) can read asks for this resolution.
         let reach = vec2<f32>(abs(h.x) + abs(u_phi.x) + abs(v_phi.x), abs(h.y) + h.z + abs(u_phi.y) + abs(v_phi.y));
@@ -242,5 +239,5 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     kernel.blocker_depth = average;
     kernel.flags = KERNEL_ACTIVE;
     kernels[index] = kernel;
-    atomicAdd(&counters[0], 1u);
+    atomicAdd(&counters[COUNTER_FILTERED], 1u);
 }

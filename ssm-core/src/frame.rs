@@ -55,13 +55,15 @@ pub struct Frame<'a> {
     timer: &'a mut PassTimer,
     /// The debug group every pass of the technique is recorded in.
     group: String,
+    /// What the last [`Frame::read_back`] waited for the GPU, ms.
+    read_back_wait_ms: f64,
 }
 
 impl<'a> Frame<'a> {
     /// A frame for technique `group` (the debug group its passes go in).
     pub(crate) fn new(gpu: &'a GpuContext, scene: &'a GpuScene, shared: &'a SharedInputs, timer: &'a mut PassTimer, group: &str) -> Self {
         let encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{group}_frame_encoder")) });
-        Self { gpu, scene, shared, encoder, timer, group: group.to_owned() }
+        Self { gpu, scene, shared, encoder, timer, group: group.to_owned(), read_back_wait_ms: 0.0 }
     }
 
     /// Starts light `light`'s passes: clears `target` to fully lit (the
@@ -146,7 +148,8 @@ impl<'a> Frame<'a> {
     /// buffer, and recording goes on in a new encoder (PVSM's tile grid). The
     /// mapping and copy, after the submitted work has finished, are timed on
     /// the CPU under `label`: the stall's own cost. The wait for the submitted
-    /// passes is not, since their GPU time is already counted.
+    /// passes is not, since their GPU time is already counted; it is kept for
+    /// [`Frame::last_read_back_wait_ms`].
     ///
     /// # Errors
     /// [`Error::Readback`] if the GPU fails or the buffer cannot be mapped.
@@ -160,11 +163,22 @@ impl<'a> Frame<'a> {
         done.pop_debug_group();
         self.gpu.queue.submit([done.finish()]);
         self.encoder.push_debug_group(&self.group);
+        let wait = std::time::Instant::now();
         self.gpu.wait_idle().map_err(|e| Error::readback(label, crate::error::Reason(e)))?;
+        self.read_back_wait_ms = wait.elapsed().as_secs_f64() * 1e3;
         let start = std::time::Instant::now();
         let bytes = crate::readback::map_and_read(self.gpu, buffer, label)?;
         self.timer.cpu_scope(label, start.elapsed().as_secs_f64() * 1e3);
         Ok(bytes)
+    }
+
+    /// How long the last [`Frame::read_back`] waited, ms, from the submission to the GPU's idle:
+    /// the submitted passes' run (their GPU time is counted already) and the stall around it.
+    /// Not a timed scope, so that the frame's total does not count the passes twice; a technique
+    /// reports it as a diagnostic.
+    #[must_use]
+    pub fn last_read_back_wait_ms(&self) -> f64 {
+        self.read_back_wait_ms
     }
 
     /// Runs CPU work of the technique's (what its paper puts on the CPU, such

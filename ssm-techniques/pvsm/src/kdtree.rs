@@ -136,6 +136,15 @@ pub struct Tile {
     pub clamped: bool,
 }
 
+impl Tile {
+    /// Texels across the whole light frame at this tile's resolution, along its finer axis: a
+    /// single map of this side over the frame would have texels as small as this tile's.
+    #[must_use]
+    pub fn resolution(&self) -> f32 {
+        (self.size.as_vec2() / (self.uv_max - self.uv_min).max(Vec2::splat(f32::MIN_POSITIVE))).max_element()
+    }
+}
+
 /// The tiles of one frame, and whether the cap on their number was reached.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tiling {
@@ -214,6 +223,13 @@ mod tests {
         let flat: Vec<Vec2> = pyramid.levels.iter().flatten().copied().collect();
         assert_eq!(Pyramid::from_levels(8, &flat).unwrap(), pyramid);
         assert!(Pyramid::from_levels(8, &flat[..10]).is_err());
+    }
+
+    #[test]
+    fn a_tiles_resolution_is_its_finer_axis_over_the_whole_frame() {
+        // 100 texels over a quarter of the frame along u (400 across it), 50 over all of it along v.
+        let tile = Tile { uv_min: Vec2::new(0.25, 0.0), uv_max: Vec2::new(0.5, 1.0), size: UVec2::new(100, 50), clamped: false };
+        assert_eq!(tile.resolution(), 400.0);
     }
 
     #[test]

@@ -11,7 +11,9 @@
 //! 4. in the same pass, the perceptual resolution prediction and its
 //!    accumulation into the shadow-map tile grid;
 //! 5. the grid's pyramid on the GPU (`pvsm_smtg_pyramid`), read back in the
-//!    middle of the frame (`pvsm_smtg_readback`, a CPU-timed stall);
+//!    middle of the frame (`pvsm_smtg_readback`, the mapping timed on the CPU;
+//!    the wait for the GPU before it is the `pvsm_smtg_readback_wait_ms`
+//!    diagnostic);
 //! 6. the kd-tree on the CPU (`pvsm_kdtree`, [`kdtree`]);
 //! 7. per tile, a shadow map of the predicted resolution (`pvsm_tile_map`);
 //! 8. per tile, the texel-as-quad filtering of the pixels whose filter
@@ -20,6 +22,8 @@
 
 pub mod kdtree;
 pub mod prediction;
+#[cfg(test)]
+mod wgsl_tests;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec2};
@@ -115,9 +119,12 @@ pub struct PvsmSettings {
     /// With prediction = fixed: side of the single map covering the light frame, texels (clamped to the device's limit).
     #[param(default = 4096, min = 64, max = 16384)]
     pub fixed_size: u32,
-    /// Analytic anisotropic anti-aliasing (Sec. 4.2): the filter convolved with the pixel's footprint on the map.
-    #[param(default = true)]
+    /// Analytic anisotropic anti-aliasing (Sec. 4.2): the filter convolved with the pixel's footprint on the map, so that a pixel gets the visibility averaged over its footprint rather than at its point (off by default: the framework compares the visibility at each pixel's point; compare with reference.footprint=pixel when on).
+    #[param(default = false)]
     pub antialiasing: bool,
+    /// With antialiasing off: texels per pixel (along each axis) that the sharpest shadows ask for, penumbrae getting two texels across down to that width (not the paper's: its 1:1 rule for hard shadows, Sec. 5, suits an average over the footprint, while a point sample of a hard edge is placed only to within half a texel). 1 is the paper's rule and costs the least.
+    #[param(default = 4, min = 1, max = 16)]
+    pub hard_texels: u32,
     /// How texels are weighted (Sec. 4.1): quads (each texel's exact overlap with the filter, Eq. 2) or points (classic PCF, which bands where the penumbra's width changes quickly, Fig. 4).
     #[param(choice, default = "quads")]
     pub integration: Integration,
@@ -153,7 +160,7 @@ pub struct PvsmSettingsUniform {
     fixed_size: f32,
     point_samples: u32,
     predicted_stride: u32,
-    _pad: f32,
+    hard_texels: f32,
 }
 
 impl From<&PvsmSettings> for PvsmSettingsUniform {
@@ -170,7 +177,7 @@ impl From<&PvsmSettings> for PvsmSettingsUniform {
             fixed_size: settings.fixed_size as f32,
             point_samples: u32::from(settings.integration == Integration::Points),
             predicted_stride: u32::from(settings.filter_texels == FilterTexels::Predicted),
-            _pad: 0.0,
+            hard_texels: settings.hard_texels as f32,
         }
     }
 }
@@ -320,6 +327,12 @@ impl KernelRecord {
     }
 }
 
+/// The `COUNTER_*` slots of `pvsm_common.wgsl`, in order: pixels filtered, skipped as lit, decimated,
+/// and not covered by any tile.
+const COUNTER_NAMES: [&str; 4] = ["COUNTER_FILTERED", "COUNTER_LIT", "COUNTER_DECIMATED", "COUNTER_UNCOVERED"];
+/// Bytes of the counters buffer.
+const COUNTER_BYTES: u64 = COUNTER_NAMES.len() as u64 * 4;
+
 /// Bytes of one [`KernelRecord`].
 const KERNEL_BYTES: u64 = std::mem::size_of::<KernelRecord>() as u64;
 
@@ -349,7 +362,10 @@ struct Pipelines {
 struct Buffers {
     kernels: wgpu::Buffer,
     accumulated: wgpu::Buffer,
+    /// Per pixel, a u32: 1 once its filter was decimated in some tile.
+    decimated: wgpu::Buffer,
     grid: wgpu::Buffer,
+    /// `COUNTER_*` of `pvsm_common.wgsl`, summed over the lights of the last frame.
     counters: wgpu::Buffer,
     pyramid: wgpu::Buffer,
     pyramid_readback: wgpu::Buffer,
@@ -363,6 +379,8 @@ struct Buffers {
 #[derive(Clone, Debug, Default)]
 struct LastFrame {
     tilings: Vec<Tiling>,
+    /// The mid-frame readbacks' waits for the GPU, summed over the lights (`Frame::last_read_back_wait_ms`).
+    readback_wait_ms: f64,
 }
 
 /// Predicted virtual soft shadow maps.
@@ -522,8 +540,9 @@ impl PredictedVirtualShadowMaps {
         Buffers {
             kernels: storage_buffer(device, "pvsm_kernel_buffer", pixels * KERNEL_BYTES),
             accumulated: storage_buffer(device, "pvsm_accumulated_buffer", pixels * 8),
+            decimated: storage_buffer(device, "pvsm_decimated_buffer", pixels * 4),
             grid: storage_buffer(device, "pvsm_smtg_buffer", cells * 8),
-            counters: storage_buffer(device, "pvsm_counters_buffer", 8),
+            counters: storage_buffer(device, "pvsm_counters_buffer", COUNTER_BYTES),
             pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * 8),
             pyramid_readback: readback_buffer(device, "pvsm_smtg_pyramid_readback", pyramid_cells * 8),
             pyramid_cells,
@@ -732,6 +751,8 @@ impl StepGroups {
                 settings_buffer.as_entire_binding(),
                 buffers.kernels.as_entire_binding(),
                 buffers.accumulated.as_entire_binding(),
+                buffers.decimated.as_entire_binding(),
+                buffers.counters.as_entire_binding(),
             ],
         );
         Self { low_res: low_res_group, kernel, pyramid, common }
@@ -775,7 +796,14 @@ impl Layouts {
             common: bind_group_layout(
                 device,
                 "pvsm_filter_common_layout",
-                &[uniform_entry(0), uniform_entry(1), storage_entry(2, true), storage_entry(3, false)],
+                &[
+                    uniform_entry(0),
+                    uniform_entry(1),
+                    storage_entry(2, true),
+                    storage_entry(3, false),
+                    storage_entry(4, false),
+                    storage_entry(5, false),
+                ],
             ),
             tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1)]),
             cull: bind_group_layout(
@@ -882,8 +910,13 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         let no_light = || Error::Technique { technique: NAME.into(), message: format!("no light {light}") };
         let resolve_group = self.resolve_groups.get(light).ok_or_else(no_light)?.clone();
         frame.clear_buffer("pvsm_clear_grid", &self.buffers.grid, 0, None);
-        frame.clear_buffer("pvsm_clear_counters", &self.buffers.counters, 0, None);
+        if light == 0 {
+            // The counters sum over the frame's lights; the renderer renders light 0 first.
+            frame.clear_buffer("pvsm_clear_counters", &self.buffers.counters, 0, None);
+            self.last.readback_wait_ms = 0.0;
+        }
         frame.clear_buffer("pvsm_clear_accumulated", &self.buffers.accumulated, 0, None);
+        frame.clear_buffer("pvsm_clear_decimated", &self.buffers.decimated, 0, None);
         // Step 2: the conservative low-resolution map.
         {
             let light_group = &frame.scene.light_bind_groups[light];
@@ -914,6 +947,9 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         self.dispatch(frame, "pvsm_kernel_shape", &self.pipelines.kernel, &[&self.kernel_group], light);
         // Steps 5 and 6.
         let tiling = self.tiling(frame)?;
+        if self.settings.prediction != Prediction::Fixed {
+            self.last.readback_wait_ms += frame.last_read_back_wait_ms();
+        }
         // Steps 7 and 8, tile by tile.
         let light_frame = frame.scene.light_frames.get(light).ok_or_else(no_light)?;
         let slots = self.slots.get(light).ok_or_else(no_light)?;
@@ -950,7 +986,9 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         Ok(())
     }
 
-    /// Tiles, their resolutions and texels, the share of pixels skipped as fully lit, the cap.
+    /// Tiles, their resolutions and texels, the finest tile's resolution, the cap; over the frame's
+    /// lights, the pixels filtered, the share skipped as fully lit, the pixels whose filter was
+    /// decimated and those no tile covered, and the mid-frame readbacks' wait for the GPU.
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
         let tiles: Vec<&Tile> = self.last.tilings.iter().flat_map(|t| &t.tiles).collect();
         let texels: f64 = tiles.iter().map(|t| f64::from(t.size.x) * f64::from(t.size.y)).sum();
@@ -960,18 +998,25 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             ("pvsm_largest_tile".to_owned(), tiles.iter().map(|t| f64::from(t.size.max_element())).fold(0.0, f64::max)),
             ("pvsm_tile_cap_reached".to_owned(), f64::from(u8::from(self.last.tilings.iter().any(|t| t.cap_reached)))),
             ("pvsm_clamped_tiles".to_owned(), tiles.iter().filter(|t| t.clamped).count() as f64),
+            ("pvsm_finest_resolution".to_owned(), tiles.iter().map(|t| f64::from(t.resolution())).fold(0.0, f64::max)),
         ];
         for (index, tile) in tiles.iter().enumerate().take(16) {
             out.push((format!("pvsm_tile{index}_size"), f64::from(tile.size.x.max(tile.size.y))));
         }
-        if let Ok(bytes) = ssm_core::readback::read_buffer(gpu, &self.buffers.counters, 8, "PVSM counters") {
+        if let Ok(bytes) = ssm_core::readback::read_buffer(gpu, &self.buffers.counters, COUNTER_BYTES, "PVSM counters") {
             let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-            if let [filtered, lit] = counts[..] {
+            if let [filtered, lit, decimated, uncovered] = counts[..] {
                 let total = f64::from(filtered) + f64::from(lit);
                 if total > 0.0 {
                     out.push(("pvsm_lit_skipped".to_owned(), f64::from(lit) / total));
                 }
+                out.push(("pvsm_filtered_pixels".to_owned(), f64::from(filtered)));
+                out.push(("pvsm_decimated_pixels".to_owned(), f64::from(decimated)));
+                out.push(("pvsm_uncovered_pixels".to_owned(), f64::from(uncovered)));
             }
+        }
+        if self.settings.prediction != Prediction::Fixed {
+            out.push(("pvsm_smtg_readback_wait_ms".to_owned(), self.last.readback_wait_ms));
         }
         // Step 7's culling: the share of the triangles the last tile drew.
         if self.settings.tile_culling
@@ -1149,5 +1194,16 @@ mod tests {
     fn the_shaders_smallest_tile_is_the_kd_trees() {
         let line = format!("const MIN_TILE_SIZE: f32 = {}.0;", super::kdtree::MIN_TILE_SIZE);
         assert!(super::KERNEL_SHADER.contains(&line), "pvsm_kernel.wgsl lacks `{line}`");
+    }
+
+    /// The diagnostics read the counters in the order the WGSL numbers them.
+    #[test]
+    fn the_counters_are_numbered_as_the_shaders_number_them() {
+        let common = super::LOCAL_SHADERS[0].1;
+        assert!(common.contains(&format!("const COUNTERS: u32 = {}u;", super::COUNTER_NAMES.len())));
+        for (index, name) in super::COUNTER_NAMES.iter().enumerate() {
+            let line = format!("const {name}: u32 = {index}u;");
+            assert!(common.contains(&line), "pvsm_common.wgsl lacks `{line}`");
+        }
     }
 }
