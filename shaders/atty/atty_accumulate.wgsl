@@ -9,11 +9,15 @@
 // #import common/light_frame.wgsl
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
+// #import atty/atty_geometry.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 // The micro-patches that can hide anything (atty_patches.wgsl), one instance each.
 @group(1) @binding(0) var<storage, read> patches: array<MicroPatchRecord>;
-@group(1) @binding(1) var receiver_map: texture_2d<f32>;
+// Per SSM texel, x: the receiver's depth (NO_SURFACE where none). With `receiver_plane`, the
+// receiver planes (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the
+// receiver map itself.
+@group(1) @binding(1) var receivers: texture_2d<f32>;
 @group(1) @binding(2) var<uniform> settings: AttySettings;
 
 struct MicroPatch {
@@ -26,6 +30,12 @@ struct MicroPatch {
     // A receiver less than this far behind the patch is its own surface (self_shadow_tolerance
     // widths of one texel's micro-patch, also for a merged patch).
     @location(3) @interpolate(flat) self_shadow_depth: f32,
+    // The patch's centre in ndc (the receiver-plane test's ray).
+    @location(4) @interpolate(flat) ndc_centre: vec2<f32>,
+    // How far in front of a receiver's tangent plane the patch may lie and still count as on it:
+    // the occluder's depth spread across the patch, plus receiver_plane_tolerance widths of one
+    // texel's micro-patch.
+    @location(5) @interpolate(flat) plane_slack: f32,
 };
 
 const CORNERS: array<vec2<f32>, 4> = array<vec2<f32>, 4>(vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(1.0, 1.0));
@@ -43,38 +53,29 @@ fn atty_patch_vertex(@builtin(vertex_index) corner: u32, @builtin(instance_index
     out.half_size = record.depth * tan_half * record.span / settings.occluder_map_size;
     out.depth = record.depth;
     out.self_shadow_depth = record.self_shadow_depth;
+    out.ndc_centre = record.ndc_centre;
+    out.plane_slack = record.depth_spread + settings.receiver_plane_tolerance * 2.0 * record.depth * max(tan_half.x, tan_half.y) / settings.occluder_map_size;
     return out;
-}
-
-// Length of [low, high] ∩ [-half, half] divided by 2·half (Sec. 4.2: the light normalised to
-// [0, 1] and the interval clamped, as the paper's saturating MOV); a point light (half = 0) is
-// hit when it lies inside the interval.
-fn light_overlap(low: f32, high: f32, half: f32) -> f32 {
-    if (half <= 0.0) {
-        return select(0.0, 1.0, low <= 0.0 && 0.0 <= high);
-    }
-    let a = clamp((low + half) / (2.0 * half), 0.0, 1.0);
-    let b = clamp((high + half) / (2.0 * half), 0.0, 1.0);
-    return max(b - a, 0.0);
 }
 
 @fragment
 fn atty_patch_fragment(in: MicroPatch) -> @location(0) f32 {
     let texel = vec2<i32>(in.clip.xy);
-    let receiver_depth = textureLoad(receiver_map, texel, 0).x;
+    let receiver = textureLoad(receivers, texel, 0);
+    let receiver_depth = receiver.x;
     // No receiver here, or the receiver is not behind this patch (beyond the tolerance that keeps a
     // surface in both maps from shadowing itself): nothing hidden.
     if (receiver_depth >= NO_SURFACE || receiver_depth <= in.depth + in.self_shadow_depth) {
         return 0.0;
     }
-    let uv = in.clip.xy / settings.soft_shadow_map_size;
-    let receiver = (uv * 2.0 - 1.0) * receiver_depth * frame.projection.xy;
-    // Sec. 3.4: project the micro-patch from the receiver point back onto the light's plane
-    // (Drettakis and Fiume 1994): a scaling about the receiver by z_R / (z_R - z_O).
-    let scale = receiver_depth / (receiver_depth - in.depth);
-    let low = receiver + (in.centre - in.half_size - receiver) * scale;
-    let high = receiver + (in.centre + in.half_size - receiver) * scale;
+    let receiver_ndc = in.clip.xy / settings.soft_shadow_map_size * 2.0 - 1.0;
+    // A patch on the receiver's tangent plane or behind it hides nothing the receiver sees: a flat
+    // surface in both maps cannot shadow itself through its own micro-patches.
+    if (settings.receiver_plane != 0.0
+        && patch_on_or_behind_receiver_plane(receiver_ndc, receiver_depth, receiver.yz, in.ndc_centre, in.depth, in.plane_slack)) {
+        return 0.0;
+    }
     let light_half = vec2<f32>(frame.u_axis.w, frame.v_axis.w);
-    // Sec. 4.2: the hidden area is the product of the two 1-D overlaps.
-    return light_overlap(low.x, high.x, light_half.x) * light_overlap(low.y, high.y, light_half.y);
+    // Sec. 3.4 and 4.2: the patch projected back onto the light from the receiver, and the hidden area.
+    return hidden_fraction(light_half, in.centre, in.half_size, in.depth, receiver_ndc * receiver_depth * frame.projection.xy, receiver_depth);
 }

@@ -7,6 +7,7 @@
 // #import common/light_frame.wgsl
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
+// #import atty/atty_geometry.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var occluder_map: texture_2d<f32>;
@@ -85,6 +86,29 @@ fn merged_block(texel: vec2<u32>, depth: f32) -> vec2<f32> {
     return vec2<f32>(f32(level), patch_depth);
 }
 
+// Depth of a neighbouring texel of the occluder map, or -1 outside the map or where it is empty.
+fn neighbour_depth(texel: vec2<i32>) -> f32 {
+    let n = i32(settings.occluder_map_size);
+    if (any(texel < vec2<i32>(0)) || any(texel >= vec2<i32>(n))) {
+        return -1.0;
+    }
+    let depth = textureLoad(occluder_map, texel, 0).x;
+    return select(depth, -1.0, depth >= NO_SURFACE);
+}
+
+// The occluder's depth change per texel along `step` at `texel` (depth `depth`): the smaller of the
+// two one-sided differences, so that a depth edge (a silhouette) does not count as a slope.
+fn depth_step(texel: vec2<i32>, depth: f32, step: vec2<i32>) -> f32 {
+    var smallest = -1.0;
+    for (var side = -1; side <= 1; side += 2) {
+        let neighbour = neighbour_depth(texel + side * step);
+        if (neighbour >= 0.0 && (smallest < 0.0 || abs(neighbour - depth) < smallest)) {
+            smallest = abs(neighbour - depth);
+        }
+    }
+    return max(smallest, 0.0);
+}
+
 // One invocation per occluder-map texel: its micro-patch (or its block's, Sec. 3.2), appended to
 // the patch list with its penumbra rectangle (Sec. 3.3) unless an empty texel, another texel of
 // its block, or no receiver behind it means it hides nothing.
@@ -112,18 +136,18 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
     let texel_ndc = (vec2<f32>(texel) + 0.5 * span) / settings.occluder_map_size * 2.0 - 1.0;
     let half_size = patch_depth * tan_half * span / settings.occluder_map_size;
     let self_shadow_depth = settings.self_shadow_tolerance * 2.0 * max(half_size.x, half_size.y) / span;
+    // The patch stands for the occluder's surface across its texels, whose depth runs this far on
+    // either side of the patch's (its slope across half the patch): the receiver-plane test
+    // (atty_accumulate.wgsl) counts a patch whose surface reaches the receiver's plane as lying on it.
+    var depth_spread = 0.0;
+    if (settings.receiver_plane != 0.0) {
+        let slope = vec2<f32>(depth_step(vec2<i32>(texel), depth, vec2<i32>(1, 0)), depth_step(vec2<i32>(texel), depth, vec2<i32>(0, 1)));
+        depth_spread = 0.5 * span * (slope.x + slope.y);
+    }
     let light_half = vec2<f32>(frame.u_axis.w, frame.v_axis.w);
-    // Sec. 3.3: the penumbra extent is the pyramid of apex O, C_L O = r/(1+r) C_L C_P with
-    // r = LL'/PP' = l/p per axis, at depth z_apex = r/(1+r) z_O. On the plane at depth z_R it is
-    // the rectangle of centre C_L C_R = (z_R/z_apex) C_L O = (z_R/z_O) C_P and half-width
-    // l (z_R - z_apex)/z_apex = (l + p) z_R/z_O - l: the same formulas written without dividing
-    // by r, so that a point light (r = 0, apex at the light) needs no special case.
-    // Projected into the SSM from the light's centre (divide by z_R tan), the centre is the
-    // texel's own and the half extent is (l + p)/(z_O tan) - l/(z_R tan), growing with z_R:
-    // evaluated at the far plane, the rectangle covers every receiver (conservative).
-    // As reach - shrink / z_R per axis.
-    let reach = (light_half + half_size) / (patch_depth * tan_half);
-    let shrink = light_half / tan_half;
+    // Sec. 3.3: the penumbra extent is a pyramid whose section on the SSM is the rectangle centred
+    // on the texel's own ndc position, of half extent penumbra_half_ndc at the receiver's depth,
+    // growing with it: evaluated at the far plane it covers every receiver (conservative).
     var bound = frame.projection.w;
     if (settings.receiver_bounded != 0.0) {
         // Bounded by the deepest receiver under the rectangle instead: the rectangle at the far
@@ -132,7 +156,7 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
         // one at any depth behind it), and the deepest receiver in that, z₂, a smaller one again.
         // The texels dropped are those whose receiver is not behind the patch: the same pixels.
         for (var refinement = 0; refinement < 2; refinement++) {
-            let half_extent = reach - shrink / bound;
+            let half_extent = penumbra_half_ndc(light_half, tan_half, half_size, patch_depth, bound);
             let deepest = deepest_receiver(texel_ndc - half_extent, texel_ndc + half_extent);
             // No receiver behind the patch under its rectangle: it hides nothing anywhere.
             if (deepest <= patch_depth + self_shadow_depth) {
@@ -141,7 +165,7 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
             bound = min(bound, deepest);
         }
     }
-    let half_ndc = reach - shrink / bound;
+    let half_ndc = penumbra_half_ndc(light_half, tan_half, half_size, patch_depth, bound);
     let slot = atomicAdd(&draw_arguments[1], 1u);
-    patches[slot] = MicroPatchRecord(texel_ndc, half_ndc, patch_depth, self_shadow_depth, span, 0.0);
+    patches[slot] = MicroPatchRecord(texel_ndc, half_ndc, patch_depth, self_shadow_depth, span, depth_spread);
 }

@@ -6,9 +6,12 @@
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
+// #import atty/atty_geometry.wgsl
 
 @group(2) @binding(0) var soft_shadow_front: texture_2d<f32>;
 @group(2) @binding(1) var soft_shadow_back: texture_2d<f32>;
+// Per texel, x: the nearest receiver's depth; with `receiver_plane`, the receiver planes
+// (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the receiver map.
 @group(2) @binding(2) var receiver_map: texture_2d<f32>;
 @group(2) @binding(3) var<uniform> settings: AttySettings;
 
@@ -40,6 +43,60 @@ fn receiver_bilinear(map: texture_2d<f32>, uv: vec2<f32>, depth: f32, tolerance:
     return sum / total;
 }
 
+// Depth margin of the hidden-receiver test against the nearest receiver's plane, in receiver-map
+// texel footprints at the lookup's depth: a tenth of the normal offset's half texel
+// (normal_offset = 0.5), which keeps a receiver's own points in front of its plane; it covers the
+// plane's rounding (atty_geometry.wgsl).
+const PLANE_MARGIN_TEXELS: f32 = 0.05;
+
+// With `receiver_plane`: the depth, along the ray through ndc `q`, of the plane of the receiver in
+// texel `texel` of the receiver map (which holds (depth, slope.x, slope.y)); NO_SURFACE where the
+// texel holds none.
+fn texel_plane_depth(texel: vec2<i32>, q: vec2<f32>) -> f32 {
+    let receiver = textureLoad(receiver_map, texel, 0);
+    if (receiver.x >= NO_SURFACE) {
+        return NO_SURFACE;
+    }
+    let size = vec2<f32>(textureDimensions(receiver_map));
+    let texel_ndc = (vec2<f32>(texel) + 0.5) / size * 2.0 - 1.0;
+    return patch_ray_plane_depth(texel_ndc, receiver.x, receiver.yz, q);
+}
+
+// With `receiver_plane`: the bilinear interpolation of both SSMs (the larger occlusion) at the
+// point `uvd` (its uv and depth) over the four texels whose receiver's plane passes within
+// `tolerance` of it, along its own ray: the texels of the point's own surface, even where that
+// surface is seen edge-on from the light and fills a texel or two (a texel beside it holds another
+// surface, deeper or nearer, whose occlusion is not the point's). Where none does, the texel whose
+// plane passes nearest.
+fn plane_bilinear(uvd: vec3<f32>, tolerance: f32) -> f32 {
+    let size = vec2<f32>(textureDimensions(receiver_map));
+    let q = uvd.xy * 2.0 - 1.0;
+    let position = uvd.xy * size - 0.5;
+    let base = floor(position);
+    let t = position - base;
+    let limit = vec2<i32>(size) - 1;
+    var sum = vec2<f32>(0.0);
+    var total = 0.0;
+    var closest = NO_SURFACE;
+    var closest_value = vec2<f32>(0.0);
+    for (var corner = 0; corner < 4; corner++) {
+        let step = vec2<i32>(corner & 1, corner >> 1u);
+        let texel = clamp(vec2<i32>(base) + step, vec2<i32>(0), limit);
+        let gap = abs(texel_plane_depth(texel, q) - uvd.z);
+        let value = vec2<f32>(textureLoad(soft_shadow_front, texel, 0).x, textureLoad(soft_shadow_back, texel, 0).x);
+        let weights = select(1.0 - t, t, vec2<bool>(step == vec2<i32>(1)));
+        let weight = select(0.0, weights.x * weights.y, gap <= tolerance);
+        sum += weight * value;
+        total += weight;
+        if (gap < closest) {
+            closest = gap;
+            closest_value = value;
+        }
+    }
+    let occlusion = select(closest_value, sum / total, total > 1e-6);
+    return max(occlusion.x, occlusion.y);
+}
+
 @fragment
 fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
@@ -56,13 +113,29 @@ fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     if (any(uvd.xy < vec2<f32>(0.0)) || any(uvd.xy >= vec2<f32>(1.0))) {
         return 1.0;
     }
-    // Depths within this of the lookup's count as the same receiver: a constant bias plus
-    // `receiver_tolerance` texel footprints of the receiver map at this depth.
-    let tolerance = scene_length(frame, settings.receiver_bias) + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);
     // The SSM holds the occlusion of the receiver nearest the light's centre in each texel. A point
     // behind it (an object with the role `both` between it and the light) has no value of its own:
     // count it as in umbra, as a hard shadow would.
     let nearest = shadow_map_depth(receiver_map, uvd.xy);
+    if (settings.receiver_plane != 0.0) {
+        // Behind the nearest receiver's tangent plane along the lookup's own ray: the plane gives
+        // that receiver's depth there, not at the texel's centre, so no depth tolerance is needed,
+        // and a point just behind a wall seen at a grazing angle (the ground outside a box around
+        // the light) is hidden, not read as the wall.
+        let size = vec2<f32>(textureDimensions(receiver_map));
+        let texel = min(vec2<i32>(uvd.xy * size), vec2<i32>(size) - 1);
+        if (uvd.z > texel_plane_depth(texel, uvd.xy * 2.0 - 1.0) + PLANE_MARGIN_TEXELS * shadow_texel_size(frame, receiver_map, uvd.z)) {
+            return 0.0;
+        }
+        // The point's own surface, found by its plane where the point itself (not the lookup moved
+        // off it) lies.
+        let own = light_uv_depth(frame, point.position);
+        let occlusion = plane_bilinear(own, settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, own.z));
+        return 1.0 - clamp(occlusion, 0.0, 1.0);
+    }
+    // Depths within this of the lookup's count as the same receiver: a constant bias plus
+    // `receiver_tolerance` texel footprints of the receiver map at this depth.
+    let tolerance = scene_length(frame, settings.receiver_bias) + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);
     if (uvd.z > nearest + tolerance) {
         return 0.0;
     }

@@ -20,7 +20,16 @@ struct AttySettings {
     // Neighbouring occluder texels whose depths differ by at most this many micro-patch widths
     // are drawn as one micro-patch (0: never).
     merge_tolerance: f32,
+    // 1: a micro-patch on or behind a receiver's tangent plane hides nothing from it (the
+    // accumulation reads the receiver planes); 0: the receiver's depth alone decides.
+    receiver_plane: f32,
+    // How far in front of a receiver's tangent plane, in widths of one texel's micro-patch, a patch
+    // still counts as lying on it.
+    receiver_plane_tolerance: f32,
+    _pad0: f32,
+    _pad1: f32,
 };
+
 
 // One micro-patch of the accumulation's list (ssm-techniques/atty's 32-byte record).
 struct MicroPatchRecord {
@@ -32,5 +41,6 @@ struct MicroPatchRecord {
     self_shadow_depth: f32,
     // Occluder texels per side (1, or 2^level for a merged block).
     span: f32,
-    _pad: f32,
+    // How far the occluder's depth runs on either side of the patch's across the patch (its slope).
+    depth_spread: f32,
 };

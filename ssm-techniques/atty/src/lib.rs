@@ -16,7 +16,13 @@
 //! micro-patches and an indirect instanced draw accumulates them (the paper's
 //! stated next step, Sec. 4.3 and 7), so the cost no longer grows with a
 //! readback. Neighbouring texels at one depth are listed as one patch (their
-//! back-projections join exactly, Sec. 5.1.2).
+//! back-projections join exactly, Sec. 5.1.2). And, where the paper separates
+//! occluders from receivers (Sec. 1, 7), a surface in both maps is kept from
+//! shadowing itself through its own micro-patches: the receiver map carries
+//! each receiver's tangent plane, and a patch on or behind it hides nothing
+//! (`receiver_plane`, on by default).
+
+pub mod geometry;
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{
@@ -33,8 +39,11 @@ use ssm_core::{
 /// The registered name.
 pub const NAME: &str = "atty";
 
-/// WGSL files the Atty shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("atty/atty_settings.wgsl", include_str!("../../../shaders/atty/atty_settings.wgsl"))];
+/// The micro-patch geometry the list pass and the accumulation evaluate, twin of [`geometry`].
+pub const GEOMETRY_SHADER: &str = include_str!("../../../shaders/atty/atty_geometry.wgsl");
+/// WGSL files the Atty shaders import besides `common/`, as `(path under shaders/, text)`.
+pub const LOCAL_SHADERS: &[(&str, &str)] =
+    &[("atty/atty_settings.wgsl", include_str!("../../../shaders/atty/atty_settings.wgsl")), ("atty/atty_geometry.wgsl", GEOMETRY_SHADER)];
 /// The accumulation of micro-patches into the SSM.
 const ACCUMULATE_SHADER: &str = include_str!("../../../shaders/atty/atty_accumulate.wgsl");
 /// The projection of the SSM onto the screen.
@@ -45,6 +54,8 @@ const PATCHES_SHADER: &str = include_str!("../../../shaders/atty/atty_patches.wg
 const PATCH_RECORD_BYTES: u64 = 32;
 /// The receiver map's max-pyramid.
 const RECEIVER_BOUNDS_SHADER: &str = include_str!("../../../shaders/atty/atty_receiver_bounds.wgsl");
+/// The receivers' tangent planes, measured from the receiver map.
+const RECEIVER_PLANES_SHADER: &str = include_str!("../../../shaders/atty/atty_receiver_planes.wgsl");
 /// An occluder map's min-max pyramid.
 const PATCH_MERGE_SHADER: &str = include_str!("../../../shaders/atty/atty_patch_merge.wgsl");
 
@@ -105,10 +116,10 @@ pub struct AttySettings {
     /// Projection lookup point moved off the surface along its normal, in receiver-map texels.
     #[param(default = 0.5, min = 0.0, max = 8.0)]
     pub normal_offset: f32,
-    /// Receiver-map depths within this many texel footprints (world size of one receiver-map texel at the depth looked up) of a receiver count as that receiver: the SSM's bilinear lookup blends only those, and a point farther behind is hidden (in umbra).
+    /// Receiver-map depths within this many texel footprints (world size of one receiver-map texel at the depth looked up) of a receiver count as that receiver: the SSM's bilinear lookup blends only those, and (without `receiver_plane`) a point farther behind is hidden (in umbra). With `receiver_plane` it is measured from each texel's plane along the point's own ray.
     #[param(default = 2.0, min = 0.0, max = 64.0)]
     pub receiver_tolerance: f32,
-    /// A micro-patch less than this many of its widths in front of a receiver hides nothing: removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper).
+    /// A micro-patch less than this many of its widths in front of a receiver hides nothing: without `receiver_plane`, removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper).
     #[param(default = 0.0, min = 0.0, max = 16.0)]
     pub self_shadow_tolerance: f32,
     /// What bounds each micro-patch's penumbra rectangle: the far plane, or the deepest receiver under it (same result; less fill for a pyramid pass, which did not pay on lavapipe).
@@ -117,6 +128,12 @@ pub struct AttySettings {
     /// Aligned blocks of occluder texels whose depths differ by at most this many micro-patch widths are drawn as one micro-patch (Sec. 5.1.2: neighbours at one depth join exactly; 0: one patch per texel).
     #[param(default = 0.01, min = 0.0, max = 16.0)]
     pub merge_tolerance: f32,
+    /// A micro-patch on or behind a receiver's tangent plane (the receiver map carries each texel's, from its triangle) hides nothing from it, so a surface in both maps does not shadow itself through its own micro-patches; and the projection finds each point's own receiver by its plane (false: the receiver's depth alone decides, the paper).
+    #[param(default = true)]
+    pub receiver_plane: bool,
+    /// With `receiver_plane`: a micro-patch less than this many of its widths (one texel's) in front of a receiver's tangent plane, beyond its own surface's depth spread across the patch, counts as lying on it (a margin for rounding).
+    #[param(default = 0.05, min = 0.0, max = 16.0)]
+    pub receiver_plane_tolerance: f32,
 }
 
 /// The settings uniform both Atty shaders read (`AttySettings` in `shaders/atty/atty_settings.wgsl`).
@@ -131,6 +148,9 @@ pub struct AttySettingsUniform {
     receiver_bias: f32,
     receiver_bounded: f32,
     merge_tolerance: f32,
+    receiver_plane: f32,
+    receiver_plane_tolerance: f32,
+    _pad: [f32; 2],
 }
 
 impl From<&AttySettings> for AttySettingsUniform {
@@ -145,6 +165,9 @@ impl From<&AttySettings> for AttySettingsUniform {
             receiver_bias: ShadowMapBias::default().constant_bias,
             receiver_bounded: if settings.penumbra_bound == PenumbraBound::Receivers { 1.0 } else { 0.0 },
             merge_tolerance: settings.merge_tolerance,
+            receiver_plane: if settings.receiver_plane { 1.0 } else { 0.0 },
+            receiver_plane_tolerance: settings.receiver_plane_tolerance,
+            _pad: [0.0; 2],
         }
     }
 }
@@ -260,9 +283,137 @@ impl DepthPyramid {
     }
 }
 
+/// The receiver map: per texel of the light frame, the nearest receiver's linear depth (`.x`),
+/// read by the accumulation, the penumbra bounds and the projection.
+enum ReceiverMap {
+    /// The depth alone (ssm-core's light depth map, no bias): without `receiver_plane`, the paper.
+    Depth(LightDepthMap),
+    /// The depth and the slope of the receiver's plane (`atty_receiver_planes.wgsl`).
+    Planes(ReceiverPlaneMap),
+}
+
+impl ReceiverMap {
+    /// The pass's name, timed.
+    const LABEL: &'static str = "atty_receiver_map";
+
+    fn new(setup: &TechniqueSetup<'_>, settings: &AttySettings, settings_buffer: &wgpu::Buffer) -> Result<Self> {
+        if settings.receiver_plane {
+            Ok(Self::Planes(ReceiverPlaneMap::new(setup, settings.ssm_size, settings_buffer)?))
+        } else {
+            Ok(Self::Depth(unbiased_depth_map(setup, Self::LABEL, settings.ssm_size, Geometry::Receivers, (None, false))?))
+        }
+    }
+
+    fn view(&self) -> &wgpu::TextureView {
+        match self {
+            Self::Depth(map) => &map.linear_depth_view,
+            Self::Planes(map) => &map.view,
+        }
+    }
+
+    /// Records the pass through `light_frame`, a light's frame bind group.
+    fn encode(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup) {
+        match self {
+            Self::Depth(map) => map.encode_with(frame, light_frame),
+            Self::Planes(map) => map.encode(frame, light_frame),
+        }
+    }
+}
+
+/// The receivers seen from the light's centre with their tangent planes: `(depth, slope.x,
+/// slope.y, 0)` per texel (`atty_receiver_planes.wgsl`), the slope read from the fragment's own
+/// triangle.
+struct ReceiverPlaneMap {
+    view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    pipeline: wgpu::RenderPipeline,
+    settings_group: wgpu::BindGroup,
+    indices: std::ops::Range<u32>,
+}
+
+impl ReceiverPlaneMap {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+    fn new(setup: &TechniqueSetup<'_>, size: u32, settings_buffer: &wgpu::Buffer) -> Result<Self> {
+        let gpu = setup.gpu;
+        let device = &gpu.device;
+        let label = ReceiverMap::LABEL;
+        let indices = setup.scene.index_range(NAME, Geometry::Receivers)?;
+        let texture = render_texture(device, &format!("{label}_planes"), size, size, Self::FORMAT, wgpu::TextureUsages::empty());
+        let depth =
+            render_texture(device, &format!("{label}_depth"), size, size, LightDepthMap::DEPTH_FORMAT, wgpu::TextureUsages::empty());
+        let settings_group =
+            bind_group(device, &format!("{label}_settings_bind_group"), gpu.uniform_layout(), &[settings_buffer.as_entire_binding()]);
+        let module = create_shader_with_imports(gpu, &format!("{label}_shader"), RECEIVER_PLANES_SHADER, LOCAL_SHADERS)?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&format!("{label}_pipeline_layout")),
+            bind_group_layouts: &[Some(gpu.uniform_layout()), Some(gpu.uniform_layout())],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(&format!("{label}_pipeline")),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("atty_receiver_vertex"),
+                compilation_options: Default::default(),
+                buffers: &[Some(ssm_core::SceneVertex::layout())],
+            },
+            // Both sides of every receiver, as the plain receiver map.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: LightDepthMap::DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                // The light frame's depth is reversed (near = 1): nearest wins with Greater.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("atty_receiver_fragment"),
+                compilation_options: Default::default(),
+                targets: &[Some(Self::FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let messages = gpu.take_errors();
+        if !messages.is_empty() {
+            return Err(Error::Gpu { during: "building Atty's receiver-plane map".into(), messages });
+        }
+        Ok(Self {
+            view: labelled_view(&texture, &format!("{label}_planes")),
+            depth_view: labelled_view(&depth, &format!("{label}_depth")),
+            pipeline,
+            settings_group,
+            indices,
+        })
+    }
+
+    fn encode(&self, frame: &mut Frame<'_>, light_frame: &wgpu::BindGroup) {
+        let scene = frame.scene;
+        let no_surface = f64::from(ssm_core::NO_SURFACE);
+        let mut pass = frame.render_pass(
+            ReceiverMap::LABEL,
+            &[color_attachment(&self.view, Some(wgpu::Color { r: no_surface, g: 0.0, b: 0.0, a: 0.0 }))],
+            Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+        );
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, light_frame, &[]);
+        pass.set_bind_group(1, &self.settings_group, &[]);
+        scene.draw(&mut pass, self.indices.clone());
+    }
+}
+
 /// Atty et al.'s soft shadow maps.
 pub struct SoftShadowMaps {
-    receiver_map: LightDepthMap,
+    receiver_map: ReceiverMap,
     /// The receiver map's max-pyramid, when it bounds the penumbra rectangles.
     receiver_bounds: Option<DepthPyramid>,
     /// Front faces (or every face, one-sided), then back faces when two-sided.
@@ -299,17 +450,17 @@ impl SoftShadowMaps {
         let settings = AttySettings::from_params(setup.params)?;
         check_receivers_resolved(setup, settings.ssm_size)?;
         let settings_buffer = uniform_buffer(&setup.gpu.device, "atty_settings_uniform", &AttySettingsUniform::from(&settings));
-        let receiver_map = unbiased_depth_map(setup, "atty_receiver_map", settings.ssm_size, Geometry::Receivers, (None, false))?;
+        let receiver_map = ReceiverMap::new(setup, &settings, &settings_buffer)?;
         let bounded = settings.penumbra_bound == PenumbraBound::Receivers;
         // Unbounded, the accumulation still binds a pyramid, of one texel, that it never reads.
         let receiver_bounds = DepthPyramid::new(
             setup,
             &RECEIVER_BOUNDS,
             "atty_receiver_bounds",
-            &receiver_map.linear_depth_view,
+            receiver_map.view(),
             if bounded { settings.ssm_size } else { 1 },
         )?;
-        let accumulations = Self::accumulations(setup, &settings, (&receiver_map, &receiver_bounds.view), &settings_buffer)?;
+        let accumulations = Self::accumulations(setup, &settings, (receiver_map.view(), &receiver_bounds.view), &settings_buffer)?;
         let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation)?;
         let patches_pipeline = Self::patches_pipeline(setup)?;
         let (project, project_group) = Self::projection(setup, &accumulations, &receiver_map, &settings_buffer)?;
@@ -330,7 +481,7 @@ impl SoftShadowMaps {
     fn accumulations(
         setup: &TechniqueSetup<'_>,
         settings: &AttySettings,
-        (receiver_map, receiver_bounds): (&LightDepthMap, &wgpu::TextureView),
+        (receivers, receiver_bounds): (&wgpu::TextureView, &wgpu::TextureView),
         settings_buffer: &wgpu::Buffer,
     ) -> Result<Vec<SideAccumulation>> {
         let device = &setup.gpu.device;
@@ -396,11 +547,7 @@ impl SoftShadowMaps {
                     device,
                     &format!("{pass_label}_bind_group"),
                     &layout,
-                    &[
-                        patches.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view),
-                        settings_buffer.as_entire_binding(),
-                    ],
+                    &[patches.as_entire_binding(), wgpu::BindingResource::TextureView(receivers), settings_buffer.as_entire_binding()],
                 );
                 Ok(SideAccumulation {
                     occluder_map,
@@ -494,7 +641,7 @@ impl SoftShadowMaps {
     fn projection(
         setup: &TechniqueSetup<'_>,
         accumulations: &[SideAccumulation],
-        receiver_map: &LightDepthMap,
+        receiver_map: &ReceiverMap,
         settings_buffer: &wgpu::Buffer,
     ) -> Result<(ScreenPass, wgpu::BindGroup)> {
         let device = &setup.gpu.device;
@@ -512,7 +659,7 @@ impl SoftShadowMaps {
             &[
                 wgpu::BindingResource::TextureView(front),
                 wgpu::BindingResource::TextureView(back),
-                wgpu::BindingResource::TextureView(&receiver_map.linear_depth_view),
+                wgpu::BindingResource::TextureView(receiver_map.view()),
                 settings_buffer.as_entire_binding(),
             ],
         );
@@ -554,7 +701,7 @@ impl ShadowTechnique for SoftShadowMaps {
             .light_bind_groups
             .get(light)
             .ok_or_else(|| Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
-        self.receiver_map.encode(frame, light);
+        self.receiver_map.encode(frame, light_frame);
         if let Some(bounds) = &self.receiver_bounds {
             bounds.encode(frame);
         }
