@@ -376,17 +376,6 @@ fn check_expectation(technique: &str, (case_name, scene): (&str, &Scene), expect
     }
 }
 
-/// Mean |a − b| over the covered pixels.
-fn mean_error(a: &[f32], b: &[f32], covered: &[bool]) -> f32 {
-    let (sum, count) = a
-        .iter()
-        .zip(b)
-        .zip(covered)
-        .filter(|(_, c)| **c)
-        .fold((0.0f64, 0usize), |(sum, count), ((a, b), _)| (sum + f64::from((a - b).abs()), count + 1));
-    (sum / count.max(1) as f64) as f32
-}
-
 /// The bound `info` must meet on `case_name`: its declared limit there, else the common one.
 fn bound_of(info: &TechniqueInfo, case_name: &str) -> (f32, Option<&'static str>) {
     info.limits.iter().find(|limit| limit.case == case_name).map_or((COMMON_BOUND, None), |limit| (limit.mean_error, Some(limit.reason)))
@@ -457,7 +446,7 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
             for (light, truth_image) in truth_images.iter().enumerate() {
                 let image = rendered.renderer.read_visibility(light, info.name);
                 match image {
-                    Ok(image) => worst = worst.max(mean_error(&image, truth_image, &covered)),
+                    Ok(image) => worst = worst.max(ssm_testing::mean_abs_difference(&image, truth_image, &covered)),
                     Err(e) => failures.push(format!("{} / {} / light {light}: {e}", info.name, case.name)),
                 }
             }

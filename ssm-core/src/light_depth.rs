@@ -80,6 +80,20 @@ impl LightDepthMap {
     /// Format of the depth buffer the nearest (or farthest) surface is kept with.
     pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+    /// The depth test of a pass that keeps the nearest surface to the light (or, with
+    /// `farthest`, the farthest) in a [`LightDepthMap::DEPTH_FORMAT`] buffer of the light frame,
+    /// whose depth is reversed (near = 1): nearest wins with `Greater`.
+    #[must_use]
+    pub fn depth_test(farthest: bool) -> wgpu::DepthStencilState {
+        wgpu::DepthStencilState {
+            format: Self::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(if farthest { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Greater }),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        }
+    }
+
     /// Allocates the map; its pipeline is built once per device and culling mode, and shared.
     ///
     /// # Errors
@@ -164,14 +178,7 @@ impl LightDepthMap {
                     buffers: &[Some(SceneVertex::layout())],
                 },
                 primitive: wgpu::PrimitiveState { cull_mode, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: Self::DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    // The light frame's depth is reversed (near = 1): nearest wins with Greater.
-                    depth_compare: Some(if farthest { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Greater }),
-                    stencil: wgpu::StencilState::default(),
-                    bias: wgpu::DepthBiasState::default(),
-                }),
+                depth_stencil: Some(Self::depth_test(farthest)),
                 multisample: wgpu::MultisampleState::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,

@@ -361,14 +361,7 @@ impl ReceiverPlaneMap {
             },
             // Both sides of every receiver, as the plain receiver map.
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: LightDepthMap::DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                // The light frame's depth is reversed (near = 1): nearest wins with Greater.
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
+            depth_stencil: Some(LightDepthMap::depth_test(false)),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,

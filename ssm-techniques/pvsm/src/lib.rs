@@ -841,14 +841,7 @@ impl Pipelines {
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState { conservative: hardware, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: LightDepthMap::DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                // The light frame's depth is reversed: nearest wins with Greater.
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
+            depth_stencil: Some(LightDepthMap::depth_test(false)),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &conservative,

@@ -33,21 +33,10 @@ fn render_with_truth(scene: &Scene) -> (Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<bool>)
     (read(&rendered, "vssm"), read(&truth, "reference"), truth.coverage())
 }
 
-/// Mean |a − b| over the covered pixels.
-fn mean_error(a: &[f32], b: &[f32], covered: &[bool]) -> f32 {
-    let (sum, count) = a
-        .iter()
-        .zip(b)
-        .zip(covered)
-        .filter(|(_, c)| **c)
-        .fold((0.0f64, 0usize), |(sum, count), ((a, b), _)| (sum + f64::from((a - b).abs()), count + 1));
-    (sum / count.max(1) as f64) as f32
-}
-
 /// Asserts the bound for every light of `scene`; returns the errors.
 fn assert_near_truth(name: &str, scene: &Scene) -> Vec<f32> {
     let (vssm, truth, covered) = render_with_truth(scene);
-    let errors: Vec<f32> = vssm.iter().zip(&truth).map(|(v, t)| mean_error(v, t, &covered)).collect();
+    let errors: Vec<f32> = vssm.iter().zip(&truth).map(|(v, t)| ssm_testing::mean_abs_difference(v, t, &covered)).collect();
     println!("{name}: mean |error| {errors:.4?} against the ground truth (bound {BOUND})");
     for (light, error) in errors.iter().enumerate() {
         assert!(*error <= BOUND, "{name}, light {light}: mean |error| {error} against the ground truth, above {BOUND}");
