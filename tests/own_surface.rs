@@ -99,4 +99,10 @@ fn a_sealed_light_follows_the_camera_in_and_out_of_its_box() {
     outside.renderer.render(technique.as_mut(), hard.name).unwrap();
     let lit = outside.renderer.read_visibility(0, hard.name).unwrap().iter().filter(|v| **v == 1.0).count();
     assert!(lit > 1000, "only {lit} pixels lit inside the box");
+    // And out again.
+    outside.renderer.set_camera(&scene.camera).unwrap();
+    assert!(outside.renderer.scene.light_frames[0].sealed);
+    outside.renderer.render(technique.as_mut(), hard.name).unwrap();
+    let covered = outside.covered_visibility();
+    assert!(covered.iter().all(|v| *v == 0.0), "the camera outside again sees the sealed light");
 }

@@ -265,12 +265,9 @@ impl ReferenceCache {
             match point {
                 Some(p) => {
                     hasher.write_f32s(&[p.position.x, p.position.y, p.position.z, p.normal.x, p.normal.y, p.normal.z]);
-                    if p.closed {
-                        hasher.write(&[0xfd]);
-                    }
-                    // Points without a footprint hash as before, so that their cache stays valid.
+                    // One byte of flags per point, so that no two point lists hash the same bytes.
+                    hasher.write(&[u8::from(p.closed) | (u8::from(p.footprint.is_some()) << 1)]);
                     if let Some(f) = &p.footprint {
-                        hasher.write(&[0xfe]);
                         for v in [f.eye, f.corner, f.across, f.down] {
                             hasher.write_f32s(&v.to_array());
                         }

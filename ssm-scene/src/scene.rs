@@ -227,57 +227,87 @@ impl Scene {
     /// any of it, however wide the light's view would have to be to show that (a single
     /// perspective frustum from the light covers less than its hemisphere).
     ///
-    /// Each segment from `eye` to the light's centre and corners is tested against each closed
-    /// instance whose bounds hold one of its ends: an odd number of crossings separates them.
-    /// A segment through an edge or a vertex may miscount, so each is also taken from two eyes
-    /// nudged by a ten-thousandth of the scene's size, and two of the three must agree.
+    /// For each closed instance whose bounds hold the eye or the light: the light's rectangle
+    /// must meet none of its triangles (a light crossing or touching the surface is not sealed,
+    /// whatever its corners say), and the segments from the eye to the light's centre and
+    /// corners, each moved off the light along its normal by a ten-thousandth of the instance's
+    /// size (the side it emits to: a light flush on a ceiling lights the room below), must cross
+    /// it an odd number of times. A segment through an edge or a vertex may miscount, and one
+    /// with a crossing at either end is ambiguous (the camera on the surface), so each is also
+    /// taken from two nudged eyes and two of the three must find an odd count. Judged from the
+    /// camera's position: a camera whose near plane reaches through a wall sees a side this does
+    /// not judge.
     #[must_use]
     pub fn separates_light_from(&self, closed: &[bool], light: &RectLight, eye: Vec3) -> bool {
-        let light_points: Vec<Vec3> = if light.is_point() {
-            vec![light.centre]
-        } else {
-            vec![light.centre, light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)]
-        };
-        let nudge = self.bounds().size().length().max(f32::MIN_POSITIVE) * 1e-4;
-        let eyes = [eye, eye + Vec3::new(0.71, 0.53, 0.47) * nudge, eye + Vec3::new(-0.37, 0.83, -0.41) * nudge];
+        let corners = [light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)];
+        let light_points: Vec<Vec3> = if light.is_point() { vec![light.centre] } else { [&[light.centre][..], &corners[..]].concat() };
         self.instances.iter().filter(|i| closed.get(i.mesh).copied().unwrap_or(false)).any(|instance| {
             let Some(mesh) = self.meshes.get(instance.mesh) else { return false };
+            let triangles: Vec<[Vec3; 3]> =
+                mesh.triangles().map(|t| t.map(|k| instance.transform.transform_point3(mesh.positions[k as usize]))).collect();
             let mut bounds = Aabb::EMPTY;
-            for &p in &mesh.positions {
-                bounds.extend(instance.transform.transform_point3(p));
+            for corner in triangles.iter().flatten() {
+                bounds.extend(*corner);
             }
+            let nudge = bounds.size().length().max(f32::MIN_POSITIVE) * 1e-4;
             let inside = |p: Vec3| p.cmpge(bounds.min - nudge).all() && p.cmple(bounds.max + nudge).all();
-            light_points.iter().all(|&target| {
-                // An odd count needs one end inside the mesh, so inside its bounds.
-                (inside(eye) || inside(target))
-                    && eyes.iter().filter(|&&from| segment_crossings(mesh, instance.transform, from, target) % 2 == 1).count() >= 2
-            })
+            // An odd count needs one end inside the mesh, so inside its bounds.
+            if !inside(eye) && !light_points.iter().any(|p| inside(*p)) {
+                return false;
+            }
+            let eyes = [eye, eye + Vec3::new(0.71, -0.53, 0.47) * nudge, eye + Vec3::new(-0.37, 0.41, -0.83) * nudge];
+            let odd = |target: Vec3| {
+                eyes.iter().filter(|&&from| segment_crossings(&triangles, from, target).is_some_and(|count| count % 2 == 1)).count() >= 2
+            };
+            light_points.iter().all(|&p| odd(p + light.normal() * nudge))
+                && (light.is_point() || !triangles.iter().any(|triangle| rectangle_meets_triangle(&corners, triangle)))
         })
     }
 }
 
-/// How many triangles of `mesh` placed by `transform` the segment from `from` to `to` crosses
-/// strictly inside (Möller and Trumbore).
-fn segment_crossings(mesh: &Mesh, transform: Mat4, from: Vec3, to: Vec3) -> usize {
+/// Where the segment from `from` to `to` meets `triangle` (Möller and Trumbore): `Some(t)` for a
+/// point strictly inside the triangle at `t` of the way, in `[0, 1]`; `None` for no such point
+/// (or a segment in the triangle's plane).
+fn segment_hit(triangle: &[Vec3; 3], from: Vec3, to: Vec3) -> Option<f32> {
+    let [a, b, c] = *triangle;
     let direction = to - from;
-    mesh.triangles()
-        .filter(|t| {
-            let [a, b, c] = t.map(|k| transform.transform_point3(mesh.positions[k as usize]));
-            let (edge1, edge2) = (b - a, c - a);
-            let p = direction.cross(edge2);
-            let determinant = edge1.dot(p);
-            if determinant.abs() <= f32::EPSILON * edge1.length() * edge2.length() * direction.length() {
-                return false;
+    let (edge1, edge2) = (b - a, c - a);
+    let p = direction.cross(edge2);
+    let determinant = edge1.dot(p);
+    if determinant.abs() <= f32::EPSILON * edge1.length() * edge2.length() * direction.length() {
+        return None;
+    }
+    let inverse = 1.0 / determinant;
+    let offset = from - a;
+    let u = offset.dot(p) * inverse;
+    let q = offset.cross(edge1);
+    let v = direction.dot(q) * inverse;
+    let t = edge2.dot(q) * inverse;
+    (u > 0.0 && v > 0.0 && u + v < 1.0 && (0.0..=1.0).contains(&t)).then_some(t)
+}
+
+/// How many of `triangles` the segment from `from` to `to` crosses; `None` when a crossing lies
+/// within a millionth of the segment of either end (an end on the surface: its side is unknown).
+fn segment_crossings(triangles: &[[Vec3; 3]], from: Vec3, to: Vec3) -> Option<usize> {
+    let mut count = 0;
+    for triangle in triangles {
+        if let Some(t) = segment_hit(triangle, from, to) {
+            if !(1e-6..=1.0 - 1e-6).contains(&t) {
+                return None;
             }
-            let inverse = 1.0 / determinant;
-            let offset = from - a;
-            let u = offset.dot(p) * inverse;
-            let q = offset.cross(edge1);
-            let v = direction.dot(q) * inverse;
-            let t = edge2.dot(q) * inverse;
-            u > 0.0 && v > 0.0 && u + v < 1.0 && t > 0.0 && t < 1.0
-        })
-        .count()
+            count += 1;
+        }
+    }
+    Some(count)
+}
+
+/// True when the rectangle with corners `corners` (in order around it) and `triangle` meet: an
+/// edge of either crosses the other (the rectangle as its two triangles). Coplanar overlap is
+/// not seen, which a light flush on a surface needs: its side is the one it emits to.
+fn rectangle_meets_triangle(corners: &[Vec3; 4], triangle: &[Vec3; 3]) -> bool {
+    let halves = [[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]];
+    let triangle_edges = (0..3).any(|k| halves.iter().any(|half| segment_hit(half, triangle[k], triangle[(k + 1) % 3]).is_some()));
+    triangle_edges || (0..4).any(|k| segment_hit(triangle, corners[k], corners[(k + 1) % 4]).is_some())
 }
 
 /// The matrix that carries normals of an object with this transform (inverse transpose).
@@ -368,5 +398,36 @@ mod tests {
         assert!(!scene.separates_light_from(&closed, &straddling, outside_eye), "straddling light");
         // An open quad separates nothing.
         assert!(!scene.separates_light_from(&closed, &light(Vec3::new(0.0, 6.0, 0.0), 0.5), Vec3::new(0.0, 4.0, 0.0)), "open quad");
+        // A light flush on the box's ceiling, facing down, lights the box's inside; one lying on
+        // its top, facing up, lights the outside: neither is sealed from an eye on its side.
+        let flush = light(Vec3::new(0.3, 1.0, 0.2), 0.5);
+        assert!(!scene.separates_light_from(&closed, &flush, Vec3::new(-0.5, -0.5, 0.5)), "flush on the ceiling");
+        let on_top = RectLight::try_facing(Vec3::new(0.3, 1.0, 0.2), Vec3::Y, Vec3::X, glam::Vec2::splat(0.5), 1.0)
+            .unwrap_or_else(|| panic!("light"));
+        assert!(!scene.separates_light_from(&closed, &on_top, outside_eye), "lying on the top");
+        assert!(scene.separates_light_from(&closed, &on_top, Vec3::new(-0.5, -0.5, 0.5)), "lying on the top, eye inside");
+    }
+
+    /// Three closed boxes in a row, one mesh: a light whose centre and corners all lie inside
+    /// boxes, but whose edges cross the gaps between them, is not sealed.
+    #[test]
+    fn a_light_whose_edges_leave_a_closed_mesh_is_not_sealed() {
+        let cube = crate::primitives::cuboid("box", Vec3::ONE);
+        let mut row = Mesh { name: "row".into(), positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
+        for x in [-2.0f32, 0.0, 2.0] {
+            let base = row.positions.len() as u32;
+            row.positions.extend(cube.positions.iter().map(|p| *p + Vec3::new(x, 0.0, 0.0)));
+            row.normals.extend_from_slice(&cube.normals);
+            row.indices.extend(cube.indices.iter().map(|i| base + i));
+        }
+        let long = RectLight::try_facing(Vec3::ZERO, -Vec3::Y, Vec3::X, glam::Vec2::new(4.4, 0.4), 1.0).unwrap_or_else(|| panic!("light"));
+        let mut scene = boxed(Vec3::ZERO, long);
+        scene.meshes[0] = row;
+        let closed = scene.closed_meshes();
+        assert!(closed[0]);
+        let eye = Vec3::new(0.0, 4.0, 6.0);
+        assert!(!scene.separates_light_from(&closed, &long, eye), "the light's edges cross the gaps");
+        let short = RectLight { half_size: glam::Vec2::splat(0.2), ..long };
+        assert!(scene.separates_light_from(&closed, &short, eye), "a light inside the middle box");
     }
 }
