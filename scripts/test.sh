@@ -16,3 +16,5 @@ cargo fmt --all --check
 cargo clippy --workspace --all-targets --locked -- -D warnings
 # --all-targets also runs the criterion benches once each, in their test mode.
 cargo test --workspace --all-targets --locked
+# The documentation's examples (--all-targets leaves them out): ssm-scene's opening example.
+cargo test --workspace --doc --locked

@@ -8,6 +8,68 @@
 //! - [`Adjacency`] (edge–face, on welded positions) is computed only when asked.
 //!
 //! Every failure is a [`SceneError`] that names the file and the element.
+//!
+//! # Example
+//!
+//! A glTF model (one triangle, its buffer inline), placed by a TOML manifest over a ground
+//! plane under a square area light; then the world-space triangles and the lights:
+//!
+//! ```
+//! use ssm_scene::Scene;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let folder = std::env::temp_dir().join(format!("ssm-scene-example-{}", std::process::id()));
+//! std::fs::create_dir_all(&folder)?;
+//! std::fs::write(
+//!     folder.join("triangle.gltf"),
+//!     r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+//!         "nodes": [{"name": "leaf", "mesh": 0}],
+//!         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+//!         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+//!                        "min": [-0.5, 1.0, -0.5], "max": [0.5, 1.0, 0.5]}],
+//!         "bufferViews": [{"buffer": 0, "byteLength": 36}],
+//!         "buffers": [{"byteLength": 36,
+//!                      "uri": "data:application/octet-stream;base64,AAAAvwAAgD8AAAC/AAAAAAAAgD8AAAA/AAAAPwAAgD8AAAC/"}]}"#,
+//! )?;
+//! std::fs::write(
+//!     folder.join("scene.toml"),
+//!     r#"
+//!     [[light]]
+//!     centre = [0.0, 3.0, 0.0]
+//!     normal = [0.0, -1.0, 0.0]
+//!     size = [0.5, 0.5]
+//!
+//!     [[object]]
+//!     model = "triangle.gltf"    # relative to the manifest
+//!     scale = 2.0
+//!     role = "occluder"
+//!
+//!     [[object]]
+//!     primitive = "plane"
+//!     size = [8.0, 8.0]
+//!     role = "receiver"
+//!     "#,
+//! )?;
+//!
+//! // A manifest, a bare model (staged with a ground, a light and a camera) or a built-in name.
+//! let (scene, _source) = Scene::load(&folder.join("scene.toml").to_string_lossy())?;
+//! let mut casting = 0;
+//! for triangle in scene.world_triangles() {
+//!     // World-space corners and normals, and the role of the instance it belongs to.
+//!     let [a, b, c] = triangle.corners;
+//!     assert!((b - a).cross(c - a).length() > 0.0);
+//!     casting += usize::from(triangle.role.casts());
+//! }
+//! assert_eq!((scene.triangle_count(), casting), (3, 1));
+//! for light in &scene.lights {
+//!     // A one-sided rectangle: centre, unit axes, half extents, normal.
+//!     println!("light at {} facing {}, area {}", light.centre, light.normal(), light.area());
+//! }
+//! assert_eq!(scene.lights[0].area(), 0.25);
+//! std::fs::remove_dir_all(&folder)?;
+//! # Ok(())
+//! # }
+//! ```
 
 mod adjacency;
 mod builtin;
