@@ -194,6 +194,24 @@ fn list_and_scenes_name_everything() {
     }
 }
 
+/// A reader that stops reading (`ssm list | head`) is not a failure: no error line, exit 0. The
+/// pipe's reading end is closed before `ssm` writes (it opens the adapter first), so its first
+/// line meets a closed pipe every time.
+#[test]
+fn a_reader_that_stops_reading_is_not_a_failure() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .arg("list")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the ssm binary runs");
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{:?}: {stderr}", output.status);
+    assert!(!stderr.lines().any(|l| l.starts_with("error")), "{stderr}");
+}
+
 #[test]
 fn bad_arguments_fail_with_one_line() {
     let out = out_dir("bad");

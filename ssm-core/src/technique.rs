@@ -328,7 +328,8 @@ inventory::collect!(TechniqueInfo);
 ///
 /// The crate must be linked into the binary for the registration to be
 /// present; binaries call its `link()` (the `ssm` tool does so for every
-/// technique crate in `ssm_bench::link_techniques`).
+/// technique crate through `ssm_techniques::link_all`; a standalone binary
+/// calls its own technique's `link()`, then `ssm_bench::run()`).
 #[macro_export]
 macro_rules! register_technique {
     ($info:expr $(,)?) => {

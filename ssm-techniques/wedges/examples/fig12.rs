@@ -23,8 +23,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use ssm_bench::charts::{PlotAxes, PlotPoint, plot};
 use ssm_bench::report::measure;
-use ssm_bench::sweep::{PlotAxes, PlotPoint, plot};
 use ssm_core::metrics::{ShadowClass, classify, compare};
 use ssm_core::{GpuContext, Renderer, Requirements};
 use ssm_wedges::scenes::{FIG12_SIDES, PAPER_RINGS, PAPER_SEGMENTS, sphere_cube};
