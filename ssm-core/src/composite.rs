@@ -34,7 +34,7 @@ impl Composite {
         // Both pipelines once per device, shared by every renderer.
         let build = |entry: &'static str, blend: Option<wgpu::BlendState>| {
             gpu.cached_render_pipeline(&format!("{entry}_pipeline"), |gpu| {
-                let module = create_shader(gpu, "composite_shader", include_str!("../../shaders/core/composite.wgsl"))?;
+                let module = create_shader(gpu, "composite_shader", ssm_shaders::core::COMPOSITE)?;
                 let layouts = [gpu.uniform_layout(), gpu.gbuffer_layout(), gpu.texture_layout()];
                 let target = wgpu::ColorTargetState { format: Self::FORMAT, blend, write_mask: wgpu::ColorWrites::ALL };
                 Ok(fullscreen_pipeline(&gpu.device, &format!("{entry}_pipeline"), &module, entry, &layouts, &[target], &[]))

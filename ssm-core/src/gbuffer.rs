@@ -73,7 +73,7 @@ impl GBuffer {
         // One pipeline per device, shared by every renderer.
         let pipeline = gpu.cached_render_pipeline("gbuffer_pipeline", |gpu| {
             let device = &gpu.device;
-            let module = create_shader(gpu, "gbuffer_shader", include_str!("../../shaders/core/gbuffer.wgsl"))?;
+            let module = create_shader(gpu, "gbuffer_shader", ssm_shaders::core::GBUFFER)?;
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("gbuffer_pipeline_layout"),
                 bind_group_layouts: &[Some(gpu.uniform_layout())],

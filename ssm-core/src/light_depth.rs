@@ -162,7 +162,7 @@ impl LightDepthMap {
         let key = format!("light_depth_pipeline/{cull_mode:?}/farthest={farthest}");
         gpu.cached_render_pipeline(&key, |gpu| {
             let device = &gpu.device;
-            let module = create_shader(gpu, "light_depth_shader", include_str!("../../shaders/core/light_depth.wgsl"))?;
+            let module = create_shader(gpu, "light_depth_shader", ssm_shaders::core::LIGHT_DEPTH)?;
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("light_depth_pipeline_layout"),
                 bind_group_layouts: &[Some(gpu.uniform_layout()), Some(gpu.uniform_layout())],

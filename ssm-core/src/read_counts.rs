@@ -119,6 +119,6 @@ mod tests {
     #[test]
     fn the_shaders_bucket_count_is_the_same() {
         let line = format!("const READ_COUNT_BUCKETS: u32 = {}u;", super::READ_COUNT_BUCKETS);
-        assert!(include_str!("../../shaders/common/read_counts.wgsl").contains(&line), "common/read_counts.wgsl lacks `{line}`");
+        assert!(ssm_shaders::common::READ_COUNTS.contains(&line), "common/read_counts.wgsl lacks `{line}`");
     }
 }

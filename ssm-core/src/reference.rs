@@ -1080,8 +1080,7 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
             (texture, group)
         })
         .collect();
-    let module =
-        crate::shader::create_shader(setup.gpu, "reference_upload_shader", include_str!("../../shaders/core/reference_upload.wgsl"))?;
+    let module = crate::shader::create_shader(setup.gpu, "reference_upload_shader", ssm_shaders::core::REFERENCE_UPLOAD)?;
     let upload = crate::ScreenPass::new(
         setup,
         NAME,

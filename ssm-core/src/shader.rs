@@ -7,24 +7,8 @@
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 
-/// `(import path, text)` of one file under `shaders/common/`.
-macro_rules! common_shader {
-    ($file:literal) => {
-        (concat!("common/", $file), include_str!(concat!("../../shaders/common/", $file)))
-    };
-}
-
-/// The shared WGSL files, by the path an import names.
-pub const COMMON_SHADERS: &[(&str, &str)] = &[
-    common_shader!("fullscreen.wgsl"),
-    common_shader!("camera.wgsl"),
-    common_shader!("scene.wgsl"),
-    common_shader!("light_frame.wgsl"),
-    common_shader!("shadow_map.wgsl"),
-    common_shader!("shadow_map_reads.wgsl"),
-    common_shader!("screen_pass.wgsl"),
-    common_shader!("read_counts.wgsl"),
-];
+/// The shared WGSL files (`shaders/common/`), by the path an import names.
+pub const COMMON_SHADERS: &[(&str, &str)] = ssm_shaders::common::FILES;
 
 /// The prefix of an import line.
 pub const IMPORT_PREFIX: &str = "// #import ";

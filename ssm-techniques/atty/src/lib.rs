@@ -40,24 +40,24 @@ use ssm_core::{
 pub const NAME: &str = "atty";
 
 /// The micro-patch geometry the list pass and the accumulation evaluate, twin of [`geometry`].
-pub const GEOMETRY_SHADER: &str = include_str!("../../../shaders/atty/atty_geometry.wgsl");
+pub const GEOMETRY_SHADER: &str = ssm_shaders::atty::ATTY_GEOMETRY;
 /// WGSL files the Atty shaders import besides `common/`, as `(path under shaders/, text)`.
 pub const LOCAL_SHADERS: &[(&str, &str)] =
-    &[("atty/atty_settings.wgsl", include_str!("../../../shaders/atty/atty_settings.wgsl")), ("atty/atty_geometry.wgsl", GEOMETRY_SHADER)];
+    &[("atty/atty_settings.wgsl", ssm_shaders::atty::ATTY_SETTINGS), ("atty/atty_geometry.wgsl", GEOMETRY_SHADER)];
 /// The accumulation of micro-patches into the SSM.
-const ACCUMULATE_SHADER: &str = include_str!("../../../shaders/atty/atty_accumulate.wgsl");
+const ACCUMULATE_SHADER: &str = ssm_shaders::atty::ATTY_ACCUMULATE;
 /// The projection of the SSM onto the screen.
-const PROJECT_SHADER: &str = include_str!("../../../shaders/atty/atty_project.wgsl");
+const PROJECT_SHADER: &str = ssm_shaders::atty::ATTY_PROJECT;
 /// The micro-patch list the accumulation draws.
-const PATCHES_SHADER: &str = include_str!("../../../shaders/atty/atty_patches.wgsl");
+const PATCHES_SHADER: &str = ssm_shaders::atty::ATTY_PATCHES;
 /// Bytes of one micro-patch record (`MicroPatchRecord` in `atty_settings.wgsl`).
 const PATCH_RECORD_BYTES: u64 = 32;
 /// The receiver map's max-pyramid.
-const RECEIVER_BOUNDS_SHADER: &str = include_str!("../../../shaders/atty/atty_receiver_bounds.wgsl");
+const RECEIVER_BOUNDS_SHADER: &str = ssm_shaders::atty::ATTY_RECEIVER_BOUNDS;
 /// The receivers' tangent planes, measured from the receiver map.
-const RECEIVER_PLANES_SHADER: &str = include_str!("../../../shaders/atty/atty_receiver_planes.wgsl");
+const RECEIVER_PLANES_SHADER: &str = ssm_shaders::atty::ATTY_RECEIVER_PLANES;
 /// An occluder map's min-max pyramid.
-const PATCH_MERGE_SHADER: &str = include_str!("../../../shaders/atty/atty_patch_merge.wgsl");
+const PATCH_MERGE_SHADER: &str = ssm_shaders::atty::ATTY_PATCH_MERGE;
 
 /// An occluder map's depth range per block.
 const PATCH_MERGE: PyramidKind = PyramidKind {

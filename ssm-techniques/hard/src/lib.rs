@@ -19,7 +19,7 @@ use ssm_core::{
 pub const NAME: &str = "hard";
 
 /// The lookup shader.
-const SHADER: &str = include_str!("../../../shaders/hard/hard.wgsl");
+const SHADER: &str = ssm_shaders::hard::HARD;
 
 /// Settings of [`HardShadowMapping`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]

@@ -22,7 +22,7 @@ use ssm_core::{
 pub const NAME: &str = "multi-sm";
 
 /// The accumulation shader.
-const SHADER: &str = include_str!("../../../shaders/multi-sm/multi_sm.wgsl");
+const SHADER: &str = ssm_shaders::multi_sm::MULTI_SM;
 
 /// Settings of [`MultiShadowMaps`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]

@@ -26,11 +26,11 @@ use ssm_core::{
 pub const NAME: &str = "pcss";
 
 /// What both passes share: the settings, the bindings, the blocker search and the filter.
-const COMMON_SHADER: &str = include_str!("../../../shaders/pcss/pcss_common.wgsl");
+const COMMON_SHADER: &str = ssm_shaders::pcss::PCSS_COMMON;
 /// The fragment pass.
-const SHADER: &str = include_str!("../../../shaders/pcss/pcss.wgsl");
+const SHADER: &str = ssm_shaders::pcss::PCSS;
 /// The compute pass whose workgroups share the texels they read.
-const TILED_SHADER: &str = include_str!("../../../shaders/pcss/pcss_tiled.wgsl");
+const TILED_SHADER: &str = ssm_shaders::pcss::PCSS_TILED;
 /// WGSL files the PCSS shaders import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("pcss/pcss_common.wgsl", COMMON_SHADER)];
 /// The label of the pass (both implementations), and of its read counts.

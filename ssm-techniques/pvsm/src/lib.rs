@@ -45,19 +45,19 @@ pub use prediction::Prediction;
 pub const NAME: &str = "pvsm";
 
 /// WGSL files the PVSM shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("pvsm/pvsm_common.wgsl", include_str!("../../../shaders/pvsm/pvsm_common.wgsl"))];
+const LOCAL_SHADERS: &[(&str, &str)] = &[("pvsm/pvsm_common.wgsl", ssm_shaders::pvsm::PVSM_COMMON)];
 /// Step 2: the conservative low-resolution map.
-const CONSERVATIVE_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_conservative.wgsl");
+const CONSERVATIVE_SHADER: &str = ssm_shaders::pvsm::PVSM_CONSERVATIVE;
 /// Steps 3–4: the kernel shape and the prediction.
-const KERNEL_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_kernel.wgsl");
+const KERNEL_SHADER: &str = ssm_shaders::pvsm::PVSM_KERNEL;
 /// Step 5: the grid's pyramid.
-const PYRAMID_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_pyramid.wgsl");
+const PYRAMID_SHADER: &str = ssm_shaders::pvsm::PVSM_PYRAMID;
 /// Step 2's minimum-depth mip chain.
-const MIPS_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_mips.wgsl");
+const MIPS_SHADER: &str = ssm_shaders::pvsm::PVSM_MIPS;
 /// Step 8 and the merge.
-const FILTER_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_filter.wgsl");
+const FILTER_SHADER: &str = ssm_shaders::pvsm::PVSM_FILTER;
 /// Step 7's culling to the tile.
-const CULL_SHADER: &str = include_str!("../../../shaders/pvsm/pvsm_cull.wgsl");
+const CULL_SHADER: &str = ssm_shaders::pvsm::PVSM_CULL;
 
 /// How the low-resolution map is rasterised conservatively (step 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]

@@ -29,21 +29,21 @@ pub const NAME: &str = "sssm";
 
 /// WGSL files the SSSM passes import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[
-    ("sssm/sssm_common.wgsl", include_str!("../../../shaders/sssm/sssm_common.wgsl")),
-    ("sssm/sssm_blocker_blur.wgsl", include_str!("../../../shaders/sssm/sssm_blocker_blur.wgsl")),
-    ("sssm/sssm_vertical_blur.wgsl", include_str!("../../../shaders/sssm/sssm_vertical_blur.wgsl")),
-    ("sssm/sssm_segment.wgsl", include_str!("../../../shaders/sssm/sssm_segment.wgsl")),
+    ("sssm/sssm_common.wgsl", ssm_shaders::sssm::SSSM_COMMON),
+    ("sssm/sssm_blocker_blur.wgsl", ssm_shaders::sssm::SSSM_BLOCKER_BLUR),
+    ("sssm/sssm_vertical_blur.wgsl", ssm_shaders::sssm::SSSM_VERTICAL_BLUR),
+    ("sssm/sssm_segment.wgsl", ssm_shaders::sssm::SSSM_SEGMENT),
 ];
 /// Step 1: hard shadow and horizontal partial blocker sums.
-const HORIZONTAL_BLOCKER_SHADER: &str = include_str!("../../../shaders/sssm/sssm_horizontal_blocker.wgsl");
+const HORIZONTAL_BLOCKER_SHADER: &str = ssm_shaders::sssm::SSSM_HORIZONTAL_BLOCKER;
 /// Step 2 (blocker average, penumbra size, horizontal blur) as a fragment pass.
-const BLOCKER_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur_fragment.wgsl");
+const BLOCKER_BLUR_FRAGMENT_SHADER: &str = ssm_shaders::sssm::SSSM_BLOCKER_BLUR_FRAGMENT;
 /// Step 2 as a compute pass sharing each workgroup's screen row.
-const BLOCKER_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_blocker_blur_compute.wgsl");
+const BLOCKER_BLUR_COMPUTE_SHADER: &str = ssm_shaders::sssm::SSSM_BLOCKER_BLUR_COMPUTE;
 /// Step 3 (vertical blur) as a fragment pass.
-const VERTICAL_BLUR_FRAGMENT_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_fragment.wgsl");
+const VERTICAL_BLUR_FRAGMENT_SHADER: &str = ssm_shaders::sssm::SSSM_VERTICAL_BLUR_FRAGMENT;
 /// Step 3 as a compute pass sharing each workgroup's screen column.
-const VERTICAL_BLUR_COMPUTE_SHADER: &str = include_str!("../../../shaders/sssm/sssm_vertical_blur_compute.wgsl");
+const VERTICAL_BLUR_COMPUTE_SHADER: &str = ssm_shaders::sssm::SSSM_VERTICAL_BLUR_COMPUTE;
 /// The binding of the shadow map as a read-only storage texture in every pass's group 2
 /// (`shadow_map_storage` of sssm_common.wgsl), past the passes' own. With it the shared-row step
 /// 2 binds four storage textures (its three targets and this), WebGPU's guaranteed minimum per

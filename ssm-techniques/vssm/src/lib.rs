@@ -26,11 +26,11 @@ use ssm_core::{
 pub const NAME: &str = "vssm";
 
 /// What the table and filter passes share.
-const COMMON_SHADER: &str = include_str!("../../../shaders/vssm/vssm_common.wgsl");
+const COMMON_SHADER: &str = ssm_shaders::vssm::VSSM_COMMON;
 /// The summed-area table's two passes.
-const SAT_SHADER: &str = include_str!("../../../shaders/vssm/vssm_sat.wgsl");
+const SAT_SHADER: &str = ssm_shaders::vssm::VSSM_SAT;
 /// The blocker search, penumbra estimate and filter.
-const FILTER_SHADER: &str = include_str!("../../../shaders/vssm/vssm.wgsl");
+const FILTER_SHADER: &str = ssm_shaders::vssm::VSSM;
 /// WGSL files the VSSM shaders import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
 

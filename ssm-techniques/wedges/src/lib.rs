@@ -56,17 +56,17 @@ pub use plan::{AllocationPlan, FINAL_BINDING_BYTES_PER_PIXEL, PlannedBuffer, STO
 pub const NAME: &str = "wedges";
 
 /// WGSL files the wedges shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("wedges/wedges_common.wgsl", include_str!("../../../shaders/wedges/wedges_common.wgsl"))];
+const LOCAL_SHADERS: &[(&str, &str)] = &[("wedges/wedges_common.wgsl", ssm_shaders::wedges::WEDGES_COMMON)];
 /// Silhouettes, regions, groups, wedge construction (compute).
-const SILHOUETTES_SHADER: &str = include_str!("../../../shaders/wedges/wedges_silhouettes.wgsl");
+const SILHOUETTES_SHADER: &str = ssm_shaders::wedges::WEDGES_SILHOUETTES;
 /// The G-buffer's depth into the stencil target.
-const DEPTH_COPY_SHADER: &str = include_str!("../../../shaders/wedges/wedges_depth_copy.wgsl");
+const DEPTH_COPY_SHADER: &str = ssm_shaders::wedges::WEDGES_DEPTH_COPY;
 /// z-fail shadow volumes.
-const VOLUMES_SHADER: &str = include_str!("../../../shaders/wedges/wedges_volumes.wgsl");
+const VOLUMES_SHADER: &str = ssm_shaders::wedges::WEDGES_VOLUMES;
 /// Penumbra wedges.
-const WEDGES_SHADER: &str = include_str!("../../../shaders/wedges/wedges_wedges.wgsl");
+const WEDGES_SHADER: &str = ssm_shaders::wedges::WEDGES_WEDGES;
 /// Blending and resolve.
-const BLEND_SHADER: &str = include_str!("../../../shaders/wedges/wedges_blend.wgsl");
+const BLEND_SHADER: &str = ssm_shaders::wedges::WEDGES_BLEND;
 
 /// Most silhouette buffers (`MAX_SILHOUETTE_BUFFERS` in the WGSL).
 pub const MAX_SILHOUETTE_BUFFERS: u32 = 64;
