@@ -22,6 +22,7 @@ macro_rules! say {
 mod compare;
 mod list;
 mod merge;
+mod new;
 mod render;
 mod sweep;
 mod view;
@@ -37,6 +38,7 @@ pub(crate) fn parse_and_run() -> Result<()> {
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::View(args) => view::run(&args),
+        Command::New(args) => new::run(&args),
     }
 }
 
@@ -64,6 +66,9 @@ enum Command {
     View(view::ViewArgs),
     /// Put the shards of a sweep (`ssm sweep --shard K/N` outputs) back together: sweep.csv, sweep.md and the plot.
     Merge(merge::MergeArgs),
+    /// Start a new technique: its crate, WGSL, README and test, a percentage-closer filter to replace with a paper's method; in
+    /// this checkout (and the facade's one line), or with --standalone DIR as a crate of its own whose binary is `ssm` with it linked.
+    New(new::NewArgs),
 }
 
 /// How a command prints what it found.
