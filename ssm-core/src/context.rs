@@ -14,6 +14,7 @@ use crate::passes::{texture_entry, uniform_entry};
 pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::FLOAT32_BLENDABLE
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::TIMESTAMP_QUERY)
+    .union(wgpu::Features::PIPELINE_STATISTICS_QUERY)
     .union(wgpu::Features::SHADER_F16)
     .union(wgpu::Features::CONSERVATIVE_RASTERIZATION)
     .union(wgpu::Features::DEPTH32FLOAT_STENCIL8)
@@ -202,6 +203,12 @@ impl GpuContext {
     #[must_use]
     pub fn features(&self) -> wgpu::Features {
         self.device.features()
+    }
+
+    /// True when each pass's invocations can be counted on the GPU (`ssm --count-work`).
+    #[must_use]
+    pub fn has_pipeline_statistics(&self) -> bool {
+        self.features().contains(wgpu::Features::PIPELINE_STATISTICS_QUERY)
     }
 
     /// True when passes can be timed on the GPU.

@@ -6,6 +6,7 @@ use crate::gbuffer::GBuffer;
 use crate::gpu_scene::GpuScene;
 use crate::passes::color_attachment;
 use crate::timing::PassTimer;
+use crate::work::{StatisticsQueries, stored_target_bytes};
 
 /// Shared inputs built by the framework, each only when a technique in use
 /// declared it in its [`Requirements`](crate::Requirements).
@@ -57,13 +58,22 @@ pub struct Frame<'a> {
     group: String,
     /// What the last [`Frame::read_back`] waited for the GPU, ms.
     read_back_wait_ms: f64,
+    /// In a counting frame ([`Renderer::count_work`](crate::Renderer::count_work)): the pipeline
+    /// statistics queried around each pass.
+    statistics: Option<&'a mut StatisticsQueries>,
 }
 
 impl<'a> Frame<'a> {
     /// A frame for technique `group` (the debug group its passes go in).
     pub(crate) fn new(gpu: &'a GpuContext, scene: &'a GpuScene, shared: &'a SharedInputs, timer: &'a mut PassTimer, group: &str) -> Self {
         let encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&format!("{group}_frame_encoder")) });
-        Self { gpu, scene, shared, encoder, timer, group: group.to_owned(), read_back_wait_ms: 0.0 }
+        Self { gpu, scene, shared, encoder, timer, group: group.to_owned(), read_back_wait_ms: 0.0, statistics: None }
+    }
+
+    /// This frame, counting each pass's work into `statistics`.
+    pub(crate) fn counting(mut self, statistics: &'a mut StatisticsQueries) -> Self {
+        self.statistics = Some(statistics);
+        self
     }
 
     /// Starts light `light`'s passes: clears `target` to fully lit (the
@@ -88,27 +98,44 @@ impl<'a> Frame<'a> {
         self.encoder
     }
 
-    /// Begins a render pass labelled `label`, timed under that name.
+    /// Begins a render pass labelled `label`, timed under that name (and, in a counting frame,
+    /// with its pipeline statistics queried). The pass derefs to a [`wgpu::RenderPass`].
     pub fn render_pass<'p>(
         &'p mut self,
         label: &str,
         color_attachments: &[Option<wgpu::RenderPassColorAttachment<'_>>],
         depth_stencil_attachment: Option<wgpu::RenderPassDepthStencilAttachment<'_>>,
-    ) -> wgpu::RenderPass<'p> {
-        let timestamp_writes = self.timer.render_pass(label);
-        self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+    ) -> CountedRenderPass<'p> {
+        let Self { encoder, timer, statistics, .. } = self;
+        let target_bytes = statistics.as_ref().map(|_| stored_target_bytes(color_attachments, depth_stencil_attachment.as_ref()));
+        let timestamp_writes = timer.render_pass(label);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments,
             depth_stencil_attachment,
             timestamp_writes,
             ..Default::default()
-        })
+        });
+        let query = statistics.as_mut().zip(target_bytes).and_then(|(queries, bytes)| queries.allocate(label, bytes));
+        let counting = query.is_some();
+        if let Some((query_set, index)) = query {
+            pass.begin_pipeline_statistics_query(query_set, index);
+        }
+        CountedRenderPass { pass, counting }
     }
 
-    /// Begins a compute pass labelled `label`, timed under that name.
-    pub fn compute_pass(&mut self, label: &str) -> wgpu::ComputePass<'_> {
-        let timestamp_writes = self.timer.compute_pass(label);
-        self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes })
+    /// Begins a compute pass labelled `label`, timed under that name (and, in a counting frame,
+    /// with its pipeline statistics queried). The pass derefs to a [`wgpu::ComputePass`].
+    pub fn compute_pass(&mut self, label: &str) -> CountedComputePass<'_> {
+        let Self { encoder, timer, statistics, .. } = self;
+        let timestamp_writes = timer.compute_pass(label);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
+        let query = statistics.as_mut().and_then(|queries| queries.allocate(label, 0));
+        let counting = query.is_some();
+        if let Some((query_set, index)) = query {
+            pass.begin_pipeline_statistics_query(query_set, index);
+        }
+        CountedComputePass { pass, counting }
     }
 
     /// Copies a texture region into a buffer, marked `label` in captures.
@@ -188,5 +215,61 @@ impl<'a> Frame<'a> {
         let out = work();
         self.timer.cpu_scope(label, start.elapsed().as_secs_f64() * 1e3);
         out
+    }
+}
+
+/// A render pass opened by [`Frame::render_pass`]: a [`wgpu::RenderPass`] (through `Deref`) that,
+/// in a counting frame, ends its pipeline-statistics query when dropped.
+pub struct CountedRenderPass<'p> {
+    pass: wgpu::RenderPass<'p>,
+    counting: bool,
+}
+
+impl<'p> std::ops::Deref for CountedRenderPass<'p> {
+    type Target = wgpu::RenderPass<'p>;
+    fn deref(&self) -> &Self::Target {
+        &self.pass
+    }
+}
+
+impl std::ops::DerefMut for CountedRenderPass<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.pass
+    }
+}
+
+impl Drop for CountedRenderPass<'_> {
+    fn drop(&mut self) {
+        if self.counting {
+            self.pass.end_pipeline_statistics_query();
+        }
+    }
+}
+
+/// A compute pass opened by [`Frame::compute_pass`]: a [`wgpu::ComputePass`] (through `Deref`)
+/// that, in a counting frame, ends its pipeline-statistics query when dropped.
+pub struct CountedComputePass<'p> {
+    pass: wgpu::ComputePass<'p>,
+    counting: bool,
+}
+
+impl<'p> std::ops::Deref for CountedComputePass<'p> {
+    type Target = wgpu::ComputePass<'p>;
+    fn deref(&self) -> &Self::Target {
+        &self.pass
+    }
+}
+
+impl std::ops::DerefMut for CountedComputePass<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.pass
+    }
+}
+
+impl Drop for CountedComputePass<'_> {
+    fn drop(&mut self) {
+        if self.counting {
+            self.pass.end_pipeline_statistics_query();
+        }
     }
 }

@@ -37,10 +37,11 @@ mod screen_pass;
 pub mod shader;
 mod technique;
 mod timing;
+pub mod work;
 
 pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
 pub use error::{BoxedError, Error, Reason, Result};
-pub use frame::{Frame, SharedInputs};
+pub use frame::{CountedComputePass, CountedRenderPass, Frame, SharedInputs};
 pub use gbuffer::GBuffer;
 pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SURFACE_CLOSED, SceneVertex};
 pub use light_depth::{
@@ -58,6 +59,7 @@ pub use technique::{
     UniformCheck, UniformStruct,
 };
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
+pub use work::{FrameWork, PassWork, ShaderWork};
 
 /// Re-exported so that technique crates can register without depending on it.
 pub use inventory;

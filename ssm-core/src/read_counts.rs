@@ -18,6 +18,7 @@
 //! read_count_word(pass_index, texel);` then `atomicAdd(&counts[word], 1u);
 //! atomicAdd(&counts[word + 1u], reads);`.
 
+use crate::work::ShaderWork;
 use crate::{Frame, GpuContext};
 
 /// Buckets (pairs of pixel and read counts) per pass.
@@ -85,6 +86,42 @@ impl ReadCounts {
         if self.enabled && light == 0 {
             frame.clear_buffer("read_counts_clear", &self.buffer, 0, None);
         }
+    }
+
+    /// The counters' totals over the last frame as each pass's [`ShaderWork`]: a counter whose
+    /// unit is `reads` gives texel reads, `atomics` atomics, `storage_bytes` bytes written to
+    /// storage (other units, such as sssm's `rows`, are diagnostics only); a pass's invocations
+    /// are the most pixels any of its counters counted. `None` when not counting.
+    ///
+    /// # Errors
+    /// A readback error.
+    pub fn work(&self, gpu: &GpuContext) -> crate::Result<Option<Vec<ShaderWork>>> {
+        if !self.enabled {
+            return Ok(None);
+        }
+        let bytes = crate::readback::read_buffer(gpu, &self.buffer, self.buffer.size(), "read counts")?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let mut work: Vec<ShaderWork> = Vec::new();
+        for ((name, unit), buckets) in self.counters.iter().zip(words.chunks_exact(2 * READ_COUNT_BUCKETS)) {
+            let invocations: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[0])).sum();
+            let counted: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[1])).sum();
+            let index = match work.iter().position(|pass| pass.pass == *name) {
+                Some(index) => index,
+                None => {
+                    work.push(ShaderWork { pass: (*name).to_owned(), ..ShaderWork::default() });
+                    work.len() - 1
+                }
+            };
+            let pass = &mut work[index];
+            pass.invocations = pass.invocations.max(invocations);
+            match *unit {
+                "reads" => pass.texel_reads += counted,
+                "atomics" => pass.atomics += counted,
+                "storage_bytes" => pass.storage_bytes += counted,
+                _ => {}
+            }
+        }
+        Ok(Some(work))
     }
 
     /// `<pass>_reads_per_pixel` (`<name>_<unit>_per_pixel`) and `<pass>_pixels` for each counter

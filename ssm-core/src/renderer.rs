@@ -17,6 +17,7 @@ use crate::passes::{labelled_view, render_texture};
 use crate::readback::read_texture;
 use crate::technique::{Requirements, ShadowTechnique, TechniqueInfo, create_checked};
 use crate::timing::{FrameTimings, PassTimer, PassTiming};
+use crate::work::{FrameWork, StatisticsQueries};
 
 /// Format of the visibility targets.
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
@@ -110,7 +111,41 @@ impl Renderer {
     /// [`Error::MissingFeatures`], [`Error::LimitTooLow`], [`Error::UndeclaredRequirement`],
     /// or whatever the technique's constructor reports.
     pub fn create_technique(&self, info: &TechniqueInfo, params: &ParamValues) -> Result<Box<dyn ShadowTechnique>> {
-        create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), (&self.shared, &self.visibility_views), params)
+        create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), (&self.shared, &self.visibility_views), params, false)
+    }
+
+    /// Counts the work of one frame of technique `info` with `params` (every light): builds it
+    /// for counting ([`TechniqueSetup::count_work`](crate::TechniqueSetup::count_work)), renders
+    /// one untimed frame with each pass's pipeline statistics queried, and joins what its shaders
+    /// counted ([`ShadowTechnique::counted_work`]). The visibility it writes is the technique's
+    /// own (counting changes no result), so a timed frame rendered after it reads the same.
+    ///
+    /// # Errors
+    /// As [`Renderer::create_technique`] and [`Renderer::render`].
+    pub fn count_work(&mut self, info: &TechniqueInfo, params: &ParamValues) -> Result<FrameWork> {
+        let mut technique =
+            create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), (&self.shared, &self.visibility_views), params, true)?;
+        let mut statistics = StatisticsQueries::new(&self.gpu);
+        self.timer.reset();
+        let mut frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, info.name).counting(&mut statistics);
+        for (light, view) in self.visibility_views.iter().enumerate() {
+            frame.begin_light(light, view);
+            let result = technique.render(&mut frame, light, view);
+            frame.end_light();
+            result?;
+        }
+        let mut encoder = frame.finish();
+        statistics.resolve(&mut encoder);
+        self.gpu.queue.submit([encoder.finish()]);
+        let during = format!("counting the work of `{}`", info.name);
+        self.gpu.wait_idle().map_err(|e| Error::Gpu { during: during.clone(), messages: vec![e] })?;
+        self.check_gpu_errors(&during)?;
+        self.timer.reset();
+        let mut work = statistics.read(&self.gpu)?;
+        if let Some(shader_work) = technique.counted_work(&self.gpu)? {
+            work.add_shader_work(&shader_work);
+        }
+        Ok(work)
     }
 
     /// Renders one frame of `technique` (registered as `name`) for every

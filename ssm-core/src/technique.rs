@@ -101,6 +101,12 @@ pub struct TechniqueSetup<'a> {
     pub outputs: &'a [wgpu::TextureView],
     /// Parameter values, complete.
     pub params: &'a ParamValues,
+    /// Build the technique to count its work: true for the extra, untimed frame of
+    /// `--count-work` ([`Renderer::count_work`](crate::Renderer::count_work)). The technique's
+    /// shaders then count texel reads, atomics and storage bytes (its
+    /// [`ReadCounts`](crate::read_counts::ReadCounts) enabled, the counting code compiled in),
+    /// and [`ShadowTechnique::counted_work`] returns them. False for every timed frame.
+    pub count_work: bool,
 }
 
 /// A soft-shadow technique.
@@ -126,6 +132,17 @@ pub trait ShadowTechnique {
     /// the GPU: it is called after the frame has finished.
     fn diagnostics(&mut self, _gpu: &GpuContext) -> Vec<(String, f64)> {
         Vec::new()
+    }
+
+    /// What the shaders counted in the last frame, per pass, when built with
+    /// [`TechniqueSetup::count_work`]: texel reads, atomics and storage bytes (the invocations and
+    /// primitives the framework counts itself, from pipeline statistics). `None` by default: the
+    /// technique does not count, and its reads are reported as unknown, not zero.
+    ///
+    /// # Errors
+    /// A readback error.
+    fn counted_work(&mut self, _gpu: &GpuContext) -> Result<Option<Vec<crate::work::ShaderWork>>> {
+        Ok(None)
     }
 
     /// The images of the last frame named in `requested`, among the debug outputs its
@@ -353,6 +370,7 @@ pub(crate) fn create_checked(
     (scene, cpu_scene): (&GpuScene, &ssm_scene::Scene),
     (shared, outputs): (&SharedInputs, &[wgpu::TextureView]),
     params: &ParamValues,
+    count_work: bool,
 ) -> Result<Box<dyn ShadowTechnique>> {
     let requirements = (info.requirements)(params)?;
     requirements.check_device(info.name, gpu)?;
@@ -371,7 +389,7 @@ pub(crate) fn create_checked(
             input: "occluder/receiver roles (the renderer was built without them)",
         });
     }
-    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params })?;
+    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params, count_work })?;
     let messages = gpu.take_errors();
     if messages.is_empty() { Ok(technique) } else { Err(Error::Gpu { during: format!("creating technique `{}`", info.name), messages }) }
 }

@@ -1,0 +1,88 @@
+//! Counted work (`--count-work`): for every registered technique, one counting frame
+//! ([`Renderer::count_work`]) gives each pass's invocations from pipeline statistics (lavapipe has
+//! them, so they must be there), and leaves the same visibility as a timed frame: counting changes
+//! no result. Where the work is known by hand it is asserted exactly.
+
+// Test helpers unwrap too: a failure should stop the test where it happens.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use ssm_core::{Renderer, Requirements, TechniqueKind};
+use ssm_integration_tests::{missing_must_run, registry, render_or_refusal};
+use ssm_scene::builtin;
+use ssm_testing::gpu;
+
+const WIDTH: u32 = 64;
+const HEIGHT: u32 = 48;
+
+#[test]
+fn every_technique_counts_its_passes_and_counting_changes_no_result() {
+    assert!(missing_must_run().is_empty(), "not registered: {:?}", missing_must_run());
+    let gpu = gpu();
+    assert!(gpu.has_pipeline_statistics(), "lavapipe exposes PIPELINE_STATISTICS_QUERY: {}", gpu.describe());
+    let scene = builtin("parallel-square").unwrap().build();
+    let mut failures = Vec::new();
+    for info in registry().iter().filter(|info| info.kind == TechniqueKind::Realtime) {
+        let params = info.params_from(std::iter::empty()).unwrap();
+        let needs = (info.requirements)(&params).unwrap().union(Requirements { gbuffer: true, ..Requirements::NONE });
+        let result = Renderer::new(&gpu, &scene, WIDTH, HEIGHT, &needs).and_then(|mut renderer| {
+            let mut timed = renderer.create_technique(info, &params)?;
+            renderer.render(timed.as_mut(), info.name)?;
+            let visibility = renderer.read_visibility(0, info.name)?;
+            let work = renderer.count_work(info, &params)?;
+            let counted_visibility = renderer.read_visibility(0, info.name)?;
+            Ok((visibility, work, counted_visibility))
+        });
+        let Some((visibility, work, counted_visibility)) = render_or_refusal(info.name, "parallel-square", result).unwrap() else {
+            continue;
+        };
+        println!("{:<12} {}", info.name, work.passes_column());
+        if !work.pipeline_statistics {
+            failures.push(format!("{}: no pipeline statistics", info.name));
+        }
+        let invocations = work.total(|p| p.fragment_invocations + p.compute_invocations);
+        if invocations == 0 {
+            failures.push(format!("{}: no fragment or compute invocation counted", info.name));
+        }
+        if let Some(pass) = work.passes.iter().find(|p| p.runs == 0) {
+            failures.push(format!("{}: pass {} counted without running", info.name, pass.name));
+        }
+        let differs = visibility.iter().zip(&counted_visibility).filter(|(a, b)| a != b).count();
+        if differs > 0 {
+            failures.push(format!("{}: counting changed {differs} pixels", info.name));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// hard's work by hand: its shadow-map pass draws the scene's vertices once per light (4
+/// triangles, no index reuse), and its lookup is one full-screen triangle that shades every pixel
+/// and stores one R32Float texel per pixel; the shadow map stores one R32Float texel per texel.
+/// Fragment invocations are at least one per pixel: Vulkan lets an implementation count helper
+/// invocations (lavapipe reports 3,456 for 64x48 = 3,072 pixels), so no upper bound is exact.
+#[test]
+fn hard_shadow_mapping_work_is_counted_exactly() {
+    let gpu = gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let info = registry().get("hard").unwrap();
+    let params = info.params_from([("shadow_map_size", "256")]).unwrap();
+    let needs = (info.requirements)(&params).unwrap().union(Requirements { gbuffer: true, ..Requirements::NONE });
+    let mut renderer = Renderer::new(&gpu, &scene, WIDTH, HEIGHT, &needs).unwrap();
+    let work = renderer.count_work(info, &params).unwrap();
+    println!("{}", work.passes_column());
+    let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
+    let shadow_map = pass("hard_shadow_map");
+    let triangles: u64 = scene.world_triangles().count() as u64;
+    assert_eq!((shadow_map.runs, shadow_map.vertex_invocations, shadow_map.primitives), (1, 3 * triangles, triangles));
+    // The map is an R32Float linear depth; its depth buffer is only tested against, not stored.
+    assert_eq!(shadow_map.target_bytes, 256 * 256 * 4, "one R32Float texel per shadow-map texel");
+    let lookup = pass("hard_lookup");
+    assert_eq!((lookup.runs, lookup.vertex_invocations, lookup.primitives), (1, 3, 1), "one full-screen triangle");
+    assert!(
+        lookup.fragment_invocations >= u64::from(WIDTH * HEIGHT),
+        "{} fragments for {} pixels",
+        lookup.fragment_invocations,
+        WIDTH * HEIGHT
+    );
+    assert_eq!(lookup.target_bytes, u64::from(WIDTH * HEIGHT) * 4, "one R32Float texel per pixel");
+    assert_eq!(work.uncounted_passes, 0);
+}
