@@ -127,14 +127,8 @@ impl Renderer {
             create_checked(info, &self.gpu, (&self.scene, &self.cpu_scene), (&self.shared, &self.visibility_views), params, true)?;
         let mut statistics = StatisticsQueries::new(&self.gpu);
         self.timer.reset();
-        let mut frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, info.name).counting(&mut statistics);
-        for (light, view) in self.visibility_views.iter().enumerate() {
-            frame.begin_light(light, view);
-            let result = technique.render(&mut frame, light, view);
-            frame.end_light();
-            result?;
-        }
-        let mut encoder = frame.finish();
+        let frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, info.name).counting(&mut statistics);
+        let mut encoder = record_lights(frame, &self.visibility_views, technique.as_mut())?;
         statistics.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
         let during = format!("counting the work of `{}`", info.name);
@@ -156,14 +150,8 @@ impl Renderer {
     pub fn render(&mut self, technique: &mut dyn ShadowTechnique, name: &str) -> Result<FrameTimings> {
         let start = Instant::now();
         self.timer.reset();
-        let mut frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, name);
-        for (light, view) in self.visibility_views.iter().enumerate() {
-            frame.begin_light(light, view);
-            let result = technique.render(&mut frame, light, view);
-            frame.end_light();
-            result?;
-        }
-        let mut encoder = frame.finish();
+        let frame = Frame::new(&self.gpu, &self.scene, &self.shared, &mut self.timer, name);
+        let mut encoder = record_lights(frame, &self.visibility_views, technique)?;
         self.timer.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait_idle().map_err(|e| Error::Gpu { during: format!("rendering `{name}`"), messages: vec![e] })?;
@@ -284,6 +272,22 @@ impl Renderer {
 }
 
 /// Renders the G-buffer for the scene's current camera and returns its pass times.
+/// Records `technique`'s passes for every light into `frame` (each light's target cleared to lit
+/// first), and returns the encoder to submit.
+fn record_lights(
+    mut frame: Frame<'_>,
+    visibility_views: &[wgpu::TextureView],
+    technique: &mut dyn ShadowTechnique,
+) -> Result<wgpu::CommandEncoder> {
+    for (light, view) in visibility_views.iter().enumerate() {
+        frame.begin_light(light, view);
+        let result = technique.render(&mut frame, light, view);
+        frame.end_light();
+        result?;
+    }
+    Ok(frame.finish())
+}
+
 fn render_gbuffer(gpu: &GpuContext, gbuffer: &GBuffer, scene: &GpuScene, timer: &mut PassTimer) -> Result<Vec<PassTiming>> {
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer_encoder") });
     encoder.push_debug_group("gbuffer");
