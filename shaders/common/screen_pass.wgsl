@@ -10,19 +10,6 @@
 @group(1) @binding(0) var gbuffer_position: texture_2d<f32>;
 @group(1) @binding(1) var gbuffer_normal: texture_2d<f32>;
 
-// `count`, a loop's trip count read from a uniform (a kernel's taps per axis), as a value known
-// only at run time. lavapipe (Mesa 22.3's Vulkan rasteriser) inlines the uniforms that bound a
-// shader's loops: at every draw that binds its uniform buffer it clones the shader, inlines their
-// values and optimises it again, for as long as that halves the shader (update_inline_shader_state
-// in lvp_execute.c); for SSSM's step 2 at small kernels, 34 ms a draw that no pixel's work
-// explains. A bound it cannot trace to uniforms alone is left alone. The value is the same on
-// every device: the zero it adds comes from the pixel's texel, which is never negative. (PCSS's
-// small shader runs faster inlined, so it reads its counts directly; the sssm README's "Where the
-// time goes" has the figures.)
-fn runtime_count(count: u32, texel: vec2<i32>) -> u32 {
-    return count + select(0u, 1u, texel.x < 0);
-}
-
 // What the G-buffer holds at one pixel.
 struct ScreenPoint {
     texel: vec2<i32>,

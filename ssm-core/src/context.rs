@@ -19,7 +19,10 @@ pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::FLOAT32_BLENDABLE
     .union(wgpu::Features::CONSERVATIVE_RASTERIZATION)
     .union(wgpu::Features::DEPTH32FLOAT_STENCIL8)
     .union(wgpu::Features::DEPTH_CLIP_CONTROL)
-    .union(wgpu::Features::POLYGON_MODE_LINE);
+    .union(wgpu::Features::POLYGON_MODE_LINE)
+    // `--count-work`: wedges forces its wedge fragments' depth test before the shader that counts
+    // them (a side effect would otherwise move the test after it, and more fragments would run).
+    .union(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
 
 /// Why no GPU context could be made.
 #[derive(Debug, thiserror::Error)]

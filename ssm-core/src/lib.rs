@@ -46,7 +46,7 @@ pub use gbuffer::GBuffer;
 pub use gpu_scene::{CameraUniform, Geometry, GpuScene, ROLE_CASTS, ROLE_RECEIVES, SURFACE_CLOSED, SceneVertex};
 pub use light_depth::{
     DepthBiasUniform, LightDepthMap, LightDepthMapDesc, NO_SURFACE, ReceiverModel, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ShadowMapBias,
-    ShadowMapReads, screen_space_requirements,
+    screen_space_requirements,
 };
 pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT, MAX_WIDENED_HALF_ANGLE_TANGENT};
 pub use params::{Choice, ParamError, ParamKind, ParamSpec, ParamValue, ParamValues, Settings, concat_params};

@@ -62,10 +62,6 @@ pub struct LightDepthMap {
     pub linear_depth: wgpu::Texture,
     /// View of `linear_depth`.
     pub linear_depth_view: wgpu::TextureView,
-    /// What to bind where a shader declares the map as a read-only storage texture
-    /// ([`ShadowMapReads::storage_layout_entry`]): `linear_depth_view` for a map made with
-    /// [`ShadowMapReads::Storage`], else a 1×1 placeholder the shaders do not read.
-    pub storage_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
     pipeline: wgpu::RenderPipeline,
     bias_bind_group: wgpu::BindGroup,
@@ -100,38 +96,12 @@ impl LightDepthMap {
     /// [`Error::UndeclaredRequirement`](crate::Error::UndeclaredRequirement) for a
     /// [`Geometry`] by role without roles, or [`Error::Gpu`](crate::Error::Gpu) if the shader is rejected.
     pub fn new(gpu: &GpuContext, scene: &GpuScene, desc: &LightDepthMapDesc<'_>) -> Result<Self> {
-        Self::read_as(gpu, scene, desc, ShadowMapReads::Sampled)
-    }
-
-    /// As [`LightDepthMap::new`], for shaders that read it as `reads` says: with
-    /// [`ShadowMapReads::Storage`] the map can also be bound as a storage texture, and
-    /// [`LightDepthMap::storage_view`] is its view; otherwise the map keeps the usages of a
-    /// sampled map alone (a storage usage can cost a GPU its framebuffer compression), and
-    /// `storage_view` is a 1×1 placeholder that fills the storage binding the shaders declare.
-    ///
-    /// # Errors
-    /// As [`LightDepthMap::new`].
-    pub fn read_as(gpu: &GpuContext, scene: &GpuScene, desc: &LightDepthMapDesc<'_>, reads: ShadowMapReads) -> Result<Self> {
         let device = &gpu.device;
         let label = desc.label;
         let indices = scene.index_range(label, desc.geometry)?;
-        let storage = if reads == ShadowMapReads::Storage { wgpu::TextureUsages::STORAGE_BINDING } else { wgpu::TextureUsages::empty() };
-        let linear_depth = render_texture(
-            device,
-            &format!("{label}_linear_depth"),
-            desc.width,
-            desc.height,
-            Self::FORMAT,
-            wgpu::TextureUsages::COPY_SRC | storage,
-        );
+        let linear_depth =
+            render_texture(device, &format!("{label}_linear_depth"), desc.width, desc.height, Self::FORMAT, wgpu::TextureUsages::COPY_SRC);
         let linear_depth_view = labelled_view(&linear_depth, &format!("{label}_linear_depth"));
-        let storage_view = if reads == ShadowMapReads::Storage {
-            linear_depth_view.clone()
-        } else {
-            let placeholder_label = format!("{label}_storage_placeholder");
-            let placeholder = render_texture(device, &placeholder_label, 1, 1, Self::FORMAT, wgpu::TextureUsages::STORAGE_BINDING);
-            labelled_view(&placeholder, &placeholder_label)
-        };
         let depth =
             render_texture(device, &format!("{label}_depth"), desc.width, desc.height, Self::DEPTH_FORMAT, wgpu::TextureUsages::empty());
         let bias_bind_group =
@@ -139,7 +109,6 @@ impl LightDepthMap {
         let pipeline = Self::pipeline(gpu, desc.cull_mode, desc.farthest)?;
         Ok(Self {
             linear_depth_view,
-            storage_view,
             linear_depth,
             depth_view: labelled_view(&depth, &format!("{label}_depth")),
             pipeline,
@@ -289,50 +258,6 @@ pub const SHADOW_MAP_MIN_SIZE: u32 = 16;
 /// Largest side of a shadow map a technique may ask for, texels (devices may allow less).
 pub const SHADOW_MAP_MAX_SIZE: u32 = 16384;
 
-/// How a technique's shaders read the texels of its light depth map: both are point reads with
-/// `textureLoad` (no sampler, no filtering), of the same texels with the same values
-/// (`shadow_map_tap` in `shaders/common/shadow_map_reads.wgsl`), so the choice is the
-/// implementation's, not the algorithm's; only the binding differs. On lavapipe (Mesa's CPU
-/// rasteriser) a sampled-texture `textureLoad` calls a generic function of about 140
-/// instructions that works out each lane's mip level and pitch before its gather, where a
-/// storage-texture load is the gather; on `leaves` at 320×240 PCSS at 29/41 takes 37% less time
-/// with storage reads (the pcss and sssm READMEs have the figures). Not measured on a GPU.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, crate::Choice)]
-pub enum ShadowMapReads {
-    /// `textureLoad` of the map bound as a sampled texture (`texture_2d<f32>`).
-    Sampled,
-    /// `textureLoad` of the same map bound as a read-only storage texture
-    /// (`texture_storage_2d<r32float, read>`).
-    Storage,
-}
-
-impl ShadowMapReads {
-    /// The WGSL pipeline constant that selects the read (`SHADOW_MAP_STORAGE_READS`, declared in
-    /// `shaders/common/shadow_map_reads.wgsl`), for the pipelines of shaders that import it.
-    #[must_use]
-    pub fn pipeline_constant(self) -> (&'static str, f64) {
-        ("SHADOW_MAP_STORAGE_READS", f64::from(u8::from(self == Self::Storage)))
-    }
-
-    /// The layout entry of the map as a read-only storage texture at `binding`, in fragment and
-    /// compute stages; bind [`LightDepthMap::storage_view`] to it, beside the sampled binding
-    /// (shaders that import `shadow_map_reads.wgsl` declare both whichever read they use; a
-    /// fragment stage then needs one storage texture, which WebGL2-class adapters lack).
-    #[must_use]
-    pub const fn storage_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-        wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::ReadOnly,
-                format: LightDepthMap::FORMAT,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        }
-    }
-}
-
 /// The bias of a light depth map and of its lookups, shared by the shadow-map
 /// techniques (flatten it into their settings).
 #[derive(Clone, Copy, Debug, PartialEq, crate::Settings)]
@@ -354,23 +279,8 @@ impl ShadowMapBias {
     /// # Errors
     /// A GPU error if the pipeline is rejected.
     pub fn depth_map(&self, setup: &crate::TechniqueSetup<'_>, label: &str, size: u32) -> Result<LightDepthMap> {
-        self.depth_map_read_as(setup, label, size, ShadowMapReads::Sampled)
-    }
-
-    /// As [`ShadowMapBias::depth_map`], for shaders that read it as `reads` says
-    /// ([`LightDepthMap::read_as`]).
-    ///
-    /// # Errors
-    /// A GPU error if the pipeline is rejected.
-    pub fn depth_map_read_as(
-        &self,
-        setup: &crate::TechniqueSetup<'_>,
-        label: &str,
-        size: u32,
-        reads: ShadowMapReads,
-    ) -> Result<LightDepthMap> {
         let diagonal = setup.scene.bounds.size().length();
-        LightDepthMap::read_as(
+        LightDepthMap::new(
             setup.gpu,
             setup.scene,
             &LightDepthMapDesc {
@@ -383,7 +293,6 @@ impl ShadowMapBias {
                 constant_bias: self.constant_bias * diagonal,
                 slope_bias: self.slope_bias,
             },
-            reads,
         )
     }
 }

@@ -90,8 +90,9 @@ impl ReadCounts {
 
     /// The counters' totals over the last frame as each pass's [`ShaderWork`]: a counter whose
     /// unit is `reads` gives texel reads, `atomics` atomics, `storage_bytes` bytes written to
-    /// storage (other units, such as sssm's `rows`, are diagnostics only); a pass's invocations
-    /// are the most pixels any of its counters counted. `None` when not counting.
+    /// storage; counters of other units, such as sssm's `rows`, are diagnostics only and make no
+    /// pass. A pass's invocations are the most pixels any of its counters counted. `None` when
+    /// not counting.
     ///
     /// # Errors
     /// A readback error.
@@ -103,6 +104,9 @@ impl ReadCounts {
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let mut work: Vec<ShaderWork> = Vec::new();
         for ((name, unit), buckets) in self.counters.iter().zip(words.chunks_exact(2 * READ_COUNT_BUCKETS)) {
+            if !matches!(*unit, "reads" | "atomics" | "storage_bytes") {
+                continue;
+            }
             let invocations: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[0])).sum();
             let counted: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[1])).sum();
             let index = match work.iter().position(|pass| pass.pass == *name) {
@@ -117,8 +121,7 @@ impl ReadCounts {
             match *unit {
                 "reads" => pass.texel_reads += counted,
                 "atomics" => pass.atomics += counted,
-                "storage_bytes" => pass.storage_bytes += counted,
-                _ => {}
+                _ => pass.storage_bytes += counted,
             }
         }
         Ok(Some(work))

@@ -60,39 +60,6 @@ pub fn render(
     Ok(Rendered { renderer, visibility })
 }
 
-/// A case of [`assert_same_pixels`] as tests list them: its name, scene and settings.
-pub type PixelCase<'a> = (&'static str, &'a Scene, &'static [(&'static str, &'static str)]);
-
-/// Renders `technique` on `scene` with `settings` plus `param` = each of `values`, and asserts
-/// that the two give the same pixels to the bit (two implementations of the same algorithm:
-/// where its taps read from, how the passes run) and that the case has more than 100 pixels in
-/// shadow or penumbra; prints the largest difference. `name` names the case in messages.
-///
-/// # Panics
-/// If rendering fails, the case has too little shadow, or a pixel differs.
-#[allow(clippy::too_many_arguments)]
-pub fn assert_same_pixels(
-    gpu: &GpuContext,
-    name: &str,
-    scene: &Scene,
-    technique: &'static TechniqueInfo,
-    settings: &[(&str, &str)],
-    (param, values): (&str, [&str; 2]),
-    (width, height): (u32, u32),
-) {
-    let with = |value: &str| {
-        let mut all = settings.to_vec();
-        all.push((param, value));
-        render(gpu, scene, technique, &all, width, height).unwrap_or_else(|e| panic!("{name}: {e}")).visibility
-    };
-    let (first, second) = (with(values[0]), with(values[1]));
-    let largest = first.iter().zip(&second).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-    let shadowed = second.iter().filter(|v| **v < 0.999).count();
-    println!("{name}: largest difference {largest:e}, {shadowed} pixels in shadow or penumbra");
-    assert!(shadowed > 100, "{name}: the case has too little shadow");
-    assert_eq!(largest, 0.0, "{name}: {param} = {} differs from {} by up to {largest}", values[0], values[1]);
-}
-
 /// The ground truth of `scene` with `samples`² rays per pixel, uncached (tests trace afresh).
 ///
 /// # Panics
