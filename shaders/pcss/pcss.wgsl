@@ -2,8 +2,10 @@
 
 // #import pcss/pcss_common.wgsl
 
+// One texel read.
 fn tap_depth(uv: vec2<f32>) -> f32 {
-    return shadow_map_tap(shadow_map, shadow_map_storage, uv);
+    reads += 1u;
+    return shadow_map_depth(shadow_map, uv);
 }
 
 @fragment

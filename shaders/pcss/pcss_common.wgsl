@@ -21,7 +21,6 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
-// #import common/shadow_map_reads.wgsl
 // #import common/read_counts.wgsl
 
 struct PcssSettings {
@@ -36,13 +35,13 @@ struct PcssSettings {
 };
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
-// The same map as a read-only storage texture, for the settings' shadow_map_reads = storage.
-@group(2) @binding(3) var shadow_map_storage: texture_storage_2d<r32float, read>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
 // Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Texture reads of this invocation: the G-buffer's two and every shadow-map tap.
+// Texel reads of this invocation: the G-buffer's two and every shadow-map tap (counted in each
+// entry file's tap_depth), or in the tiled pass the texels it loaded into the tile instead of the
+// taps that read the tile.
 var<private> reads: u32;
 
 // A pixel's lookup, prepared before its taps.
@@ -76,7 +75,6 @@ fn soft_visibility(pixel: PcssPixel) -> f32 {
         for (var i = 0u; i < n; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * pixel.search;
             let depth = tap_depth(uv);
-            reads += 1u;
             if (depth < tap_plane_depth(receiver, uv)) {
                 blocker_sum += depth;
                 blocker_count += 1u;
@@ -96,17 +94,23 @@ fn soft_visibility(pixel: PcssPixel) -> f32 {
         for (var i = 0u; i < m; i++) {
             let uv = uvd.xy + vec2<f32>(grid_offset(i, m), grid_offset(j, m)) * filter_extent;
             lit += select(0.0, 1.0, tap_plane_depth(receiver, uv) <= tap_depth(uv));
-            reads += 1u;
         }
     }
     return lit / f32(m * m);
 }
 
-// Records this invocation's reads (with COUNT_READS, the settings' count_reads).
+// Records this invocation's reads (with COUNT_READS: the settings' count_reads, or a counting
+// frame) for a computed pixel.
 fn record_pcss_reads(texel: vec2<i32>) {
-    if (COUNT_READS) {
+    record_pcss_reads_of(texel, 1u);
+}
+
+// Records `pixels` (0 or 1) and this invocation's reads: 0 for an invocation of the tiled pass
+// that only loaded its share of the tile.
+fn record_pcss_reads_of(texel: vec2<i32>, pixels: u32) {
+    if (COUNT_READS && (pixels != 0u || reads != 0u)) {
         let word = read_count_word(0u, texel);
-        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
     }
 }

@@ -22,11 +22,13 @@ var<private> tile_origin: vec2<i32>;
 var<private> tile_width: i32;
 var<private> tiled: bool;
 
+// A texel read where the tap reads the shadow map; none where it reads the tile.
 fn tap_depth(uv: vec2<f32>) -> f32 {
     if (!tiled || any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
-        return shadow_map_tap(shadow_map, shadow_map_storage, uv);
+        reads += 1u;
+        return shadow_map_depth(shadow_map, uv);
     }
-    // The texel shadow_map_tap reads, inside the union by construction.
+    // The texel shadow_map_depth reads, inside the union by construction.
     let texel = vec2<i32>(uv * vec2<f32>(textureDimensions(shadow_map))) - tile_origin;
     return tile[texel.y * tile_width + texel.x];
 }
@@ -68,7 +70,8 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     tile_width = extent.x;
     if (tiled) {
         for (var index = i32(local); index < extent.x * extent.y; index += 64) {
-            tile[index] = shadow_map_texel(shadow_map, shadow_map_storage, low + vec2<i32>(index % extent.x, index / extent.x));
+            tile[index] = textureLoad(shadow_map, low + vec2<i32>(index % extent.x, index / extent.x), 0).x;
+            reads += 1u;
         }
     }
     workgroupBarrier();
@@ -77,13 +80,15 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         atomicAdd(&tile_counts[1], 1u);
     }
     if (!inside) {
+        record_pcss_reads_of(vec2<i32>(id.xy), 0u);
         return;
     }
     var visibility = trivial;
     if (trivial < 0.0) {
-        reads = 2u;
+        // The G-buffer's two texels.
+        reads += 2u;
         visibility = soft_visibility(pixel);
-        record_pcss_reads(point.texel);
     }
+    record_pcss_reads_of(point.texel, u32(trivial < 0.0));
     textureStore(visibility_target, vec2<i32>(id.xy), vec4<f32>(visibility));
 }

@@ -32,20 +32,11 @@ fn store_penumbra_error(texel: vec2<i32>) {
 // The blocker sum and count over every row of the n×n window, none reused: PCSS's search, and
 // what SSSM's rows add up to with α = 0.
 fn full_blocker_search(uvd: vec3<f32>, search: vec2<f32>, receiver: TapPlane, n: u32) -> vec2<f32> {
-    let steps = kernel_steps(n);
-    var sum = 0.0;
-    var count = 0.0;
-    for (var j = 0u; j < n; j++) {
-        for (var i = 0u; i < n; i++) {
-            let tap = uvd.xy + vec2<f32>(kernel_offset(steps, i), kernel_offset(steps, j)) * search;
-            let depth = tap_depth(tap);
-            if (depth < tap_plane_depth(receiver, tap)) {
-                sum += depth;
-                count += 1.0;
-            }
-        }
+    var sum_count = vec2<f32>(0.0);
+    for (var t = 0u; t < n; t++) {
+        sum_count += blocker_row(vec2<f32>(uvd.x, uvd.y + grid_offset(t, n) * search.y), search.x, receiver, n);
     }
-    return vec2<f32>(sum, count);
+    return sum_count;
 }
 
 // Full width in shadow-map texels (along u) of the penumbra of a blocker sum and count seen from
@@ -80,54 +71,34 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
     let uvd = light_uv_depth(frame, lookup);
     let receiver = compared_plane(lookup, point.normal, d);
     let search = light_half_extent_uv(frame, frame.projection.z, d);
-    let n = runtime_count(max(settings.blocker_kernel, 1u), point.texel);
-    let steps = kernel_steps(n);
+    let n = max(settings.blocker_kernel, 1u);
     var sum = 0.0;
     var count = 0.0;
     var reused = 0.0;
-    // The rows' points at depth d lie on a line, and clip space is linear in them: project the two ends once.
-    let first_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y - search.y), d), 1.0);
-    let last_clip = camera.view_proj * vec4<f32>(light_point(vec2<f32>(uvd.x, uvd.y + search.y), d), 1.0);
-    // Rows failing the α test, read after the reused ones.
-    var failed_rows = FailedRows();
     for (var t = 0u; t < n; t++) {
+        let row_uv = vec2<f32>(uvd.x, uvd.y + grid_offset(t, n) * search.y);
         // The pixel that sees the point of this row at the same light depth d (Fig. 4).
-        let clip = mix(first_clip, last_clip, kernel_offset(steps, t) * 0.5 + 0.5);
-        let ndc = clip.xy * (1.0 / clip.w);
-        let screen = vec3<f32>((ndc.x * 0.5 + 0.5) * camera.viewport.x, (0.5 - ndc.y * 0.5) * camera.viewport.y, clip.w);
+        let screen = screen_position(light_point(row_uv, d));
+        let from_screen = screen.z > 0.0 && row_read_from_screen(screen.xy);
         var reuse = false;
         var no_data = false;
-        let visible = screen.z > 0.0 && row_read_from_screen(screen.xy);
-        if (visible) {
+        if (from_screen) {
             let other = textureLoad(horizontal_blocker, clamped_texel(screen.xy), 0);
             reads += 1u;
             no_data = other.x < 0.0;
-            if (other.x >= 0.0 && abs(d - other.x) < scene_length(frame, settings.alpha)) {
+            reuse = !no_data && abs(d - other.x) < scene_length(frame, settings.alpha);
+            if (reuse) {
                 sum += other.y;
                 count += other.z;
                 reused += 1.0;
-                reuse = true;
             }
         }
         if (!reuse) {
-            mark_failed_row(&failed_rows, t);
-            count_failed_row(!visible, no_data);
-        }
-    }
-    loop {
-        let failed = pop_failed_row(&failed_rows);
-        if (failed < 0) {
-            break;
-        }
-        let row_uv = vec2<f32>(uvd.x, uvd.y + kernel_offset(steps, u32(failed)) * search.y);
-        for (var i = 0u; i < n; i++) {
-            let tap = row_uv + vec2<f32>(kernel_offset(steps, i) * search.x, 0.0);
-            let depth = tap_depth(tap);
-            reads += 1u;
-            if (depth < tap_plane_depth(receiver, tap)) {
-                sum += depth;
-                count += 1.0;
-            }
+            // |d - d_t| ≥ α, or no row to reuse: the row is read from the depth map (Fig. 4).
+            count_failed_row(!from_screen, no_data);
+            let partial = blocker_row(row_uv, search.x, receiver, n);
+            sum += partial.x;
+            count += partial.y;
         }
     }
     if (MEASURE_PENUMBRA_ERROR) {
@@ -166,44 +137,31 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
 // from `horizontal_source`.
 fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
     let radii = searched.yz;
-    let m = runtime_count(max(settings.blur_kernel, 1u), point.texel);
-    let steps = kernel_steps(m);
+    let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
-    let line = tap_line(rays, point.position, point.normal, centre, vec2<f32>(radii.x, 0.0));
     var blurred = 0.0;
     var total = 0.0;
-    // The taps on the screen are a run of consecutive taps (the tap's x grows with its index).
-    var first_on_screen = m;
-    var last_on_screen = -1;
-    let bilateral = bilateral_weights(point.normal);
     for (var j = 0u; j < m; j++) {
-        let offset = kernel_offset(steps, j);
+        let offset = grid_offset(j, m);
         let tap = vec2<f32>(centre.x + offset * radii.x, centre.y);
+        let weight = blur_weight(offset);
         if (on_screen(tap)) {
             let source = horizontal_source(vec2<i32>(tap));
-            var weight = tap_weight(j);
-            if (settings.bilateral_depth > 0.0) {
-                weight *= bilateral_weight_of(bilateral, source, tap_line_distance(line, offset));
+            let expected = plane_distance(rays, point.position, point.normal, tap);
+            let tap_weight = weight * bilateral_weight_of(point.normal, source, expected);
+            blurred += tap_weight * source.value;
+            total += tap_weight;
+        } else {
+            // Past the screen's edges: the shadow test of the point of this pixel's tangent plane
+            // seen there (the pixel's own value where the ray misses the plane).
+            let plane = tangent_plane_point(rays, point.position, point.normal, tap);
+            var hard = own.w;
+            if (plane.w > 0.0) {
+                hard = hard_visibility(plane.xyz, point.normal);
             }
-            blurred += weight * source.value;
+            blurred += weight * hard;
             total += weight;
-            first_on_screen = min(first_on_screen, j);
-            last_on_screen = i32(j);
         }
-    }
-    // The taps past the screen's edges (those before the run and after it; none for most pixels):
-    // the shadow test of the point of this pixel's tangent plane seen there. In a loop of their own
-    // so that the loop above does not carry this code for every tap: a SIMD processor (lavapipe's
-    // vectors, a GPU's warps) executes a branch's code for all its lanes when any lane takes it.
-    let before = first_on_screen;
-    let after = select(m - 1u - u32(last_on_screen), 0u, last_on_screen < 0);
-    for (var k = 0u; k < before + after; k++) {
-        let j = select(k, u32(last_on_screen + 1) + (k - before), k >= before);
-        let tap = vec2<f32>(centre.x + kernel_offset(steps, j) * radii.x, centre.y);
-        let plane = tangent_plane_point(rays, point.position, point.normal, tap);
-        let weight = tap_weight(j);
-        blurred += weight * select(own.w, hard_visibility(plane.xyz, point.normal), plane.w > 0.0);
-        total += weight;
     }
     // Every tap on other surfaces (an even m has no centre tap): keep the hard value.
     let horizontal = select(own.w, blurred / total, total > 1e-6);

@@ -2,24 +2,8 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
-// #import common/shadow_map_reads.wgsl
 // #import common/camera.wgsl
 // #import common/read_counts.wgsl
-
-// The blur weights stepped outward from the kernel's centre (sssm's BlurWeightSteps): the taps
-// pair up about the centre and share a weight; pair k + 1's weight is pair k's times a ratio that
-// itself changes by a constant factor (a Gaussian's), so step 3's taps and recomputed rows read
-// no weight table.
-struct BlurWeightSteps {
-    // Weight of the centre tap of an odd kernel.
-    centre: f32,
-    // Weight of the pair next to the centre.
-    first_pair: f32,
-    // Ratio of the second pair's weight to the first's.
-    first_ratio: f32,
-    // Ratio of each ratio to the one before.
-    ratio_step: f32,
-};
 
 struct SssmSettings {
     // Samples per axis of the blocker search (n) and of the blur (m).
@@ -35,22 +19,14 @@ struct SssmSettings {
     normal_offset: f32,
     // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
-    // The sum of the blur_kernel tap weights below.
-    blur_weight_total: f32,
-    // The same weights as a recurrence outward from the kernel's centre (step 3's vertical_tap
-    // and recomputed_row).
-    blur_weight_steps: BlurWeightSteps,
-    // The weight of blur tap i (of blur_kernel) at [i / 4][i % 4] (Sec. 4.4: Gaussian of the
-    // settings' sigma, or 1 for the mean filter), computed once on the CPU instead of an
-    // exponential per tap.
-    blur_weights: array<vec4<f32>, 32>,
+    // a in a blur tap's weight exp(-a x²) at its offset x in [-1, 1] (Sec. 4.4): 1 / (2σ²) for the
+    // Gaussian of σ kernel half-widths, 0 for the mean filter.
+    blur_weight_exponent: f32,
 };
 
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
-// The same map as a read-only storage texture, for the settings' shadow_map_reads = storage.
-@group(2) @binding(15) var shadow_map_storage: texture_storage_2d<r32float, read>;
 // Per pass (0 horizontal blocker, 1 blocker and horizontal blur, 2 vertical blur): (pixels,
 // reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
@@ -107,9 +83,35 @@ fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
     }
 }
 
-// The shadow map's depth at `uv` (shadow_map_depth), read as the settings' shadow_map_reads say.
+// The shadow map's depth at `uv`: one texel read (a textureLoad; counted by the caller).
 fn tap_depth(uv: vec2<f32>) -> f32 {
-    return shadow_map_tap(shadow_map, shadow_map_storage, uv);
+    return shadow_map_depth(shadow_map, uv);
+}
+
+// The partial blocker sum and count (Sec. 4.1) of the n taps of the shadow-map row through
+// `row_uv`, `half_width` either side along u: partial_blocker_sum = Σ dm(x, t) over the taps
+// nearer the light than `receiver` (the receiver's depth, or its tangent plane along each tap's
+// ray), and partial_blocker_count their number. Step 1's row, and a row step 2 reads because its
+// reuse test failed (Table 1: "for each (x point) get data from DepthMap"). n texel reads.
+fn blocker_row(row_uv: vec2<f32>, half_width: f32, receiver: TapPlane, n: u32) -> vec2<f32> {
+    var sum = 0.0;
+    var count = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let tap = row_uv + vec2<f32>(grid_offset(i, n) * half_width, 0.0);
+        let depth = tap_depth(tap);
+        reads += 1u;
+        if (depth < tap_plane_depth(receiver, tap)) {
+            sum += depth;
+            count += 1.0;
+        }
+    }
+    return vec2<f32>(sum, count);
+}
+
+// The weight of a blur tap at offset `offset` in [-1, 1] of the kernel's half-width (Sec. 4.4:
+// a Gaussian of σ half-widths, the paper's N(0, 0.5), or 1 for the mean filter).
+fn blur_weight(offset: f32) -> f32 {
+    return exp(-settings.blur_weight_exponent * offset * offset);
 }
 
 // The world point at shadow-map coordinates `uv` and linear light depth `depth` (inverse of light_uv_depth).
@@ -117,7 +119,6 @@ fn light_point(uv: vec2<f32>, depth: f32) -> vec3<f32> {
     let xy = (uv * 2.0 - 1.0) * depth * frame.projection.xy;
     return frame.centre.xyz + xy.x * frame.u_axis.xyz + xy.y * frame.v_axis.xyz + depth * frame.normal.xyz;
 }
-
 
 // Camera rays, unnormalised, as an affine function of the pixel position: for a perspective
 // camera the far-plane points' homogeneous w is the same at every pixel, so the ray through pixel
@@ -162,56 +163,12 @@ fn tangent_plane_point(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pi
     return vec4<f32>(camera.position.xyz + hit.xyz * max(hit.w, 0.0), select(0.0, 1.0, hit.w > 0.0));
 }
 
-// The camera rays of a line of blur taps through pixel position `centre`, tap k at centre +
-// offset_k · `step` (a separable pass's row or column), and where each meets the tangent plane
-// through `point` with normal `normal`. The ray and its dot with the normal are linear in the
-// offset, so a tap costs a few multiply-adds, a division and a square root instead of building its
-// ray and intersecting the plane anew.
-struct TapLine {
-    centre_ray: vec3<f32>,
-    ray_step: vec3<f32>,
-    centre_denominator: f32,
-    denominator_step: f32,
-    // (point - eye) · normal.
-    plane_offset: f32,
-};
-
-fn tap_line(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, centre: vec2<f32>, step: vec2<f32>) -> TapLine {
-    let centre_ray = rays.base + centre.x * rays.per_x + centre.y * rays.per_y;
-    let ray_step = step.x * rays.per_x + step.y * rays.per_y;
-    return TapLine(centre_ray, ray_step, dot(centre_ray, normal), dot(ray_step, normal), dot(point - camera.position.xyz, normal));
-}
-
-// The eye's distance to the plane along the ray of the tap at `offset` along `line`
-// (tangent_plane_hit's t times the ray's length); -1 where the ray runs along the plane or meets
-// it behind the eye.
-fn tap_line_distance(line: TapLine, offset: f32) -> f32 {
-    let direction = line.centre_ray + offset * line.ray_step;
-    let denominator = line.centre_denominator + offset * line.denominator_step;
-    // Selected rather than branched: a division by a vanishing denominator is discarded.
-    let t = line.plane_offset / denominator;
-    return select(-1.0, t * length(direction), abs(denominator) >= 1e-12 && t > 0.0);
-}
-
-// The offsets in [-1, 1] of a kernel's `count` taps, grid_offset's, as (2i + 1 - count) / count
-// with the reciprocal taken once: a multiply-add and a product per tap where grid_offset divides
-// by the count (PCSS's loops need not: lavapipe inlines its kernel sizes and folds the division
-// away; SSSM's are kept out of its reach, see runtime_count). The centre tap of an odd kernel is
-// exactly 0 and the offsets exactly symmetric, as grid_offset's: a search window as wide as a
-// grazing light's makes a blocker search tell an offset of 1e-7 from 0.
-struct KernelSteps {
-    // 1 - count.
-    first: f32,
-    // 1 / count.
-    inverse_count: f32,
-};
-
-fn kernel_steps(count: u32) -> KernelSteps {
-    return KernelSteps(1.0 - f32(count), 1.0 / f32(count));
-}
-
-fn kernel_offset(steps: KernelSteps, i: u32) -> f32 {
-    return (2.0 * f32(i) + steps.first) * steps.inverse_count;
+// The eye's distance to the tangent plane through `point` (normal `normal`) along the camera ray
+// through pixel position `pixel`: what the bilateral weight and step 3's β test compare a tap
+// pixel's own distance with. -1 where the ray runs along the plane or meets it behind the eye.
+fn plane_distance(rays: CameraRays, point: vec3<f32>, normal: vec3<f32>, pixel: vec2<f32>) -> f32 {
+    let hit = tangent_plane_hit(rays, point, normal, pixel);
+    return select(-1.0, hit.w * length(hit.xyz), hit.w > 0.0);
 }
 
 // Hard visibility of a world point seen with normal `normal` (the shadow test of Step 1).
@@ -224,7 +181,8 @@ fn lookup_offset(point: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return normal_offset_position(frame, shadow_map, point, normal, settings.normal_offset) - point;
 }
 
-// Hard visibility of a tap on a pixel's tangent plane, with that pixel's lookup offset.
+// Hard visibility of a tap on a pixel's tangent plane, with that pixel's lookup offset: one
+// texel read, none behind the light's plane.
 fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
     if (!in_front_of_light(frame, world)) {
         return 0.0;
@@ -232,49 +190,6 @@ fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
     let uvd = light_uv_depth(frame, world + offset);
     reads += 1u;
     return select(0.0, 1.0, uvd.z <= tap_depth(uvd.xy));
-}
-
-// Weight of blur tap `i` of the m taps (Sec. 4.4: Gaussian, or 1 for the mean filter).
-fn tap_weight(i: u32) -> f32 {
-    return settings.blur_weights[i / 4u][i % 4u];
-}
-
-// Rows of a kernel that failed their reuse test, recomputed after the reused ones (bit t % 32 of
-// word t / 32 for row t < 128): each pixel then loops over its own failures, so pixels sharing a
-// SIMD vector (a GPU's warp, a CPU rasteriser's lanes) wait for the one with the most, not for
-// every row any of them failed, which with a tenth of the rows failing and 32 lanes would be nearly
-// all of them.
-struct FailedRows {
-    words: vec4<u32>,
-};
-
-// The four words' indices, to pick one by comparison: selects instead of a dynamically indexed
-// array or a loop over the words, whose every iteration a SIMD rasteriser runs for all its lanes.
-const WORD_INDICES: vec4<u32> = vec4<u32>(0u, 1u, 2u, 3u);
-
-fn mark_failed_row(failed: ptr<function, FailedRows>, row: u32) {
-    mark_failed_row_if(failed, row, true);
-}
-
-// mark_failed_row where `failed_test` holds, without a branch.
-fn mark_failed_row_if(failed: ptr<function, FailedRows>, row: u32, failed_test: bool) {
-    let bit = select(0u, 1u << (row % 32u), failed_test);
-    (*failed).words |= select(vec4<u32>(0u), vec4<u32>(bit), WORD_INDICES == vec4<u32>(row / 32u));
-}
-
-// Removes and returns the lowest marked row; -1 when none is left.
-fn pop_failed_row(failed: ptr<function, FailedRows>) -> i32 {
-    let words = (*failed).words;
-    // The first word with a bit left (4: none).
-    var word = 4u;
-    word = select(word, 3u, words.w != 0u);
-    word = select(word, 2u, words.z != 0u);
-    word = select(word, 1u, words.y != 0u);
-    word = select(word, 0u, words.x != 0u);
-    let picked = WORD_INDICES == vec4<u32>(word);
-    let bits = dot(select(vec4<u32>(0u), words, picked), vec4<u32>(1u));
-    (*failed).words = select(words, vec4<u32>(bits & (bits - 1u)), picked);
-    return select(-1, i32(word * 32u + firstTrailingBit(bits)), word < 4u);
 }
 
 // Whether a pixel position lies on the screen.
@@ -421,36 +336,25 @@ fn unpack_vertical_tap_source(packed: vec4<f32>) -> BlurSource {
     return BlurSource(packed.x, abs(packed.y), vec3<f32>(packed.zw, select(-normal_z, normal_z, packed.y > 0.0)));
 }
 
-// What the bilateral weights of one pixel's blur taps share, computed once per pixel: its normal,
-// and the reciprocal of the depth tolerance. lavapipe runs the body of a branch as masked code
-// and LLVM does not move a division out of it, so a reciprocal taken per tap inside the
-// horizontal blur's on-screen branch was a division per tap (about 5% of step 2 at 29/41).
-struct BilateralWeights {
-    normal: vec3<f32>,
-    // 1 / (bilateral_depth · the scene's diagonal); unused when bilateral_depth is 0.
-    inverse_tolerance: f32,
-};
-
-fn bilateral_weights(normal: vec3<f32>) -> BilateralWeights {
-    return BilateralWeights(normal, 1.0 / scene_length(frame, settings.bilateral_depth));
-}
-
-// Bilateral weight of a blur tap landing on `source`, for the pixel of `bilateral`, where
-// `expected_distance` is the eye's distance to this pixel's tangent plane along the tap
-// pixel's ray (tap_line_distance): how much the surface seen there looks like this pixel's
-// tangent plane, by the difference of camera distances (the distance of the vertical pass's β
-// test) and of normals. Taps on another object across a silhouette get no weight, so shadow does
-// not leak over edges.
-fn bilateral_weight_of(bilateral: BilateralWeights, source: BlurSource, expected_distance: f32) -> f32 {
-    let gap = (source.eye_distance - expected_distance) * bilateral.inverse_tolerance;
-    let turn = max(dot(bilateral.normal, source.normal), 0.0);
-    // turn⁸ by three squarings (a pow costs a logarithm and an exponential): the normal term
-    // falls to 1/2 at about 23°.
+// Bilateral weight of a blur tap landing on `source`, for a pixel of normal `normal`, where
+// `expected_distance` is the eye's distance to this pixel's tangent plane along the tap pixel's
+// ray (plane_distance): how much the surface seen there looks like this pixel's tangent plane, by
+// the difference of camera distances (the distance of the vertical pass's β test) and of
+// normals. Taps on another object across a silhouette get no weight, so shadow does not leak over
+// edges. 1 with bilateral_depth = 0 (the paper's plain blur).
+fn bilateral_weight_of(normal: vec3<f32>, source: BlurSource, expected_distance: f32) -> f32 {
+    if (settings.bilateral_depth <= 0.0) {
+        return 1.0;
+    }
+    if (source.eye_distance < 0.0 || expected_distance < 0.0) {
+        return 0.0;
+    }
+    let gap = (source.eye_distance - expected_distance) / scene_length(frame, settings.bilateral_depth);
+    let turn = max(dot(normal, source.normal), 0.0);
+    // turn⁸: the normal term falls to 1/2 at about 23°.
     let turn_2 = turn * turn;
     let turn_4 = turn_2 * turn_2;
-    let weight = select(exp(-gap * gap) * turn_4 * turn_4, 0.0, source.eye_distance < 0.0 || expected_distance < 0.0);
-    // Selected rather than branched (a division by a zero tolerance is discarded).
-    return select(weight, 1.0, settings.bilateral_depth <= 0.0);
+    return exp(-gap * gap) * turn_4 * turn_4;
 }
 
 // Whether the tap pixel seen as `source` lies within β of this pixel's tangent plane along its ray

@@ -35,18 +35,6 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     reads += 1u;
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
     let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
-    let n = runtime_count(max(settings.blocker_kernel, 1u), point.texel);
-    let steps = kernel_steps(n);
-    var sum = 0.0;
-    var count = 0.0;
-    for (var i = 0u; i < n; i++) {
-        let tap = uvd.xy + vec2<f32>(kernel_offset(steps, i) * search.x, 0.0);
-        let depth = tap_depth(tap);
-        reads += 1u;
-        if (depth < tap_plane_depth(receiver, tap)) {
-            sum += depth;
-            count += 1.0;
-        }
-    }
-    return vec4<f32>(uvd.z, sum, count, hard);
+    let partial = blocker_row(uvd.xy, search.x, receiver, max(settings.blocker_kernel, 1u));
+    return vec4<f32>(uvd.z, partial, hard);
 }

@@ -18,8 +18,8 @@ use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
     Choice, Frame, GpuContext, LightDepthMap, ParamValues, ReceiverModel, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE,
-    ScreenPass, Settings, ShadowMapBias, ShadowMapReads, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
-    UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
+    ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
+    VISIBILITY_FORMAT, register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -67,9 +67,6 @@ pub struct PcssSettings {
     /// Where taps read their depth: texture (a fragment pass reading the shadow map) or workgroup_tile (a compute pass whose workgroups share the texels their pixels read, when they fit; the same pixels).
     #[param(choice, default = "texture")]
     pub tap_source: TapSource,
-    /// How taps read the shadow map's texels: sampled (a sampled texture) or storage (the same map as a read-only storage texture; the same texels, cheaper on lavapipe); as sssm's, which has the same choice.
-    #[param(choice, default = "sampled")]
-    pub shadow_map_reads: ShadowMapReads,
     /// What the taps are compared with.
     #[param(flatten)]
     pub receiver: ReceiverModel,
@@ -97,12 +94,6 @@ impl From<&PcssSettings> for PcssSettingsUniform {
             normal_offset: settings.bias.normal_offset,
         }
     }
-}
-
-/// The pass's pipeline constants: whether it counts reads and how it reads the shadow map.
-fn constants(read_counts: &ReadCounts, shadow_map_reads: ShadowMapReads) -> [(&'static str, f64); 2] {
-    let [count_reads] = read_counts.pipeline_constants();
-    [count_reads, shadow_map_reads.pipeline_constant()]
 }
 
 /// The blocker search and filter, as one of [`TapSource`]'s passes.
@@ -136,14 +127,11 @@ impl Pcss {
     pub fn new(setup: &TechniqueSetup<'_>) -> Result<Self> {
         let settings = PcssSettings::from_params(setup.params)?;
         let device = &setup.gpu.device;
-        let depth_map = settings.bias.depth_map_read_as(setup, "pcss_shadow_map", settings.shadow_map_size, settings.shadow_map_reads)?;
+        let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
-        let read_counts = ReadCounts::new(device, "pcss_read_counts", &[PASS], settings.count_reads);
-        let map_layout = bind_group_layout(
-            device,
-            "pcss_map_layout",
-            &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2), ShadowMapReads::storage_layout_entry(3)],
-        );
+        // Counting pipelines for count_reads, and for the framework's counting frame (--count-work).
+        let read_counts = ReadCounts::new(device, "pcss_read_counts", &[PASS], settings.count_reads || setup.count_work);
+        let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
             "pcss_map_bind_group",
@@ -152,7 +140,6 @@ impl Pcss {
                 wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
                 settings_buffer.as_entire_binding(),
                 read_counts.buffer().as_entire_binding(),
-                wgpu::BindingResource::TextureView(&depth_map.storage_view),
             ],
         );
         // Blocker search, penumbra estimate and filtering are one pass: each needs only the previous one's result at the same pixel.
@@ -166,21 +153,16 @@ impl Pcss {
                     (&module, "pcss_filter"),
                     Some(&map_layout),
                     VISIBILITY_FORMAT.into(),
-                    &constants(&read_counts, settings.shadow_map_reads),
+                    &read_counts.pipeline_constants(),
                 )?)
             }
-            TapSource::WorkgroupTile => Self::tiled(setup, &map_layout, &read_counts, settings.shadow_map_reads)?,
+            TapSource::WorkgroupTile => Self::tiled(setup, &map_layout, &read_counts)?,
         };
         Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, width: setup.scene.width, height: setup.scene.height })
     }
 
     /// The compute pass of [`TapSource::WorkgroupTile`].
-    fn tiled(
-        setup: &TechniqueSetup<'_>,
-        map_layout: &wgpu::BindGroupLayout,
-        read_counts: &ReadCounts,
-        shadow_map_reads: ShadowMapReads,
-    ) -> Result<SearchAndFilter> {
+    fn tiled(setup: &TechniqueSetup<'_>, map_layout: &wgpu::BindGroupLayout, read_counts: &ReadCounts) -> Result<SearchAndFilter> {
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let module = create_shader_with_imports(setup.gpu, "pcss_filter_tiled_shader", TILED_SHADER, LOCAL_SHADERS)?;
@@ -191,7 +173,7 @@ impl Pcss {
             &module,
             "pcss_filter_tiled",
             &[&setup.scene.uniform_layout, &gbuffer.layout, map_layout, &output_layout],
-            &constants(read_counts, shadow_map_reads),
+            &read_counts.pipeline_constants(),
         );
         let tile_counts = storage_buffer(device, "pcss_tile_counts", 8);
         let output_groups = setup
@@ -233,6 +215,13 @@ impl ShadowTechnique for Pcss {
             }
         }
         Ok(())
+    }
+
+    /// The pass's texel reads (the G-buffer's two texels and every shadow-map tap, one each; in the
+    /// tiled pass a tap read from workgroup memory is not a texel read, the tile's loads are not
+    /// counted either) and the pixels it computed, when built for counting.
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 
     /// With `count_reads`: texture reads per computed pixel, and the pixels; with `tap_source =

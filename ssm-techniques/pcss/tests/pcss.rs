@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use ssm_scene::builtin;
-use ssm_testing::{assert_same_pixels, at, error_against_reference, gpu, parallel_square_exact, pixel_of, render};
+use ssm_testing::{at, error_against_reference, gpu, parallel_square_exact, pixel_of, render};
 
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 120;
@@ -153,24 +153,5 @@ fn workgroup_tiles_give_the_fragment_passes_pixels() {
         assert!(shadowed > 100, "{name}: the case has too little shadow");
         assert!((low..=high).contains(&share), "{name}: {share} of the workgroups tiled, expected {low} to {high}");
         assert_eq!(largest, 0.0, "{name}: the tiled pass differs from the fragment pass by up to {largest}");
-    }
-}
-
-/// `shadow_map_reads = storage` reads each tap's texel from the shadow map bound as a read-only
-/// storage texture: the same texels as the sampled reads, so the same pixels to the bit, in the
-/// fragment pass and in the tiled compute pass (which loads its tiles through the same read), on
-/// leaves at Table 4's largest kernels and on a coarse map whose tiles hold every window.
-#[test]
-fn storage_reads_give_the_sampled_reads_pixels() {
-    let gpu = gpu();
-    let leaves = builtin("leaves").unwrap().build();
-    let cases: [ssm_testing::PixelCase<'_>; 3] = [
-        ("leaves 29/41", &leaves, &[("blocker_kernel", "29"), ("pcf_kernel", "41")]),
-        ("leaves 29/41 tiled", &leaves, &[("blocker_kernel", "29"), ("pcf_kernel", "41"), ("tap_source", "workgroup_tile")]),
-        ("coarse map tiled", &builtin("floating-sphere").unwrap().build(), &[("shadow_map_size", "64"), ("tap_source", "workgroup_tile")]),
-    ];
-    for (name, scene, settings) in cases {
-        let reads = ("shadow_map_reads", ["storage", "sampled"]);
-        assert_same_pixels(&gpu, name, scene, &ssm_pcss::INFO, settings, reads, (WIDTH, HEIGHT));
     }
 }
