@@ -3,6 +3,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
 
 struct HardSettings {
     // Normal offset of the lookup point, in shadow-map texels.
@@ -13,15 +14,35 @@ struct HardSettings {
 };
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: HardSettings;
+// Counter 0: hard_lookup's (pixels, texel reads) per bucket (common/read_counts.wgsl), written
+// only with COUNT_READS (a counting frame, TechniqueSetup::count_work).
+@group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-@fragment
-fn hard_lookup(in: FullscreenVertex) -> @location(0) f32 {
-    let point = screen_point(in);
+// Texel reads of this invocation, each a textureLoad (1 texel): the G-buffer's two (position and
+// normal, at every pixel), and the one shadow-map texel of a pixel that needs the lookup. The
+// normal offset reads none (it takes the map's size only).
+var<private> reads: u32 = 0u;
+
+fn hard_visibility(point: ScreenPoint) -> f32 {
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         return trivial;
     }
     let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
     let uvd = light_uv_depth(frame, lookup);
+    reads += 1u;
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+}
+
+@fragment
+fn hard_lookup(in: FullscreenVertex) -> @location(0) f32 {
+    let point = screen_point(in);
+    reads = 2u;
+    let visibility = hard_visibility(point);
+    if (COUNT_READS) {
+        let word = read_count_word(0u, point.texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+    return visibility;
 }

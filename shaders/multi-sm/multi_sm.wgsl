@@ -5,6 +5,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
 
 struct MultiSmSettings {
     // 1 / K.
@@ -19,6 +20,13 @@ struct MultiSmSettings {
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: MultiSmSettings;
 @group(2) @binding(2) var visibility: texture_storage_2d<r32float, read_write>;
+// Counters 0 (texel reads) and 1 (storage bytes) of multi_sm_accumulate, (invocations, count) per
+// bucket (common/read_counts.wgsl), summed over the K dispatches; written only with COUNT_READS
+// (a counting frame, TechniqueSetup::count_work). Each textureLoad is one texel: per invocation
+// inside the target, the G-buffer's two, the visibility's running sum, and the shadow map's one
+// where the sample's lookup is made (the normal offset reads none); it stores one r32float, 4
+// bytes.
+@group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 @compute @workgroup_size(8, 8)
 fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -29,6 +37,7 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let texel = vec2<i32>(id.xy);
     let point = screen_point_at(texel);
     var lit = 1.0;
+    var reads = 3u;
     if (point.covered) {
         // This sample's frame is a point light: behind a closed surface's tangent plane, the
         // surface itself hides it (and the other shared rules, screen_pass.wgsl).
@@ -37,9 +46,18 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
         } else {
             let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
             let uvd = light_uv_depth(frame, lookup);
+            reads += 1u;
             lit = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
         }
     }
     let sum = textureLoad(visibility, texel).x + settings.weight * lit;
     textureStore(visibility, texel, vec4<f32>(sum, 0.0, 0.0, 0.0));
+    if (COUNT_READS) {
+        let reads_word = read_count_word(0u, texel);
+        atomicAdd(&read_counts[reads_word], 1u);
+        atomicAdd(&read_counts[reads_word + 1u], reads);
+        let bytes_word = read_count_word(1u, texel);
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], 4u);
+    }
 }

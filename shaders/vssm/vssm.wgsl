@@ -21,6 +21,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
 // #import vssm/vssm_common.wgsl
 
 struct VssmSettings {
@@ -39,6 +40,17 @@ struct VssmSettings {
 @group(2) @binding(1) var<uniform> settings: VssmSettings;
 // The depth map the table was built from, for its size and the normal offset's texel.
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
+// Counter 4 (after vssm_sat.wgsl's four): vssm_filter's (pixels, texel reads) per bucket
+// (common/read_counts.wgsl), written only with COUNT_READS (a counting frame,
+// TechniqueSetup::count_work).
+@group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texel reads of this invocation, each a textureLoad (1 texel, of 16 bytes in the table): the
+// G-buffer's two at every pixel, and every table entry loaded (table_at; an entry before the
+// table's first row or column is 0 and not loaded). The normal offset reads none (it takes the
+// map's size only). With one sub-region a query loads 16 entries (four columns of four),
+// neighbouring sub-regions share their columns: 8(k + 1) a row of k.
+var<private> reads: u32 = 0u;
 
 // The table at texel (i, j): the moments' sums over [0, i] × [0, j]; 0 for i or j below 0.
 fn table_at(i: i32, j: i32) -> vec4<u32> {
@@ -46,6 +58,7 @@ fn table_at(i: i32, j: i32) -> vec4<u32> {
         return vec4<u32>(0u);
     }
     let last = i32(settings.size) - 1;
+    reads += 1u;
     return textureLoad(moment_table, vec2<i32>(min(i, last), min(j, last)), 0);
 }
 
@@ -239,6 +252,18 @@ fn blocker_search(uvd: vec3<f32>, extent: vec2<f32>, k: u32, receiver: TapPlane,
 @fragment
 fn vssm_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
+    reads = 2u;
+    let visibility = vssm_visibility(point);
+    if (COUNT_READS) {
+        let word = read_count_word(4u, point.texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+    return visibility;
+}
+
+// The visibility at a pixel's point: steps 1 to 3.
+fn vssm_visibility(point: ScreenPoint) -> f32 {
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         return trivial;

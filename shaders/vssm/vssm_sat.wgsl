@@ -8,6 +8,7 @@
 // one per column (along y).
 
 // #import common/light_frame.wgsl
+// #import common/read_counts.wgsl
 // #import vssm/vssm_common.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
@@ -17,6 +18,24 @@
 // Columns pass (its own layout of group 1).
 @group(1) @binding(2) var row_sums: texture_2d<u32>;
 @group(1) @binding(3) var table_out: texture_storage_2d<rgba32uint, write>;
+// Both passes: (threads, count) per bucket (common/read_counts.wgsl), written only with
+// COUNT_READS (a counting frame, TechniqueSetup::count_work). Counters: 0 the rows pass's texel
+// reads, 1 its storage bytes, 2 and 3 the columns pass's. Each thread loads one texel (a
+// textureLoad) and stores one rgba32uint texel (16 bytes) per texel of its row or column.
+@group(1) @binding(4) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Adds one thread's `texels` loaded and stored to the counters from `counter` (reads) on; the
+// bucket is chosen by the thread's row or column.
+fn record_sat_work(counter: u32, line: u32, texels: u32) {
+    if (COUNT_READS) {
+        let reads_word = read_count_word(counter, vec2<i32>(0, i32(line)));
+        atomicAdd(&read_counts[reads_word], 1u);
+        atomicAdd(&read_counts[reads_word + 1u], texels);
+        let bytes_word = read_count_word(counter + 1u, vec2<i32>(0, i32(line)));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], 16u * texels);
+    }
+}
 
 @compute @workgroup_size(64)
 fn vssm_sat_rows(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -30,6 +49,7 @@ fn vssm_sat_rows(@builtin(global_invocation_id) id: vec3<u32>) {
         sums = add_sums(sums, texel_value(textureLoad(depth_map, texel, 0).x, frame.projection.w));
         textureStore(row_sums_out, texel, sums);
     }
+    record_sat_work(0u, id.x, size.x);
 }
 
 @compute @workgroup_size(64)
@@ -44,4 +64,5 @@ fn vssm_sat_columns(@builtin(global_invocation_id) id: vec3<u32>) {
         sums = add_sums(sums, textureLoad(row_sums, texel, 0));
         textureStore(table_out, texel, sums);
     }
+    record_sat_work(2u, id.x, size.y);
 }

@@ -8,11 +8,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, LightDepthMap, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings, ShadowMapBias,
-    ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique,
-    screen_space_requirements,
+    Frame, GpuContext, LightDepthMap, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings,
+    ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
+    register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -20,6 +21,8 @@ pub const NAME: &str = "hard";
 
 /// The lookup shader.
 const SHADER: &str = ssm_shaders::hard::HARD;
+/// The lookup pass's label, and its read counter's.
+const LOOKUP_PASS: &str = "hard_lookup";
 
 /// Settings of [`HardShadowMapping`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
@@ -53,6 +56,8 @@ pub struct HardShadowMapping {
     depth_map: LightDepthMap,
     lookup: ScreenPass,
     map_bind_group: wgpu::BindGroup,
+    /// The lookup's texel reads, counted in a counting frame only ([`TechniqueSetup::count_work`]).
+    read_counts: ReadCounts,
 }
 
 impl HardShadowMapping {
@@ -65,25 +70,44 @@ impl HardShadowMapping {
         let device = &setup.gpu.device;
         let depth_map = settings.bias.depth_map(setup, "hard_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "hard_settings_uniform", &HardSettingsUniform::from(&settings));
-        let map_layout = bind_group_layout(device, "hard_map_layout", &[texture_entry(0), uniform_entry(1)]);
+        // The shadow-map pass reads no texel (it rasterises the scene); the lookup reads the
+        // G-buffer and the map (shaders/hard/hard.wgsl says what it counts).
+        let read_counts = ReadCounts::new(device, "hard_read_counts", &[LOOKUP_PASS], setup.count_work);
+        let map_layout = bind_group_layout(device, "hard_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
             "hard_map_bind_group",
             &map_layout,
-            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), settings_buffer.as_entire_binding()],
+            &[
+                wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                settings_buffer.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
+            ],
         );
         let module = create_shader(setup.gpu, "hard_lookup_shader", SHADER)?;
-        let lookup =
-            ScreenPass::new(setup, NAME, "hard_lookup", (&module, "hard_lookup"), Some(&map_layout), VISIBILITY_FORMAT.into(), &[])?;
-        Ok(Self { depth_map, lookup, map_bind_group })
+        let lookup = ScreenPass::new(
+            setup,
+            NAME,
+            LOOKUP_PASS,
+            (&module, "hard_lookup"),
+            Some(&map_layout),
+            VISIBILITY_FORMAT.into(),
+            &read_counts.pipeline_constants(),
+        )?;
+        Ok(Self { depth_map, lookup, map_bind_group, read_counts })
     }
 }
 
 impl ShadowTechnique for HardShadowMapping {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
+        self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
         self.lookup.encode(frame, light, output, Some(&self.map_bind_group), None);
         Ok(())
+    }
+
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 }
 

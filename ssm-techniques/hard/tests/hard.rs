@@ -83,3 +83,30 @@ fn every_builtin_scene_matches_its_exact_hard_shadow_up_to_the_edges() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The lookup's texel reads in a counting frame (`--count-work`) against the count by hand
+/// (shaders/hard/hard.wgsl's convention: a textureLoad is one texel): every pixel loads its two
+/// G-buffer texels, and every covered pixel one shadow-map texel, as none is left to the shared
+/// rules on `parallel-square` (no closed mesh, every surface in front of the light); the normal
+/// offset reads none. One invocation per pixel: the full-screen triangle shades each once, and a
+/// helper invocation's atomics do nothing. The shadow-map pass reads no texel.
+#[test]
+fn the_lookup_reads_two_gbuffer_texels_per_pixel_and_one_map_texel_per_covered_pixel() {
+    let (width, height) = (96u32, 72u32);
+    let settings = [("shadow_map_size", "256")];
+    let gpu = gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let mut rendered = render(&gpu, &scene, &ssm_hard::INFO, &settings, width, height).unwrap();
+    let pixels = u64::from(width * height);
+    let covered = rendered.coverage().iter().filter(|covered| **covered).count() as u64;
+    assert!(covered > 0 && covered < pixels, "{covered} of {pixels} pixels covered: the case must have both");
+    let params = ssm_hard::INFO.params_from(settings).unwrap();
+    let work = rendered.renderer.count_work(&ssm_hard::INFO, &params).unwrap();
+    println!("{}", work.passes_column());
+    assert!(work.shader_counts, "hard counts its reads");
+    let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
+    let lookup = pass("hard_lookup");
+    assert_eq!((lookup.counted_invocations, lookup.texel_reads), (pixels, 2 * pixels + covered));
+    assert_eq!((lookup.atomics, lookup.storage_bytes), (0, 0), "the lookup writes its render target only");
+    assert_eq!(pass("hard_shadow_map").texel_reads, 0);
+}

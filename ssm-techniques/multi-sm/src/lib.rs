@@ -10,10 +10,11 @@ use ssm_core::passes::{
     bind_group, bind_group_layout, color_attachment, compute_pipeline, texture_entry, uniform_buffer, uniform_entry,
     visibility_storage_entry,
 };
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
 use ssm_core::ssm_scene::RectLight;
 use ssm_core::{
-    Error, Frame, LightDepthMap, LightFrame, LightFrameUniform, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE,
+    Error, Frame, GpuContext, LightDepthMap, LightFrame, LightFrameUniform, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE,
     SHADOW_MAP_MIN_SIZE, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
     UniformStruct, register_technique, screen_space_requirements,
 };
@@ -23,6 +24,11 @@ pub const NAME: &str = "multi-sm";
 
 /// The accumulation shader.
 const SHADER: &str = ssm_shaders::multi_sm::MULTI_SM;
+/// The accumulation pass's label.
+const ACCUMULATE_PASS: &str = "multi_sm_accumulate";
+/// What the accumulation counts in a counting frame, in the order its shader indexes them: texel
+/// reads and bytes stored (the clears and the K shadow-map passes read no texel).
+const COUNTERS: &[(&str, &str)] = &[(ACCUMULATE_PASS, "reads"), (ACCUMULATE_PASS, "storage_bytes")];
 
 /// Settings of [`MultiShadowMaps`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
@@ -70,6 +76,8 @@ pub struct MultiShadowMaps {
     gbuffer_bind_group: wgpu::BindGroup,
     /// Per light: the group binding the shadow map, the settings and that light's target.
     own_groups: Vec<wgpu::BindGroup>,
+    /// The accumulation's counts, made in a counting frame only ([`TechniqueSetup::count_work`]).
+    read_counts: ReadCounts,
     width: u32,
     height: u32,
 }
@@ -92,8 +100,12 @@ impl MultiShadowMaps {
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let depth_map = settings.bias.depth_map(setup, "multi_sm_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "multi_sm_settings_uniform", &MultiSmSettingsUniform::from(&settings));
-        let own_layout =
-            bind_group_layout(device, "multi_sm_own_layout", &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2)]);
+        let read_counts = ReadCounts::with_units(device, "multi_sm_read_counts", COUNTERS, setup.count_work);
+        let own_layout = bind_group_layout(
+            device,
+            "multi_sm_own_layout",
+            &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2), ReadCounts::layout_entry(3)],
+        );
         let own_groups = setup
             .outputs
             .iter()
@@ -107,6 +119,7 @@ impl MultiShadowMaps {
                         wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
                         settings_buffer.as_entire_binding(),
                         wgpu::BindingResource::TextureView(output),
+                        read_counts.buffer().as_entire_binding(),
                     ],
                 )
             })
@@ -118,7 +131,7 @@ impl MultiShadowMaps {
             &module,
             "multi_sm_accumulate",
             &[setup.gpu.uniform_layout(), &gbuffer.layout, &own_layout],
-            &[],
+            &read_counts.pipeline_constants(),
         );
         Ok(Self {
             depth_map,
@@ -126,6 +139,7 @@ impl MultiShadowMaps {
             accumulate,
             gbuffer_bind_group: gbuffer.bind_group.clone(),
             own_groups,
+            read_counts,
             width: setup.scene.width,
             height: setup.scene.height,
         })
@@ -189,11 +203,12 @@ impl ShadowTechnique for MultiShadowMaps {
             sample.frame.sealed = sealed;
             frame.gpu.queue.write_buffer(&sample.buffer, 0, bytemuck::bytes_of(&LightFrameUniform::from(&sample.frame)));
         }
+        self.read_counts.clear(frame, light);
         // The sum starts at 0, not at the framework's 1.
         drop(frame.render_pass("multi_sm_clear", &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))], None));
         for sample in frames.iter() {
             self.depth_map.encode_with(frame, &sample.bind_group);
-            let mut pass = frame.compute_pass("multi_sm_accumulate");
+            let mut pass = frame.compute_pass(ACCUMULATE_PASS);
             pass.set_pipeline(&self.accumulate);
             pass.set_bind_group(0, &sample.bind_group, &[]);
             pass.set_bind_group(1, &self.gbuffer_bind_group, &[]);
@@ -201,6 +216,10 @@ impl ShadowTechnique for MultiShadowMaps {
             pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
         }
         Ok(())
+    }
+
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 }
 

@@ -67,3 +67,34 @@ fn on_parallel_planes_k_maps_compute_the_midpoint_rule() {
         assert!(difference < 0.01, "K = {k}: {difference}");
     }
 }
+
+/// The accumulation's counts in a counting frame (`--count-work`) against the count by hand
+/// (shaders/multi-sm/multi_sm.wgsl's convention: a textureLoad is one texel, an r32float store 4
+/// bytes): each of the K dispatches runs one invocation per pixel, which loads its two G-buffer
+/// texels and the visibility's running sum, and stores the sum; a covered pixel also loads one
+/// shadow-map texel, as none is left to the shared rules on `parallel-square` (no closed mesh,
+/// every surface in front of every sample). The K shadow-map passes read no texel.
+#[test]
+fn the_accumulation_counts_k_times_its_reads_and_stores_per_pixel() {
+    let (width, height) = (96u32, 72u32);
+    let settings = [("samples", "4"), ("shadow_map_size", "256")];
+    let gpu = ssm_testing::gpu();
+    let scene = builtin("parallel-square").unwrap().build();
+    let mut rendered = ssm_testing::render(&gpu, &scene, &ssm_multi_sm::INFO, &settings, width, height).unwrap();
+    let pixels = u64::from(width * height);
+    let covered = rendered.coverage().iter().filter(|covered| **covered).count() as u64;
+    assert!(covered > 0 && covered < pixels, "{covered} of {pixels} pixels covered: the case must have both");
+    let params = ssm_multi_sm::INFO.params_from(settings).unwrap();
+    let work = rendered.renderer.count_work(&ssm_multi_sm::INFO, &params).unwrap();
+    println!("{}", work.passes_column());
+    let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
+    let accumulate = pass("multi_sm_accumulate");
+    let k = 4;
+    assert_eq!(accumulate.runs, k, "one dispatch per sample");
+    assert_eq!(
+        (accumulate.counted_invocations, accumulate.texel_reads, accumulate.storage_bytes),
+        (k * pixels, k * (3 * pixels + covered), k * 4 * pixels)
+    );
+    assert_eq!(accumulate.atomics, 0);
+    assert_eq!(pass("multi_sm_shadow_map").texel_reads, 0);
+}

@@ -16,10 +16,12 @@ use ssm_core::passes::{
     bind_group, bind_group_layout, compute_pipeline, labelled_view, texture_entry, uniform_buffer, uniform_entry,
     write_storage_texture_entry,
 };
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
-    Frame, LightDepthMap, ParamValues, Preset, Requirements, Result, ScreenPass, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo,
-    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique, screen_space_requirements,
+    Frame, GpuContext, LightDepthMap, ParamValues, Preset, Requirements, Result, ScreenPass, Settings, ShadowMapBias, ShadowTechnique,
+    TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique,
+    screen_space_requirements,
 };
 
 /// The registered name.
@@ -33,6 +35,17 @@ const SAT_SHADER: &str = ssm_shaders::vssm::VSSM_SAT;
 const FILTER_SHADER: &str = ssm_shaders::vssm::VSSM;
 /// WGSL files the VSSM shaders import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
+
+/// What the shaders count in a counting frame, in the order they index the counters: the table's
+/// two passes their texel reads and bytes stored (vssm_sat.wgsl), the filter its texel reads
+/// (vssm.wgsl). The depth map's pass reads no texel.
+const COUNTERS: &[(&str, &str)] = &[
+    ("vssm_sat_rows", "reads"),
+    ("vssm_sat_rows", "storage_bytes"),
+    ("vssm_sat_columns", "reads"),
+    ("vssm_sat_columns", "storage_bytes"),
+    ("vssm_filter", "reads"),
+];
 
 /// The table's texel format: one 128-bit integer of three fixed-point sums (Σz², Σz, the texels with a surface) as four 32-bit words.
 const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
@@ -100,6 +113,8 @@ pub struct VarianceSoftShadowMaps {
     columns_group: wgpu::BindGroup,
     filter: ScreenPass,
     filter_group: wgpu::BindGroup,
+    /// The passes' counts, made in a counting frame only ([`TechniqueSetup::count_work`]).
+    read_counts: ReadCounts,
     size: u32,
 }
 
@@ -136,30 +151,53 @@ impl VarianceSoftShadowMaps {
             },
             ..texture_entry(binding)
         };
-        let rows_layout =
-            bind_group_layout(device, "vssm_sat_rows_layout", &[texture_entry(0), write_storage_texture_entry(1, TABLE_FORMAT)]);
-        let columns_layout =
-            bind_group_layout(device, "vssm_sat_columns_layout", &[uint_texture_entry(2), write_storage_texture_entry(3, TABLE_FORMAT)]);
+        let read_counts = ReadCounts::with_units(device, "vssm_read_counts", COUNTERS, setup.count_work);
+        let rows_layout = bind_group_layout(
+            device,
+            "vssm_sat_rows_layout",
+            &[texture_entry(0), write_storage_texture_entry(1, TABLE_FORMAT), ReadCounts::layout_entry(4)],
+        );
+        let columns_layout = bind_group_layout(
+            device,
+            "vssm_sat_columns_layout",
+            &[uint_texture_entry(2), write_storage_texture_entry(3, TABLE_FORMAT), ReadCounts::layout_entry(4)],
+        );
         let sat_module = create_shader_with_imports(gpu, "vssm_sat_shader", SAT_SHADER, LOCAL_SHADERS)?;
         let frame_layout = &setup.scene.uniform_layout;
-        let rows = compute_pipeline(device, "vssm_sat_rows_pipeline", &sat_module, "vssm_sat_rows", &[frame_layout, &rows_layout], &[]);
-        let columns =
-            compute_pipeline(device, "vssm_sat_columns_pipeline", &sat_module, "vssm_sat_columns", &[frame_layout, &columns_layout], &[]);
-        let rows_group = bind_group(
+        let constants = read_counts.pipeline_constants();
+        let rows =
+            compute_pipeline(device, "vssm_sat_rows_pipeline", &sat_module, "vssm_sat_rows", &[frame_layout, &rows_layout], &constants);
+        let columns = compute_pipeline(
             device,
-            "vssm_sat_rows_bind_group",
-            &rows_layout,
-            &[wgpu::BindingResource::TextureView(&depth_map.linear_depth_view), wgpu::BindingResource::TextureView(&row_sums)],
+            "vssm_sat_columns_pipeline",
+            &sat_module,
+            "vssm_sat_columns",
+            &[frame_layout, &columns_layout],
+            &constants,
         );
+        let rows_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vssm_sat_rows_bind_group"),
+            layout: &rows_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&row_sums) },
+                wgpu::BindGroupEntry { binding: 4, resource: read_counts.buffer().as_entire_binding() },
+            ],
+        });
         let columns_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("vssm_sat_columns_bind_group"),
             layout: &columns_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&row_sums) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&table) },
+                wgpu::BindGroupEntry { binding: 4, resource: read_counts.buffer().as_entire_binding() },
             ],
         });
-        let filter_layout = bind_group_layout(device, "vssm_filter_layout", &[uint_texture_entry(0), uniform_entry(1), texture_entry(2)]);
+        let filter_layout = bind_group_layout(
+            device,
+            "vssm_filter_layout",
+            &[uint_texture_entry(0), uniform_entry(1), texture_entry(2), ReadCounts::layout_entry(3)],
+        );
         let filter_group = bind_group(
             device,
             "vssm_filter_bind_group",
@@ -168,6 +206,7 @@ impl VarianceSoftShadowMaps {
                 wgpu::BindingResource::TextureView(&table),
                 uniform_buffer(device, "vssm_settings_uniform", &VssmSettingsUniform::new(&settings)).as_entire_binding(),
                 wgpu::BindingResource::TextureView(&depth_map.linear_depth_view),
+                read_counts.buffer().as_entire_binding(),
             ],
         );
         let filter_module = create_shader_with_imports(gpu, "vssm_filter_shader", FILTER_SHADER, LOCAL_SHADERS)?;
@@ -178,14 +217,15 @@ impl VarianceSoftShadowMaps {
             (&filter_module, "vssm_filter"),
             Some(&filter_layout),
             VISIBILITY_FORMAT.into(),
-            &[],
+            &constants,
         )?;
-        Ok(Self { depth_map, rows, columns, rows_group, columns_group, filter, filter_group, size })
+        Ok(Self { depth_map, rows, columns, rows_group, columns_group, filter, filter_group, read_counts, size })
     }
 }
 
 impl ShadowTechnique for VarianceSoftShadowMaps {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
+        self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
         let groups = self.size.div_ceil(64);
         {
@@ -206,6 +246,10 @@ impl ShadowTechnique for VarianceSoftShadowMaps {
         }
         self.filter.encode(frame, light, output, Some(&self.filter_group), None);
         Ok(())
+    }
+
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 }
 

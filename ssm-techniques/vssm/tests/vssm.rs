@@ -101,3 +101,54 @@ fn a_point_light_gives_the_hard_shadow() {
     );
     assert!(off_edge.is_empty(), "off the hard shadow's edge (x, y, vssm, pcss): {off_edge:?}");
 }
+
+/// The counts of a counting frame (`--count-work`) against the counts by hand (a textureLoad is
+/// one texel; a table texel stored is 16 bytes), on `parallel-square` under a point light with a
+/// 128² map:
+/// - the table's rows pass runs one thread per row, which loads the 128 depths of its row and
+///   stores 128 sums; the columns pass the same per column: 128² texels loaded and 16 · 128²
+///   bytes stored each;
+/// - the filter loads two G-buffer texels at every pixel, and table entries at every covered pixel
+///   (none is left to the shared rules here: no closed mesh, every surface in front of the light).
+///   Under a point light every region is the one-texel box under the point (the search's and the
+///   filter's extents are the least one), one sub-region whose four table columns of four entries
+///   are 16 loads, none skipped when the point is at least 1.5 texels from the table's first row
+///   and column (asserted). A search that finds no blocker ends there (no retry: the region is
+///   already the least); one that finds some is refined twice over the same region, then filtered
+///   over it, 64 loads, and exactly those pixels read below 1 (a blocker share above 1e-6).
+#[test]
+fn counted_work_is_the_tables_texels_and_16_entries_per_region() {
+    let (width, height) = (96u32, 72u32);
+    let size = 128u64;
+    let settings = [("shadow_map_size", "128")];
+    let gpu = gpu();
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.lights[0].half_size = Vec2::ZERO;
+    let mut rendered = render(&gpu, &scene, &ssm_vssm::INFO, &settings, width, height).unwrap();
+    let params = ssm_vssm::INFO.params_from(settings).unwrap();
+    let work = rendered.renderer.count_work(&ssm_vssm::INFO, &params).unwrap();
+    println!("{}", work.passes_column());
+    let visibility = rendered.renderer.read_visibility(0, "vssm").unwrap();
+    let positions = rendered.renderer.read_positions().unwrap();
+    let frame = &rendered.renderer.scene.light_frames[0];
+    let (mut found, mut not_found) = (0u64, 0u64);
+    for (position, visibility) in positions.iter().zip(&visibility) {
+        if position[3] < 0.5 {
+            continue;
+        }
+        let texel = frame.uv_depth(glam::Vec3::new(position[0], position[1], position[2])).truncate() * size as f32;
+        assert!(texel.min_element() > 2.0 && texel.max_element() < size as f32 - 1.0, "lookup at texel {texel} too near the map's edge");
+        if *visibility < 1.0 { found += 1 } else { not_found += 1 }
+    }
+    let pixels = u64::from(width * height);
+    assert!(found > 0 && not_found > 0, "{found} pixels in shadow, {not_found} lit: the case must have both");
+    let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
+    for name in ["vssm_sat_rows", "vssm_sat_columns"] {
+        let sat = pass(name);
+        assert_eq!((sat.counted_invocations, sat.texel_reads, sat.storage_bytes), (size, size * size, 16 * size * size), "{name}");
+    }
+    let filter = pass("vssm_filter");
+    assert_eq!((filter.counted_invocations, filter.texel_reads), (pixels, 2 * pixels + 16 * not_found + 64 * found));
+    assert_eq!(work.total(|p| p.atomics), 0);
+    assert_eq!(pass("vssm_shadow_map").texel_reads, 0);
+}

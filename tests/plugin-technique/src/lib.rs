@@ -6,36 +6,60 @@
 //! blocks: a [`LightDepthMap`] over every triangle and a [`ScreenPass`] that
 //! compares each pixel's light depth with it. It needs the G-buffer and
 //! nothing else, and keeps its WGSL in the crate to show that a plug-in needs
-//! nothing of ours but the `common/` imports.
+//! nothing of ours but the `common/` imports. Built for `--count-work`, its lookup counts the
+//! texels it reads ([`ReadCounts`]).
 
 use ssm_core::passes::texture_entry;
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
 use ssm_core::{
-    Frame, Geometry, LightDepthMap, LightDepthMapDesc, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
+    Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc, ParamKind, ParamSpec, ParamValues, Requirements, Result, ScreenPass,
     ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, VISIBILITY_FORMAT, register_technique,
 };
 
 /// The registered name.
 pub const NAME: &str = "plugin-hard";
 
+/// The lookup pass's label, and its read counter's.
+pub const LOOKUP_PASS: &str = "plugin_hard_lookup";
+
 /// The lookup: lit where the surface is no farther from the light than the nearest surface the
-/// depth map saw along the same ray (one texel of normal offset against acne).
+/// depth map saw along the same ray (one texel of normal offset against acne). With COUNT_READS
+/// (a counting frame) it counts the texels it loads: the G-buffer's two at every pixel, the depth
+/// map's one where it looks up (the normal offset takes the map's size only).
 const SHADER: &str = r"
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
+// #import common/read_counts.wgsl
 
 @group(2) @binding(0) var depth_map: texture_2d<f32>;
+@group(2) @binding(1) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-@fragment
-fn plugin_hard(in: FullscreenVertex) -> @location(0) f32 {
-    let point = screen_point(in);
+// Texels this invocation loads.
+var<private> reads: u32 = 0u;
+
+fn plugin_hard_visibility(point: ScreenPoint) -> f32 {
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         return trivial;
     }
     let lookup = normal_offset_position(frame, depth_map, point.position, point.normal, 1.0);
     let uvd = light_uv_depth(frame, lookup);
+    reads += 1u;
     return select(0.0, 1.0, uvd.z <= shadow_map_depth(depth_map, uvd.xy));
+}
+
+@fragment
+fn plugin_hard(in: FullscreenVertex) -> @location(0) f32 {
+    let point = screen_point(in);
+    reads = 2u;
+    let visibility = plugin_hard_visibility(point);
+    if (COUNT_READS) {
+        let word = read_count_word(0u, point.texel);
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
+    return visibility;
 }
 ";
 
@@ -47,13 +71,19 @@ struct PluginHard {
     depth_map: LightDepthMap,
     lookup: ScreenPass,
     depth_map_group: wgpu::BindGroup,
+    read_counts: ReadCounts,
 }
 
 impl ShadowTechnique for PluginHard {
     fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
+        self.read_counts.clear(frame, light);
         self.depth_map.encode(frame, light);
         self.lookup.encode(frame, light, output, Some(&self.depth_map_group), None);
         Ok(())
+    }
+
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 }
 
@@ -78,17 +108,30 @@ fn create(setup: &TechniqueSetup<'_>) -> Result<Box<dyn ShadowTechnique>> {
         },
     )?;
     let device = &setup.gpu.device;
-    let layout = device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("plugin_hard_layout"), entries: &[texture_entry(0)] });
+    let read_counts = ReadCounts::new(device, "plugin_hard_read_counts", &[LOOKUP_PASS], setup.count_work);
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("plugin_hard_layout"),
+        entries: &[texture_entry(0), ReadCounts::layout_entry(1)],
+    });
     let depth_map_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("plugin_hard_bind_group"),
         layout: &layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) }],
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_map.linear_depth_view) },
+            wgpu::BindGroupEntry { binding: 1, resource: read_counts.buffer().as_entire_binding() },
+        ],
     });
     let module = create_shader(setup.gpu, "plugin_hard_shader", SHADER)?;
-    let lookup =
-        ScreenPass::new(setup, NAME, "plugin_hard_lookup", (&module, "plugin_hard"), Some(&layout), VISIBILITY_FORMAT.into(), &[])?;
-    Ok(Box::new(PluginHard { depth_map, lookup, depth_map_group }))
+    let lookup = ScreenPass::new(
+        setup,
+        NAME,
+        LOOKUP_PASS,
+        (&module, "plugin_hard"),
+        Some(&layout),
+        VISIBILITY_FORMAT.into(),
+        &read_counts.pipeline_constants(),
+    )?;
+    Ok(Box::new(PluginHard { depth_map, lookup, depth_map_group, read_counts }))
 }
 
 /// The registration.
