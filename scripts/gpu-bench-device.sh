@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs scripts/gpu-bench.sh on a lent GPU machine with what scripts/gpu-bench-pack.sh packed in
 # .gpu-bench/ (a prebuilt `ssm`, the Vulkan loader and GL dispatch libraries), and hands back through $OUT (the device
-# tool's folder) the one Markdown table and an archive of every preset's sweep.csv and sweep.md.
+# tool's folder) the one Markdown table and an archive of every preset's sweep.csv and sweep.md,
+# each with the times and the counted work (`--count-work`) side by side.
 # Refuses to time a software adapter unless SSM_BENCH_ALLOW_CPU=1 (how it is tested here).
 #
 #   scripts/gpu-bench-device.sh        # on the lent machine; $OUT must be set

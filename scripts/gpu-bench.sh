@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The speed presets on whatever adapter wgpu picks, at 1920×1080 unless told otherwise, gathered
 # into one Markdown table that names the adapter (issue 13: run it on a machine with a GPU and put
-# the table in the README beside the lavapipe one).
+# the table in the README beside the lavapipe one). Every point's work is counted too (`--count-work`,
+# issue 40: one extra, untimed frame per point), so the table and each sweep.csv give times and
+# counted work (invocations, texel reads, per pass in passes_work) side by side.
 #
 #   scripts/gpu-bench.sh [OUT]          # default OUT: gpu-bench; writes OUT/gpu-bench.md
 #
@@ -21,7 +23,7 @@ frames="${SSM_BENCH_FRAMES:-5}"
 # edges, fragment or shared-row passes, sampled or storage reads; PCSS's workgroup tiles), Atty
 # et al.'s map sizes (one- and two-sided), 1–3 lights for every technique, Shen et al.'s Figs. 10
 # and 11, Forest et al.'s Fig. 12.
-presets="${SSM_BENCH_PRESETS:-sssm-table4 sssm-edges sssm-passes sssm-reads pcss-taps atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
+presets="${SSM_BENCH_PRESETS:-sssm-table4 sssm-edges sssm-passes pcss-taps atty-map-size-time lights pvsm-fig10 pvsm-fig11 wedges-fig12}"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 
 settings=()
@@ -41,7 +43,7 @@ table="$out/gpu-bench.md"
 first=1
 for preset in $presets; do
     echo "== $preset" >&2
-    ssm sweep --preset "$preset" --width "$width" --height "$height" --frames "$frames" \
+    ssm sweep --preset "$preset" --width "$width" --height "$height" --frames "$frames" --count-work \
         "${settings[@]}" --out "$out/$preset"
     # sweep.md: a title naming the adapter, a blank line, the header and its rule, then rows.
     if [ "$first" = 1 ]; then

@@ -7,13 +7,17 @@
 // Keys: 1-9 a technique (the table's order), hold R (or hover the reference's
 // button) for the ground truth, S V E A F the views (shaded, visibility,
 // signed error, absolute error, FLIP), 0 resets the view. Wheel: zoom about
-// the cursor, to single pixels without smoothing; drag: pan.
+// the cursor, to single pixels without smoothing; drag: pan. With counted
+// work (ssm compare --count-work), W switches the metrics table and the
+// per-pass chart between milliseconds and work (the chart then shows texel
+// reads or invocations per pass, as chosen).
 //
 // The view is kept in the address's fragment (#technique=pcss&mode=signed&
-// light=0&zoom=4&x=120&y=80), so a link opens the page on the same view.
+// light=0&zoom=4&x=120&y=80&units=work&chart=reads), so a link opens the
+// page on the same view.
 //
 // For tests, <body> carries data-viewer-ready, data-technique, data-mode,
-// data-light and data-zoom; #readout carries data-pixel="x,y".
+// data-light, data-zoom and data-units; #readout carries data-pixel="x,y".
 (function () {
   'use strict';
   const data = window.SSM_DATA;
@@ -79,6 +83,8 @@
     originX: 0,
     originY: 0,
     pointer: null,
+    units: 'ms',
+    chart: 'reads',
   };
 
   function shown() {
@@ -286,7 +292,9 @@
       return;
     }
     const key = event.key.toLowerCase();
-    if (key >= '1' && key <= '9' && Number(key) <= choices.length) {
+    if (key === 'w' && data.work_columns) {
+      setUnits(state.units === 'ms' ? 'work' : 'ms');
+    } else if (key >= '1' && key <= '9' && Number(key) <= choices.length) {
       select(choices[Number(key) - 1]);
     } else if (key === 'r') {
       state.flipped = true;
@@ -354,18 +362,31 @@
     }
   });
 
-  // The metrics table: sortable by any column, a click on a row selects its technique.
+  // The metrics table: sortable by any column, a click on a row selects its technique. Its
+  // columns are the milliseconds' or, switched to work, the counted work's.
   const table = document.getElementById('metrics');
-  const columns = data.columns;
+  let columns = data.columns;
   const head = table.createTHead().insertRow();
-  columns.forEach(([key, label]) => {
-    const cell = document.createElement('th');
-    cell.textContent = label;
-    cell.dataset.key = key;
-    cell.title = 'sort by ' + label;
-    cell.addEventListener('click', () => sortBy(key));
-    head.appendChild(cell);
-  });
+  function fillHead() {
+    head.textContent = '';
+    columns.forEach(([key, label]) => {
+      const cell = document.createElement('th');
+      cell.textContent = label;
+      cell.dataset.key = key;
+      cell.title = 'sort by ' + label;
+      cell.addEventListener('click', () => sortBy(key));
+      head.appendChild(cell);
+    });
+  }
+  fillHead();
+  // Counts are whole numbers; a count not made is null, shown as '-' (never 0).
+  const COUNTS = ['vertex_invocations', 'fragment_invocations', 'compute_invocations', 'texel_reads', 'atomics', 'target_bytes', 'storage_bytes'];
+  function cellText(key, value) {
+    if (COUNTS.includes(key)) {
+      return typeof value === 'number' ? String(value) : '-';
+    }
+    return typeof value === 'number' ? (Number.isFinite(value) ? value.toFixed(key === 'gpu_ms' ? 2 : 4) : '') : value === null || value === undefined ? '' : String(value);
+  }
   const tableBody = table.createTBody();
   let sorted = { key: null, ascending: true };
   function fill(rows) {
@@ -375,8 +396,7 @@
       line.dataset.technique = row.technique;
       for (const [key] of columns) {
         const cell = line.insertCell();
-        const value = row[key];
-        cell.textContent = typeof value === 'number' ? (Number.isFinite(value) ? value.toFixed(key === 'gpu_ms' ? 2 : 4) : '') : value === null ? '' : String(value);
+        cell.textContent = cellText(key, row[key]);
       }
       line.addEventListener('click', () => {
         if (row.light !== null && row.light !== undefined && row.light !== '') {
@@ -394,7 +414,15 @@
     const rows = data.rows.slice().sort((a, b) => {
       const x = a[key];
       const y = b[key];
-      const order = typeof x === 'number' && typeof y === 'number' ? x - y : String(x).localeCompare(String(y));
+      // Uncounted (null) after every count.
+      const order =
+        typeof x === 'number' && typeof y === 'number'
+          ? x - y
+          : typeof x === 'number' && COUNTS.includes(key)
+            ? -1
+            : typeof y === 'number' && COUNTS.includes(key)
+              ? 1
+              : String(x).localeCompare(String(y));
       return sorted.ascending ? order : -order;
     });
     for (const cell of head.cells) {
@@ -404,6 +432,54 @@
     fill(rows);
     draw();
   }
+  // Milliseconds or work: the table's columns and the per-pass chart's source (the chart's
+  // data-ms, data-reads, data-invocations attributes name the files drawn).
+  const unitBar = document.getElementById('viewer-units');
+  const passChart = document.getElementById('pass-chart');
+  const charts = passChart ? ['reads', 'invocations'].filter((name) => passChart.dataset[name]) : [];
+  function setUnits(units, chart) {
+    state.units = data.work_columns ? units : 'ms';
+    if (chart && charts.includes(chart)) {
+      state.chart = chart;
+    }
+    if (!charts.includes(state.chart) && charts.length > 0) {
+      state.chart = charts[0];
+    }
+    columns = state.units === 'work' ? data.work_columns : data.columns;
+    fillHead();
+    sorted = { key: null, ascending: true };
+    table.dataset.sortedBy = '';
+    fill(data.rows);
+    if (passChart) {
+      const file = state.units === 'work' ? passChart.dataset[state.chart] : passChart.dataset.ms;
+      if (file) {
+        passChart.src = file;
+      }
+    }
+    body.dataset.units = state.units;
+    for (const button of unitBar.querySelectorAll('button')) {
+      button.classList.toggle('selected', button.dataset.units === state.units || (state.units === 'work' && button.dataset.chart === state.chart));
+    }
+    draw();
+  }
+  if (data.work_columns) {
+    const unitChoices = [['ms', null, 'milliseconds'], ['work', null, 'W work']].concat(
+      charts.map((chart) => ['work', chart, 'chart: ' + (chart === 'reads' ? 'texel reads' : 'invocations')]),
+    );
+    for (const [units, chart, label] of unitChoices) {
+      const button = document.createElement('button');
+      if (chart) {
+        button.dataset.chart = chart;
+      } else {
+        button.dataset.units = units;
+      }
+      button.textContent = label;
+      button.addEventListener('click', () => setUnits(units, chart));
+      unitBar.appendChild(button);
+    }
+  }
+  body.dataset.units = state.units;
+
   // The view in the address's fragment: read once at load, rewritten on every change.
   const MODES = ['shaded', 'visibility', 'signed', 'absolute', 'flip'];
   function readFragment() {
@@ -434,6 +510,12 @@
       state.originX = x;
       state.originY = y;
     }
+    if (fields.get('units') === 'work' && data.work_columns) {
+      state.units = 'work';
+    }
+    if (charts.includes(fields.get('chart'))) {
+      state.chart = fields.get('chart');
+    }
   }
   function writeFragment() {
     const fields = new URLSearchParams({
@@ -444,10 +526,13 @@
       x: String(Math.round(state.originX * 100) / 100),
       y: String(Math.round(state.originY * 100) / 100),
     });
+    if (state.units === 'work') {
+      fields.set('units', 'work');
+      fields.set('chart', state.chart);
+    }
     history.replaceState(null, '', '#' + fields.toString());
   }
   readFragment();
-  fill(data.rows);
-  draw();
+  setUnits(state.units, state.chart);
   body.dataset.viewerReady = '1';
 })();

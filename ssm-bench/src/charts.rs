@@ -55,24 +55,50 @@ fn register_plot_font() {
     });
 }
 
-/// Where each technique's frame time goes: one bar per technique (`(label, passes)`, each pass
-/// `(name, ms)`), its passes stacked as shares of its frame so that a 10 ms technique and a 10 s
-/// one read alike; the frame's milliseconds are in the bar's label, a pass's name in its
-/// segment when the segment is wide enough. Written to `png` and `svg`.
+/// What a per-pass chart measures: milliseconds ([`PassMeasure::MILLISECONDS`]) or a count of work.
+#[derive(Clone, Copy, Debug)]
+pub struct PassMeasure {
+    /// The x axis caption: what the shares are of.
+    pub share_of: &'static str,
+    /// The frame's total as written beside a bar's name: `12.3 ms`, `4.56 M texel reads`.
+    pub total: fn(f64) -> String,
+}
+
+impl PassMeasure {
+    /// GPU time per pass.
+    pub const MILLISECONDS: Self = Self { share_of: "share of the frame's GPU time, %", total: |ms| format!("{ms:.1} ms") };
+    /// Texel reads per pass, as the techniques' shaders count them.
+    pub const TEXEL_READS: Self =
+        Self { share_of: "share of the frame's counted texel reads, %", total: |n| format!("{} texel reads", crate::work::short(n)) };
+    /// Vertex, fragment and compute invocations per pass (pipeline statistics).
+    pub const INVOCATIONS: Self =
+        Self { share_of: "share of the frame's counted invocations, %", total: |n| format!("{} invocations", crate::work::short(n)) };
+}
+
+/// Where each technique's frame goes: one bar per technique (`(label, passes)`, each pass
+/// `(name, amount)`, in `measure`'s unit), its passes stacked as shares of its frame so that a
+/// 10 ms technique and a 10 s one read alike; the frame's total is in the bar's label, a pass's
+/// name in its segment when the segment is wide enough. Written to `png` and `svg`.
 ///
 /// # Errors
-/// Drawing or file errors, or no bar with a positive time.
-pub fn pass_chart(bars: &[(String, Vec<(String, f64)>)], title: &str, png: &std::path::Path, svg: &std::path::Path) -> Result<()> {
+/// Drawing or file errors, or no bar with a positive total.
+pub fn pass_chart(
+    bars: &[(String, Vec<(String, f64)>)],
+    title: &str,
+    measure: PassMeasure,
+    png: &std::path::Path,
+    svg: &std::path::Path,
+) -> Result<()> {
     let bars: Vec<&(String, Vec<(String, f64)>)> =
         bars.iter().filter(|(_, passes)| passes.iter().map(|(_, ms)| ms.max(0.0)).sum::<f64>() > 0.0).collect();
     if bars.is_empty() {
-        bail!("no technique with a timed pass");
+        bail!("no technique with a positive total");
     }
     register_plot_font();
     let height = 120 + 76 * bars.len() as u32;
-    draw_pass_chart(&BitMapBackend::new(png, (1000, height)).into_drawing_area(), &bars, title)
+    draw_pass_chart(&BitMapBackend::new(png, (1000, height)).into_drawing_area(), &bars, title, measure)
         .with_context(|| format!("drawing {}", png.display()))?;
-    draw_pass_chart(&SVGBackend::new(svg, (1000, height)).into_drawing_area(), &bars, title)
+    draw_pass_chart(&SVGBackend::new(svg, (1000, height)).into_drawing_area(), &bars, title, measure)
         .with_context(|| format!("drawing {}", svg.display()))?;
     Ok(())
 }
@@ -81,13 +107,14 @@ fn draw_pass_chart<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     bars: &[&(String, Vec<(String, f64)>)],
     title: &str,
+    measure: PassMeasure,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
     area.fill(&WHITE).map_err(chart_error)?;
     let totals: Vec<f64> = bars.iter().map(|(_, passes)| passes.iter().map(|(_, ms)| ms.max(0.0)).sum()).collect();
-    let names: Vec<String> = bars.iter().zip(&totals).map(|((label, _), total)| format!("{label} ({total:.1} ms)")).collect();
+    let names: Vec<String> = bars.iter().zip(&totals).map(|((label, _), total)| format!("{label} ({})", (measure.total)(*total))).collect();
     let count = bars.len();
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 22))
@@ -101,7 +128,7 @@ where
     chart
         .configure_mesh()
         .disable_y_mesh()
-        .x_desc("share of the frame's GPU time, %")
+        .x_desc(measure.share_of)
         .label_style(("sans-serif", 15))
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_labels(count * 2 + 1)
@@ -401,11 +428,16 @@ mod tests {
             ("slow".to_owned(), vec![("tiles".to_owned(), 900.0), ("filter".to_owned(), 100.0)]),
             ("untimed".to_owned(), Vec::new()),
         ];
-        pass_chart(&bars, "title", &png, &svg).unwrap();
+        pass_chart(&bars, "title", PassMeasure::MILLISECONDS, &png, &svg).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(text.contains("fast (4.0 ms)") && text.contains("slow (1000.0 ms)") && !text.contains("untimed"), "{text}");
         assert!(text.lines().any(|line| line.trim() == "tiles"), "a wide segment is named");
-        assert!(pass_chart(&bars[2..], "title", &png, &svg).is_err(), "nothing timed");
+        assert!(pass_chart(&bars[2..], "title", PassMeasure::MILLISECONDS, &png, &svg).is_err(), "nothing timed");
+        // In work: the same shares, the frame's count in the label and the axis naming the count.
+        let reads = vec![("fast".to_owned(), vec![("shadow_map".to_owned(), 0.0), ("filter".to_owned(), 4_560_000.0)])];
+        pass_chart(&reads, "title", PassMeasure::TEXEL_READS, &png, &svg).unwrap();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("fast (4.560 M texel reads)") && text.contains("counted texel reads, %"), "{text}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 

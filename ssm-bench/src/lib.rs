@@ -9,6 +9,7 @@ pub mod report;
 pub mod shard;
 pub mod sweep;
 pub mod view;
+pub mod work;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -206,6 +207,9 @@ pub fn write_run(renderer: &Renderer, measured: &report::Measured, dir: &Path) -
         "shared_passes": renderer.shared_timings,
         "frame_timings": measured.frames,
         "diagnostics": measured.diagnostics.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        // `--count-work`: each pass's counts (null when not counted, with the reason when asked).
+        "work": measured.work,
+        "work_note": measured.work_note,
     });
     let file = dir.join("timings.json");
     let text = serde_json::to_string_pretty(&report).map_err(|e| ssm_core::Error::write(&file, e))?;

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use ssm_core::image_io::{write_exr_gray, write_png_gray16, write_png_rgba8};
 use ssm_core::metrics::{ErrorMetrics, compare, flip_map, flip_mean, heat_map};
-use ssm_core::{Error, FrameTimings, GBuffer, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
+use ssm_core::{Error, FrameTimings, FrameWork, GBuffer, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
 
 use crate::median;
 
@@ -27,6 +27,11 @@ pub struct Measured {
     pub shaded: Vec<u8>,
     /// The debug outputs asked of the technique.
     pub extra_images: Vec<ssm_core::ExtraImage>,
+    /// The work of one extra, untimed frame, when counted ([`MeasureJob::count_work`]; never for
+    /// the ground truth: [`crate::work::GROUND_TRUTH_NOT_COUNTED`]).
+    pub work: Option<FrameWork>,
+    /// Why the work was not counted although asked: [`crate::work::GROUND_TRUTH_NOT_COUNTED`].
+    pub work_note: Option<&'static str>,
 }
 
 impl Measured {
@@ -121,7 +126,7 @@ pub fn measure(
     frames: u32,
     debug: &[&str],
 ) -> Result<Measured> {
-    let job = MeasureJob { info, params, debug };
+    let job = MeasureJob { info, params, debug, count_work: false };
     let mut measured = measure_all(renderer, &[job], frames, FrameOrder::Sequential, || {})?;
     Ok(measured.remove(0))
 }
@@ -135,6 +140,9 @@ pub struct MeasureJob<'a> {
     pub params: &'a ParamValues,
     /// The debug outputs to read after its frames.
     pub debug: &'a [&'a str],
+    /// Count its work ([`crate::work::count`]) in one extra, untimed frame after its timed
+    /// frames and outputs (`--count-work`), so that its times are unaffected.
+    pub count_work: bool,
 }
 
 /// In what order [`measure_all`] renders the timed frames of several techniques.
@@ -249,7 +257,22 @@ impl Running {
                 });
             }
         }
-        Ok(Measured { info, params: job.params.clone(), frames: self.timings, diagnostics, visibility, shaded, extra_images })
+        // The counting frame builds an instance of its own: the timed one goes first, so that the
+        // two are not held at once.
+        drop(self.technique);
+        let work = if job.count_work { crate::work::count(renderer, info, job.params)? } else { None };
+        let work_note = (job.count_work && work.is_none()).then_some(crate::work::GROUND_TRUTH_NOT_COUNTED);
+        Ok(Measured {
+            info,
+            params: job.params.clone(),
+            frames: self.timings,
+            diagnostics,
+            visibility,
+            shaded,
+            extra_images,
+            work,
+            work_note,
+        })
     }
 }
 
@@ -367,6 +390,9 @@ pub struct Row {
     pub extra_images: Vec<String>,
     /// Those of them the HTML report draws over the visibility image.
     pub overlays: Vec<String>,
+    /// The frame's counted work (every light; `--count-work`), in the `all` row only: `None`
+    /// when not counted, and in per-light rows.
+    pub work: Option<FrameWork>,
 }
 
 /// The leading columns of `results.csv`, in order; more follow.
@@ -395,6 +421,11 @@ pub const CSV_COLUMNS: &[&str] = &[
     "timing_source",
     "passes_ms",
     "diagnostics",
+    "vertex_invocations",
+    "fragment_invocations",
+    "compute_invocations",
+    "texel_reads",
+    "passes_work",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -427,6 +458,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         diagnostics: measured.diagnostics.clone(),
         extra_images: measured.extra_images.iter().map(|e| e.name.clone()).collect(),
         overlays: measured.extra_images.iter().filter(|e| e.overlay).map(|e| e.name.clone()).collect(),
+        work: measured.work.clone(),
     }
 }
 
@@ -447,6 +479,8 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
                 gpu_ms_min: None,
                 metrics: compare(truth, image, covered, width, height),
                 passes: measured.pass_medians_for_light(light),
+                // Counted over the whole frame: the `all` row holds it.
+                work: None,
                 ..total.clone()
             });
         }
@@ -523,6 +557,27 @@ impl Row {
             csv_field(&pairs(&self.passes)),
             csv_field(&pairs(&self.diagnostics)),
         ]
+        .into_iter()
+        .chain(self.work_fields())
+        .collect()
+    }
+
+    /// The work columns: per frame (every light) vertex, fragment and compute invocations and
+    /// texel reads, then `passes_work`; empty where not counted.
+    fn work_fields(&self) -> [String; 5] {
+        match &self.work {
+            None => Default::default(),
+            Some(work) => {
+                let totals = crate::work::Totals::of(work);
+                [
+                    crate::work::field(totals.vertex_invocations),
+                    crate::work::field(totals.fragment_invocations),
+                    crate::work::field(totals.compute_invocations),
+                    crate::work::field(totals.texel_reads),
+                    csv_field(&work.passes_column()),
+                ]
+            }
+        }
     }
 }
 
@@ -543,6 +598,7 @@ pub fn csv(rows: &[Row]) -> String {
 pub fn row_json(row: &Row) -> serde_json::Value {
     let object = |items: &[(String, f64)]| items.iter().map(|(k, v)| (k.clone(), finite(*v))).collect::<serde_json::Map<_, _>>();
     let m = &row.metrics;
+    let totals = row.work.as_ref().map(crate::work::Totals::of);
     serde_json::json!({
         "scene": row.scene,
         "technique": row.technique,
@@ -573,6 +629,14 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         },
         "passes_ms": object(&row.passes),
         "diagnostics": object(&row.diagnostics),
+        "vertex_invocations": totals.and_then(|t| t.vertex_invocations),
+        "fragment_invocations": totals.and_then(|t| t.fragment_invocations),
+        "compute_invocations": totals.and_then(|t| t.compute_invocations),
+        "texel_reads": totals.and_then(|t| t.texel_reads),
+        "passes_work": row.work.as_ref().map(FrameWork::passes_column),
+        // Every pass's counts, and whether the invocations (pipeline_statistics) and the texel
+        // reads (shader_counts) were counted at all.
+        "work": row.work.as_ref().map(|work| serde_json::to_value(work).unwrap_or(serde_json::Value::Null)),
     })
 }
 
@@ -665,6 +729,20 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                 diagnostics: pairs("diagnostics")?,
                 extra_images: Vec::new(),
                 overlays: Vec::new(),
+                work: {
+                    let columns = ["vertex_invocations", "fragment_invocations", "compute_invocations", "texel_reads", "passes_work"];
+                    if columns.iter().all(|c| field(c).is_empty()) {
+                        None
+                    } else {
+                        Some(FrameWork {
+                            pipeline_statistics: !field("vertex_invocations").is_empty(),
+                            shader_counts: !field("texel_reads").is_empty(),
+                            passes: crate::work::parse_passes_column(field("passes_work"))
+                                .with_context(|| format!("line {line_number}"))?,
+                            uncounted_passes: 0,
+                        })
+                    }
+                },
             })
         })
         .collect()
@@ -753,6 +831,81 @@ pub struct ReportContext<'a> {
     pub skipped: &'a [(String, String)],
     /// The per-pass time chart beside the report (`passes.svg`), when one was drawn.
     pub pass_chart: Option<&'a str>,
+    /// Whether the work was counted (`--count-work`): the reports then have a section on it.
+    pub count_work: bool,
+    /// The per-pass work charts beside the report, when drawn: (what they count, `passes-reads.svg`).
+    pub work_charts: &'a [(&'a str, &'a str)],
+}
+
+/// The counted techniques of `rows` (their `all` rows), in order.
+fn counted(rows: &[Row]) -> Vec<(&str, &FrameWork)> {
+    rows.iter().filter(|r| r.light.is_none()).filter_map(|r| r.work.as_ref().map(|w| (r.technique.as_str(), w))).collect()
+}
+
+/// The pixels of the rows' images (for texel reads per pixel).
+fn pixels_of(rows: &[Row]) -> u64 {
+    rows.first().map_or(1, |r| u64::from(r.width) * u64::from(r.height))
+}
+
+/// `report.md`'s section on the counted work: how it is counted, the frame's totals per
+/// technique, each pass's counts, what `-` means, and the ground truth's.
+fn markdown_work(context: &ReportContext<'_>, rows: &[Row]) -> String {
+    use crate::work::{FRAME_HEADER, HOW_COUNTED, PASS_HEADER, frame_table, notes, pass_table};
+    if !context.count_work {
+        return String::new();
+    }
+    let techniques = counted(rows);
+    let table = |header: &[&str], cells: Vec<[String; 12]>| {
+        let mut out = format!("| {} |\n|---|{}\n", header.join(" | "), "---:|".repeat(header.len() - 1));
+        for row in cells {
+            let _ = writeln!(out, "| {} |", row.join(" | "));
+        }
+        out
+    };
+    let mut out = format!("\n## Counted work\n\n{HOW_COUNTED}\n\nPer frame:\n\n");
+    out += &table(&FRAME_HEADER, frame_table(&techniques, pixels_of(rows)));
+    out += "\nPer pass:\n\n";
+    out += &table(&PASS_HEADER, pass_table(&techniques));
+    for note in notes(&techniques) {
+        let _ = writeln!(out, "\n{note}");
+    }
+    let _ = writeln!(out, "\nGround truth (`reference`): {}.", crate::work::GROUND_TRUTH_NOT_COUNTED);
+    out
+}
+
+/// `index.html`'s section on the counted work: [`markdown_work`]'s tables and notes, and the
+/// per-pass work charts.
+fn html_work(context: &ReportContext<'_>, rows: &[Row]) -> String {
+    use crate::work::{FRAME_HEADER, HOW_COUNTED, PASS_HEADER, frame_table, notes, pass_table};
+    if !context.count_work {
+        return String::new();
+    }
+    let techniques = counted(rows);
+    let table = |id: &str, header: &[&str], cells: Vec<[String; 12]>| {
+        let mut out = format!("<table id=\"{id}\">\n<tr>");
+        for name in header {
+            let _ = write!(out, "<th>{}</th>", escape(name));
+        }
+        out += "</tr>\n";
+        for row in cells {
+            out += "<tr>";
+            for cell in row {
+                let _ = write!(out, "<td>{}</td>", escape(&cell));
+            }
+            out += "</tr>\n";
+        }
+        out + "</table>\n"
+    };
+    let mut out =
+        format!("<h2 id=\"counted-work\">Counted work</h2>\n<p class=\"legend\">{}</p>\n<p>Per frame:</p>\n", escape(HOW_COUNTED));
+    out += &table("work-frames", &FRAME_HEADER, frame_table(&techniques, pixels_of(rows)));
+    out += "<p>Per pass:</p>\n";
+    out += &table("work-passes", &PASS_HEADER, pass_table(&techniques));
+    for note in notes(&techniques) {
+        let _ = writeln!(out, "<p>{}</p>", escape(&note));
+    }
+    let _ = writeln!(out, "<p>Ground truth (<code>reference</code>): {}.</p>", crate::work::GROUND_TRUTH_NOT_COUNTED);
+    out
 }
 
 /// `report.md`: the context and the table.
@@ -766,6 +919,7 @@ pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     for (name, why) in context.skipped {
         let _ = writeln!(out, "\nNot run: `{name}`: {why}");
     }
+    out += &markdown_work(context, rows);
     out
 }
 
@@ -821,7 +975,7 @@ pub fn viewer_data(
         .iter()
         .map(|r| {
             let m = &r.metrics;
-            serde_json::json!({
+            let mut row = serde_json::json!({
                 "technique": r.technique,
                 "light": r.light.map_or_else(|| "all".to_owned(), |l| l.to_string()),
                 "gpu_ms": r.gpu_ms_median.map_or(serde_json::Value::Null, finite),
@@ -833,7 +987,24 @@ pub fn viewer_data(
                 "frac_over_0_05": finite(m.frac_over_0_05),
                 "flip": finite(r.flip),
                 "passes": r.passes.iter().map(|(name, ms)| format!("{name} {ms:.2}")).collect::<Vec<_>>().join(", "),
-            })
+            });
+            if let Some(work) = &r.work {
+                let totals = crate::work::Totals::of(work);
+                let counts = [
+                    ("vertex_invocations", totals.vertex_invocations),
+                    ("fragment_invocations", totals.fragment_invocations),
+                    ("compute_invocations", totals.compute_invocations),
+                    ("texel_reads", totals.texel_reads),
+                    ("atomics", totals.atomics),
+                    ("target_bytes", Some(totals.target_bytes)),
+                    ("storage_bytes", totals.storage_bytes),
+                ];
+                for (key, count) in counts {
+                    row[key] = count.map_or(serde_json::Value::Null, |n| serde_json::json!(n));
+                }
+                row["passes_work"] = serde_json::json!(pass_work_summary(work));
+            }
+            row
         })
         .collect();
     let lights = images.first().map_or(1, |set| set.visibility.len());
@@ -851,8 +1022,29 @@ pub fn viewer_data(
             ["rmse", "RMSE"], ["ssim", "SSIM"], ["psnr", "PSNR dB"], ["umbra_leak", "umbra leak"],
             ["frac_over_0_05", "> 0.05"], ["flip", "FLIP"], ["passes", "passes, ms"],
         ],
+        // The table's columns when it shows counted work instead of milliseconds (`null`: not counted).
+        "work_columns": rows.iter().any(|r| r.work.is_some()).then(|| serde_json::json!([
+            ["technique", "technique"], ["light", "light"], ["vertex_invocations", "vertex inv."],
+            ["fragment_invocations", "fragment inv."], ["compute_invocations", "compute inv."], ["texel_reads", "texel reads"],
+            ["atomics", "atomics"], ["target_bytes", "target bytes"], ["storage_bytes", "storage bytes"],
+            ["mae_penumbra", "MAE pen."], ["passes_work", "passes: reads, invocations"],
+        ])),
     });
     format!("// Written by ssm compare: the data of index.html's viewer (viewer.js).\nwindow.SSM_DATA = {data};\n")
+}
+
+/// Each pass of `work` in a few words for the viewer's table: its texel reads (`?` where the
+/// shaders do not count) and its invocations (vertex, fragment and compute).
+fn pass_work_summary(work: &FrameWork) -> String {
+    work.passes
+        .iter()
+        .map(|pass| {
+            let totals = crate::work::Totals::of_passes(work, std::slice::from_ref(pass));
+            let count = |n: Option<u64>| n.map_or_else(|| "?".to_owned(), |n| crate::work::short(n as f64));
+            format!("{} {} reads, {} inv.", pass.name, count(totals.texel_reads), count(totals.invocations()))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// The interactive viewer's part of `index.html`: controls, canvas, readout and table (filled by `viewer.js`).
@@ -860,7 +1052,7 @@ fn viewer_section((width, height): (u32, u32)) -> String {
     // The readout wraps within the image's width (and its border), so that the table fits beside it.
     let frame = width + 2;
     format!(
-        "<section id=\"viewer\">\n<h2>Compare</h2>\n<p class=\"legend\">Keys: <kbd>1</kbd>–<kbd>9</kbd> a technique (or click it), hold <kbd>R</kbd> (or hover its button) for the ground truth; views <kbd>S</kbd> shaded, <kbd>V</kbd> visibility, <kbd>E</kbd> signed error, <kbd>A</kbd> absolute error, <kbd>F</kbd> FLIP; wheel: zoom to the pixel, drag: pan, <kbd>0</kbd>: reset. Click a column to sort, a row to show it.</p>\n<div id=\"viewer-techniques\" class=\"bar\"></div>\n<div id=\"viewer-modes\" class=\"bar\"></div>\n<div class=\"bar\"><label>light <select id=\"viewer-light\"></select></label> <label>exposure (shaded) <input id=\"viewer-exposure\" type=\"range\" min=\"-4\" max=\"4\" step=\"0.1\" value=\"0\"> <span id=\"viewer-exposure-value\">+0.0 EV</span></label></div>\n<div class=\"viewer-row\">\n<div style=\"width: {frame}px\">\n<canvas id=\"viewer-canvas\" width=\"{width}\" height=\"{height}\"></canvas>\n<div id=\"viewer-scale\" class=\"legend\"></div>\n<div id=\"readout\">move the pointer over the image for every technique's value at that pixel</div>\n</div>\n<table id=\"metrics\"></table>\n</div>\n</section>\n"
+        "<section id=\"viewer\">\n<h2>Compare</h2>\n<p class=\"legend\">Keys: <kbd>1</kbd>–<kbd>9</kbd> a technique (or click it), hold <kbd>R</kbd> (or hover its button) for the ground truth; views <kbd>S</kbd> shaded, <kbd>V</kbd> visibility, <kbd>E</kbd> signed error, <kbd>A</kbd> absolute error, <kbd>F</kbd> FLIP; wheel: zoom to the pixel, drag: pan, <kbd>0</kbd>: reset; <kbd>W</kbd>: the table and the per-pass chart in milliseconds or counted work (with <code>--count-work</code>). Click a column to sort, a row to show it.</p>\n<div id=\"viewer-techniques\" class=\"bar\"></div>\n<div id=\"viewer-modes\" class=\"bar\"></div>\n<div id=\"viewer-units\" class=\"bar\"></div>\n<div class=\"bar\"><label>light <select id=\"viewer-light\"></select></label> <label>exposure (shaded) <input id=\"viewer-exposure\" type=\"range\" min=\"-4\" max=\"4\" step=\"0.1\" value=\"0\"> <span id=\"viewer-exposure-value\">+0.0 EV</span></label></div>\n<div class=\"viewer-row\">\n<div style=\"width: {frame}px\">\n<canvas id=\"viewer-canvas\" width=\"{width}\" height=\"{height}\"></canvas>\n<div id=\"viewer-scale\" class=\"legend\"></div>\n<div id=\"readout\">move the pointer over the image for every technique's value at that pixel</div>\n</div>\n<table id=\"metrics\"></table>\n</div>\n</section>\n"
     )
 }
 
@@ -911,13 +1103,23 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
     for (name, why) in context.skipped {
         let _ = writeln!(out, "<p>Not run: <code>{}</code>: {}</p>", escape(name), escape(why));
     }
-    if let Some(chart) = context.pass_chart {
+    // The viewer's milliseconds/work switch changes this image's source to a work chart's
+    // (`data-reads`, `data-invocations`); without timestamps only the work charts exist.
+    if let Some(chart) = context.pass_chart.or_else(|| context.work_charts.first().map(|(_, file)| *file)) {
+        let sources: String = context
+            .pass_chart
+            .map(|ms| ("ms", ms))
+            .into_iter()
+            .chain(context.work_charts.iter().copied())
+            .map(|(unit, file)| format!(" data-{}=\"{}\"", escape(unit), escape(file)))
+            .collect();
         let _ = writeln!(
             out,
-            "<h2>Where the time goes</h2>\n<p class=\"legend\">Each technique's frame split into its passes (medians), as shares of the frame; the frame's milliseconds beside its name.</p>\n<img src=\"{}\" alt=\"GPU time per pass\" style=\"max-width: 100%\">",
+            "<h2>Where the time goes</h2>\n<p class=\"legend\" id=\"pass-chart-legend\">Each technique's frame split into its passes, as shares of the frame: of its GPU time (medians; the frame's milliseconds beside its name), or with the viewer's switch on work, of its counted texel reads or invocations.</p>\n<img src=\"{}\" id=\"pass-chart\"{sources} alt=\"per-pass chart\" style=\"max-width: 100%\">",
             escape(chart)
         );
     }
+    out += &html_work(context, rows);
     out += "<p class=\"legend\">Each row: shaded image, visibility, and the error against the ground truth (red: darker than the reference, over-shadowing; blue: lighter, under-shadowing; full colour at an error of 0.5).</p>\n";
     let _ = writeln!(
         out,
@@ -1032,11 +1234,37 @@ mod tests {
             diagnostics: vec![("memory_mib".into(), 4.0)],
             extra_images: Vec::new(),
             overlays: Vec::new(),
+            work: None,
         };
-        let rows = vec![row("hard", None, Some(3.25)), row("pcss", Some(1), None)];
+        let mut rows = vec![row("hard", None, Some(3.25)), row("pcss", Some(1), None), row("pcss", None, None)];
+        // Counted with pipeline statistics but not in the shaders: its reads are unknown, not 0.
+        rows[0].work = Some(FrameWork {
+            pipeline_statistics: true,
+            shader_counts: false,
+            passes: vec![ssm_core::PassWork {
+                name: "hard_lookup".into(),
+                runs: 1,
+                vertex_invocations: 3,
+                fragment_invocations: 3456,
+                target_bytes: 12288,
+                ..ssm_core::PassWork::default()
+            }],
+            uncounted_passes: 0,
+        });
+        rows[2].work = Some(FrameWork { shader_counts: true, pipeline_statistics: false, ..rows[0].work.clone().unwrap() });
         let text = csv(&rows);
         let back = parse_csv(&text).unwrap();
         assert_eq!(csv(&back), text);
+        assert_eq!(back[0].work, rows[0].work);
+        assert_eq!((back[1].work.as_ref(), back[2].work.as_ref()), (None, rows[2].work.as_ref()));
+        let work_columns = |line: &str| -> Vec<String> { split_csv_line(line).unwrap()[CSV_COLUMNS.len() - 5..].to_vec() };
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            work_columns(lines[1]),
+            ["3", "3456", "0", "", "hard_lookup:runs=1,vertex_invocations=3,fragment_invocations=3456,target_bytes=12288"]
+        );
+        assert_eq!(work_columns(lines[2]), ["", "", "", "", ""], "not counted: every work column empty");
+        assert_eq!(&work_columns(lines[3])[..4], ["", "", "", "0"], "no statistics: invocations unknown; shaders counted no read");
         assert_eq!((back[1].light, back[0].metrics.penumbra_pixels, back[0].adapter.as_str()), (Some(1), 17, "llvmpipe \"x\", y"));
         assert!(parse_csv("scene,technique\n").is_err(), "another header");
         assert!(parse_csv(&text.replace("96,72", "96")).is_err(), "a field missing");

@@ -84,6 +84,12 @@ pub struct SweepIdentity {
     pub x_axis: String,
     /// The plot's y axis, as `--error` names it.
     pub error: String,
+    /// Whether every run's work was counted (`--count-work` or `--cost work`).
+    pub count_work: bool,
+    /// What the Pareto front weighs error against, as `--cost` names it.
+    pub cost: String,
+    /// The work plot's unit, as `--work-unit` names it.
+    pub work_unit: String,
     /// How many runs the whole sweep has.
     pub runs: usize,
 }
@@ -102,6 +108,9 @@ impl SweepIdentity {
             "pixels": self.pixels,
             "x_axis": self.x_axis,
             "error": self.error,
+            "count_work": self.count_work,
+            "cost": self.cost,
+            "work_unit": self.work_unit,
             "runs": self.runs,
         })
     }
@@ -133,6 +142,10 @@ impl SweepIdentity {
             pixels: text("pixels")?,
             x_axis: text("x_axis")?,
             error: text("error")?,
+            // Shards written before counted work (issue 40) counted none.
+            count_work: value.get("count_work").and_then(Value::as_bool).unwrap_or(false),
+            cost: value.get("cost").and_then(Value::as_str).unwrap_or("time").to_owned(),
+            work_unit: value.get("work_unit").and_then(Value::as_str).unwrap_or("reads-and-invocations").to_owned(),
             runs: usize::try_from(number("runs")?).with_context(|| format!("{}: `runs` too large", file.display()))?,
         })
     }
@@ -322,7 +335,7 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged> {
 /// The first field in which `record` differs from `identity` (and `count` shards), for the message.
 fn first_difference(identity: &SweepIdentity, count: usize, record: &ShardRecord) -> String {
     let other = &record.identity;
-    let fields: [(&str, String, String); 11] = [
+    let fields: [(&str, String, String); 14] = [
         ("preset", format!("{:?}", identity.preset), format!("{:?}", other.preset)),
         ("scene", identity.scene.clone(), other.scene.clone()),
         ("varies", identity.varies.join(" "), other.varies.join(" ")),
@@ -332,6 +345,9 @@ fn first_difference(identity: &SweepIdentity, count: usize, record: &ShardRecord
         ("pixels", identity.pixels.clone(), other.pixels.clone()),
         ("x axis", identity.x_axis.clone(), other.x_axis.clone()),
         ("error", identity.error.clone(), other.error.clone()),
+        ("count work", identity.count_work.to_string(), other.count_work.to_string()),
+        ("cost", identity.cost.clone(), other.cost.clone()),
+        ("work unit", identity.work_unit.clone(), other.work_unit.clone()),
         ("runs", identity.runs.to_string(), other.runs.to_string()),
         ("shards", count.to_string(), record.shard.count.to_string()),
     ];

@@ -460,21 +460,34 @@ pub struct MarkdownRow {
     pub mae_penumbra: f64,
     /// PSNR against the ground truth, dB.
     pub psnr: f64,
+    /// Counted texel reads per frame (`--count-work`); `None` when not counted.
+    pub texel_reads: Option<u64>,
+    /// Counted vertex, fragment and compute invocations per frame; `None` when not counted.
+    pub invocations: Option<u64>,
 }
 
 /// `sweep.md`: the sweep's rows as one Markdown table whose first column names the sweep (a
-/// preset's name), under a line naming the adapter, the image size and the frames timed. The
+/// preset's name), under a line naming the adapter, the image size and the frames timed; the
+/// last two columns are the counted work (`--count-work`), `-` where not counted. The
 /// table's lines from the fifth on are rows only, so that tables of several sweeps on one machine
 /// concatenate into one (`scripts/gpu-bench.sh`).
 #[must_use]
 pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
     let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
-    text.push_str("| sweep | scene | technique | point | ms | penumbra MAE | PSNR dB |\n|---|---|---|---|---:|---:|---:|\n");
+    text.push_str(
+        "| sweep | scene | technique | point | ms | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|\n",
+    );
     for row in rows {
         let point = if row.point.is_empty() { "defaults" } else { &row.point };
         text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {:.4} | {:.1} |\n",
-            row.scene, row.technique, row.ms, row.mae_penumbra, row.psnr
+            "| {sweep} | {} | {} | {point} | {:.2} | {:.4} | {:.1} | {} | {} |\n",
+            row.scene,
+            row.technique,
+            row.ms,
+            row.mae_penumbra,
+            row.psnr,
+            crate::work::cell(row.texel_reads),
+            crate::work::cell(row.invocations)
         ));
     }
     text
@@ -648,11 +661,13 @@ mod tests {
             ms: 12.345,
             mae_penumbra: 0.01234,
             psnr: 31.25,
+            texel_reads: None,
+            invocations: Some(3456),
         };
         let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
         let lines: Vec<&str> = first.lines().collect();
         assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
-        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0123 | 31.2 |");
+        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0123 | 31.2 | - | 3456 |");
         assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }
 

@@ -13,6 +13,11 @@
 //! camera, or the "render continuously" box): on a software rasteriser a
 //! frame of some techniques takes seconds, and the panel must stay usable.
 //!
+//! With "count work" (the box, the W key, or `--count-work`), the panel also shows the selected
+//! technique's counted work per pass ([`crate::work`]): one extra, untimed frame counted after the
+//! first frame of each technique and setting, not every frame (and announced on stdout as
+//! `ssm view: counted <technique> [<params>] passes <n> invocations <n|-> texel_reads <n|->`).
+//!
 //! Each image shown is announced on stdout as one line,
 //! `ssm view: showing <technique> [<params>] frame <n> view <view> image <x>,<y> <w>x<h>`,
 //! with the image's place in the window in pixels, so that scripts (and the
@@ -27,7 +32,8 @@ use glam::{Quat, Vec3};
 use ssm_core::metrics::{self, ErrorMetrics};
 use ssm_core::reference::{ReferenceCache, surface_points};
 use ssm_core::{
-    FrameTimings, GpuContext, ParamKind, ParamSpec, ParamValue, ParamValues, Renderer, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    FrameTimings, FrameWork, GpuContext, ParamKind, ParamSpec, ParamValue, ParamValues, Renderer, ShadowTechnique, TechniqueInfo,
+    TechniqueKind,
 };
 use ssm_scene::{Camera, Scene};
 use winit::application::ApplicationHandler;
@@ -50,6 +56,8 @@ pub struct ViewOptions {
     pub width: u32,
     /// Rendered image height in pixels.
     pub height: u32,
+    /// Start with "count work" on.
+    pub count_work: bool,
 }
 
 /// Opens the window and runs until it is closed.
@@ -166,6 +174,21 @@ struct FrameReport {
     failure: Option<String>,
 }
 
+/// The counted work of one technique and setting, shown while it stays selected.
+struct CountedWork {
+    /// The slot and its parameters (as text) when counted: counting is redone when either changes.
+    slot: usize,
+    params: String,
+    outcome: WorkOutcome,
+}
+
+enum WorkOutcome {
+    Counted(FrameWork),
+    /// Why it is not counted (the ground truth: [`crate::work::GROUND_TRUTH_NOT_COUNTED`]).
+    NotCounted(&'static str),
+    Failed(String),
+}
+
 /// The ground truth of the current view where the cache holds it.
 struct TruthLookup {
     cache: ReferenceCache,
@@ -204,6 +227,10 @@ struct Live {
     mode: ViewMode,
     /// The light whose visibility or error is shown (the shaded view has every light).
     light: usize,
+    /// "count work": count the selected technique's work once per technique and setting.
+    count_work: bool,
+    /// The last counted work.
+    work: Option<CountedWork>,
 }
 
 /// What the viewer's image shows (keys S, V, E, as in the HTML report).
@@ -229,7 +256,7 @@ impl ViewMode {
 
 impl Live {
     fn new(event_loop: &ActiveEventLoop, options: ViewOptions) -> Result<Self> {
-        let ViewOptions { scene_name, scene, techniques, width, height } = options;
+        let ViewOptions { scene_name, scene, techniques, width, height, count_work } = options;
         let attributes = Window::default_attributes()
             .with_title(format!("ssm view: {scene_name}"))
             .with_inner_size(winit::dpi::PhysicalSize::new(width + PANEL_WIDTH as u32 + 24, (height + 320).max(600)));
@@ -309,6 +336,8 @@ impl Live {
             image_origin: [0, 0],
             mode: ViewMode::Shaded,
             light: 0,
+            count_work,
+            work: None,
         };
         live.look_up_truth()?;
         Ok(live)
@@ -464,6 +493,7 @@ impl Live {
         let params = slot.params.to_string();
         let traced_truth = slot.info.kind == TechniqueKind::GroundTruth;
         self.report.timings = Some(timings);
+        self.count_work_once();
         // The ground truth just traced this view into the cache: the other techniques' error can now be shown.
         if traced_truth && let Err(error) = self.look_up_truth() {
             self.report.failure = Some(format!("{error}"));
@@ -486,6 +516,40 @@ impl Live {
         let shown = self.show(encoder, &visibility);
         self.frame += 1;
         self.announce = Some(format!("ssm view: showing {name} [{params}] frame {} view {}", self.frame, shown.name()));
+    }
+
+    /// With "count work" on, counts the selected technique's work in one extra, untimed frame,
+    /// unless it was counted at these settings already, and announces it on stdout.
+    fn count_work_once(&mut self) {
+        let slot = &self.slots[self.current];
+        let params = slot.params.to_string();
+        let counted = self.work.as_ref().is_some_and(|w| w.slot == self.current && w.params == params);
+        if !self.count_work || counted {
+            return;
+        }
+        let outcome = match crate::work::count(&mut self.renderer, slot.info, &slot.params) {
+            Ok(Some(work)) => WorkOutcome::Counted(work),
+            Ok(None) => WorkOutcome::NotCounted(crate::work::GROUND_TRUTH_NOT_COUNTED),
+            Err(error) => WorkOutcome::Failed(format!("{error}")),
+        };
+        let summary = match &outcome {
+            WorkOutcome::Counted(work) => {
+                let totals = crate::work::Totals::of(work);
+                format!(
+                    "passes {} invocations {} texel_reads {}",
+                    work.passes.len(),
+                    crate::work::cell(totals.invocations()),
+                    crate::work::cell(totals.texel_reads)
+                )
+            }
+            WorkOutcome::NotCounted(why) => (*why).to_owned(),
+            WorkOutcome::Failed(error) => format!("failed: {error}"),
+        };
+        let mut stdout = std::io::stdout();
+        // A closed stdout (the caller stopped reading) must not stop the viewer.
+        let _ = writeln!(stdout, "ssm view: counted {} [{params}] {summary}", slot.info.name);
+        let _ = stdout.flush();
+        self.work = Some(CountedWork { slot: self.current, params, outcome });
     }
 
     /// Puts the frame just rendered into the display texture as the chosen view; returns the
@@ -572,6 +636,9 @@ impl Live {
                 actions.mode = Some(mode);
             }
         }
+        if !typing && ui.input(|i| i.key_pressed(egui::Key::W)) {
+            actions.count_work = Some(!self.count_work);
+        }
         egui::Panel::right("view_panel").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.heading(format!("ssm view: {}", self.scene_name));
@@ -622,6 +689,13 @@ impl Live {
                     actions.defaults = true;
                 }
                 ui.checkbox(&mut self.continuous, "render continuously");
+                let mut count_work = self.count_work;
+                ui.checkbox(&mut count_work, "count work per pass (W)").on_hover_text(
+                    "one extra, untimed frame per technique and setting: invocations, texel reads, bytes stored (shown under the times)",
+                );
+                if count_work != self.count_work {
+                    actions.count_work = Some(count_work);
+                }
             });
         });
         egui::CentralPanel::default().show(ui, |ui| {
@@ -654,6 +728,52 @@ impl Live {
         self.error_ui(ui);
         ui.add_space(8.0);
         self.timings_ui(ui);
+        if self.count_work {
+            ui.add_space(8.0);
+            self.work_ui(ui);
+        }
+    }
+
+    /// The selected technique's counted work per pass: invocations (vertex, fragment, compute),
+    /// texel reads and bytes stored to targets; `-` where not counted.
+    fn work_ui(&self, ui: &mut egui::Ui) {
+        use crate::work::{Totals, cell};
+        let params = self.slots[self.current].params.to_string();
+        let Some(work) = self.work.as_ref().filter(|w| w.slot == self.current && w.params == params) else {
+            ui.label("counted work: at the next frame");
+            return;
+        };
+        match &work.outcome {
+            WorkOutcome::NotCounted(why) => {
+                ui.label(format!("counted work: {why}"));
+            }
+            WorkOutcome::Failed(error) => {
+                ui.colored_label(egui::Color32::from_rgb(230, 80, 80), format!("counting the work failed: {error}"));
+            }
+            WorkOutcome::Counted(frame) => {
+                ui.strong("counted work per pass (one untimed frame, every light)");
+                egui::Grid::new("view_work").striped(true).show(ui, |ui| {
+                    for heading in ["pass", "vertex", "fragment", "compute", "texel reads", "target bytes"] {
+                        ui.label(heading);
+                    }
+                    ui.end_row();
+                    let totals = Totals::of(frame);
+                    let rows = frame.passes.iter().map(|p| (p.name.as_str(), Totals::of_passes(frame, std::slice::from_ref(p))));
+                    for (name, counts) in rows.chain([("frame", totals)]) {
+                        ui.label(name);
+                        ui.label(cell(counts.vertex_invocations));
+                        ui.label(cell(counts.fragment_invocations));
+                        ui.label(cell(counts.compute_invocations));
+                        ui.label(cell(counts.texel_reads));
+                        ui.label(counts.target_bytes.to_string());
+                        ui.end_row();
+                    }
+                });
+                for note in crate::work::notes(&[(self.slots[self.current].info.name, frame)]) {
+                    ui.label(note.replace('`', ""));
+                }
+            }
+        }
     }
 
     fn timings_ui(&self, ui: &mut egui::Ui) {
@@ -715,6 +835,11 @@ impl Live {
             self.light = light;
             self.dirty = true;
         }
+        if let Some(count_work) = actions.count_work {
+            self.count_work = count_work;
+            // A frame to count at (once; later frames of the same setting count nothing).
+            self.dirty |= count_work;
+        }
         let slot = &mut self.slots[self.current];
         let mut params_changed = false;
         if let Some((name, text)) = actions.set {
@@ -760,6 +885,8 @@ struct Actions {
     defaults: bool,
     mode: Option<ViewMode>,
     light: Option<usize>,
+    /// "count work" switched on or off.
+    count_work: Option<bool>,
     orbit: Option<(f32, f32)>,
     dolly: Option<f32>,
 }

@@ -1,8 +1,8 @@
 //! `scripts/gpu-bench-device.sh`, what a session lent a GPU machine runs there (issue 13, item 7),
 //! run here with this build's `ssm` in a packed folder as `scripts/gpu-bench-pack.sh` lays it out:
 //! it refuses to time a software adapter unless told to, and otherwise hands back through `$OUT`
-//! the adapter's name, one Markdown table with every point of the preset, and an archive of the
-//! preset's sweep.
+//! the adapter's name, one Markdown table with every point of the preset (its time and its counted
+//! work), and an archive of the preset's sweep.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -88,10 +88,16 @@ fn the_device_script_hands_back_the_table_and_the_sweeps() {
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         let ms: f64 = cells[5].parse().unwrap_or_else(|_| panic!("a time in `{row}`"));
         assert!(ms.is_finite() && ms > 0.0, "{row}");
+        // The work beside the time: lavapipe has pipeline statistics, so invocations are counted.
+        let invocations: u64 = cells[9].parse().unwrap_or_else(|_| panic!("counted invocations in `{row}`"));
+        assert!(invocations > 0, "{row}");
     }
 
     let listing = Command::new("tar").arg("-tzf").arg(out.join("sweeps.tar.gz")).output().expect("tar runs");
     let listing = String::from_utf8_lossy(&listing.stdout);
     assert!(listing.contains("atty-map-size-time/sweep.csv"), "the archive holds the sweep: {listing}");
     assert!(listing.contains("atty-map-size-time/sweep.md"), "{listing}");
+    let archive = Command::new("tar").arg("-xzOf").arg(out.join("sweeps.tar.gz")).arg("./atty-map-size-time/sweep.csv").output().unwrap();
+    let csv = String::from_utf8_lossy(&archive.stdout);
+    assert!(csv.lines().next().is_some_and(|h| h.ends_with(",texel_reads,passes_work")), "the sweep's work columns: {csv}");
 }

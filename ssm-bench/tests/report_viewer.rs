@@ -159,7 +159,7 @@ fn the_comparison_page_switches_flips_reads_out_zooms_and_sorts_in_a_browser() {
     let status = Command::new(env!("CARGO_BIN_EXE_ssm"))
         .env("SSM_CACHE_DIR", &cache)
         .args(["compare", "--scene", "parallel-square", "--technique", "hard,pcss", "--width", "96", "--height", "72"])
-        .args(["--frames", "1", "--set", "reference.samples=8", "--out"])
+        .args(["--frames", "1", "--set", "reference.samples=8", "--count-work", "--out"])
         .arg(&out)
         .stdout(Stdio::null())
         .status()
@@ -237,17 +237,37 @@ fn the_comparison_page_switches_flips_reads_out_zooms_and_sorts_in_a_browser() {
     page.eval("document.querySelector('#metrics tbody tr[data-technique=\"hard\"]').click()");
     assert_eq!(page.body("technique"), "hard");
 
+    // W switches the table and the per-pass chart from milliseconds to the counted work (the
+    // chart's texel reads or, as chosen, invocations per pass), and back.
+    assert_eq!(page.body("units"), "ms");
+    let chart = "document.getElementById('pass-chart').getAttribute('src')";
+    assert_eq!(page.eval(chart), "passes.svg");
+    page.press("w");
+    assert_eq!(page.body("units"), "work");
+    let keys = page.eval("Array.from(document.querySelectorAll('#metrics th')).map((h) => h.dataset.key).join(',')");
+    let keys = keys.as_str().unwrap();
+    assert!(keys.contains("fragment_invocations") && keys.contains("texel_reads") && !keys.contains("gpu_ms"), "{keys}");
+    // lavapipe has pipeline statistics: hard's fragments are counted (the fourth column).
+    let fragments = page.eval("document.querySelector('#metrics tbody tr[data-technique=\"hard\"]').cells[3].textContent");
+    assert!(fragments.as_str().and_then(|f| f.parse::<u64>().ok()).is_some_and(|f| f > 0), "hard's fragments: {fragments}");
+    assert!(page.eval(chart).as_str().is_some_and(|src| src.starts_with("passes-") && src != "passes.svg"), "{}", page.eval(chart));
+    page.eval("document.querySelector('#viewer-units button[data-chart=\"invocations\"]').click()");
+    assert_eq!(page.eval(chart), "passes-invocations.svg");
+    page.press("w");
+    assert_eq!((page.body("units"), page.eval(chart)), ("ms".into(), json!("passes.svg")));
+
     // The view lives in the address's fragment: a link opens the page on it.
     let fragment = page.eval("window.location.hash");
     assert!(fragment.as_str().is_some_and(|f| f.contains("technique=hard") && f.contains("mode=flip")), "fragment {fragment}");
     // Away and back, so that the link is a fresh load (a fragment alone would not reload the page).
     page.call("Page.navigate", json!({ "url": "about:blank" }));
     page.wait_for("window.location.href === 'about:blank'");
-    page.call("Page.navigate", json!({ "url": format!("{url}#technique=pcss&mode=signed&zoom=4&x=10&y=20") }));
+    page.call("Page.navigate", json!({ "url": format!("{url}#technique=pcss&mode=signed&zoom=4&x=10&y=20&units=work&chart=invocations") }));
     page.wait_for(
         "window.location.protocol === 'file:' && document.readyState === 'complete' && document.body !== null && document.body.dataset.viewerReady === '1'",
     );
     assert_eq!((page.body("technique"), page.body("mode"), page.body("zoom")), ("pcss".into(), "signed".into(), "4".into()));
+    assert_eq!((page.body("units"), page.eval(chart)), ("work".into(), json!("passes-invocations.svg")));
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&cache);
 }

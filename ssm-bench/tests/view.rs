@@ -2,7 +2,8 @@
 //! from xdotool (XTEST, as a user's), screenshots of the whole screen by
 //! ImageMagick's `import`. The window must show exactly what `ssm render`
 //! shades for the technique selected, switch technique on a number key,
-//! show the visibility on V, and orbit the camera when the image is dragged.
+//! show the visibility on V, orbit the camera when the image is dragged, and
+//! on W count the selected technique's work once per technique, not every frame.
 //!
 //! The tools come from `scripts/install-deps.sh --for-tests`; without them
 //! the test fails, saying so, rather than skipping.
@@ -44,12 +45,21 @@ fn image_origin(line: &str) -> (u32, u32) {
 
 /// Waits for a stdout line of the viewer containing `needle`; on failure shows the viewer's stderr (`log`).
 fn wait_for(lines: &Receiver<String>, needle: &str, timeout: Duration, log: &Path) -> String {
+    lines_until(lines, needle, timeout, log).pop().expect("the line found")
+}
+
+/// The viewer's stdout lines up to the first containing `needle`, that one last.
+fn lines_until(lines: &Receiver<String>, needle: &str, timeout: Duration, log: &Path) -> Vec<String> {
     let deadline = Instant::now() + timeout;
+    let mut seen = Vec::new();
     loop {
         let left = deadline.saturating_duration_since(Instant::now());
         match lines.recv_timeout(left) {
-            Ok(line) if line.contains(needle) => return line,
-            Ok(_) => {}
+            Ok(line) if line.contains(needle) => {
+                seen.push(line);
+                return seen;
+            }
+            Ok(line) => seen.push(line),
             Err(error) => {
                 let stderr = std::fs::read_to_string(log).unwrap_or_default();
                 panic!("ssm view did not print `{needle}` within {timeout:?} ({error}); its stderr:\n{stderr}");
@@ -224,6 +234,20 @@ fn view_shows_the_selected_technique_switches_on_number_keys_and_orbits_on_drag(
         moved = mean_difference(&orbited, &shown_pcss);
     }
     assert!(moved > 2.0, "dragging the image did not move the camera ({moved:.2} levels)");
+
+    // W: the selected technique's work per pass, counted in one extra frame (announced), with
+    // invocations from pipeline statistics (lavapipe has them); a later frame of the same
+    // technique and settings counts nothing; another technique is counted when shown.
+    xdotool(&display, &["key", "w"]);
+    let counted = wait_for(&lines, "ssm view: counted pcss [", Duration::from_secs(120), &log);
+    let invocations = counted.split(" invocations ").nth(1).and_then(|rest| rest.split(' ').next()).unwrap_or_default();
+    assert!(invocations.parse::<u64>().is_ok_and(|n| n > 0), "no invocations counted: `{counted}`");
+    xdotool(&display, &["key", "s"]);
+    let frames = lines_until(&lines, "view shaded", Duration::from_secs(120), &log);
+    assert!(!frames.iter().any(|l| l.contains("ssm view: counted")), "counted again at the same settings: {frames:#?}");
+    xdotool(&display, &["key", "1"]);
+    let frames = lines_until(&lines, "showing hard", Duration::from_secs(120), &log);
+    assert!(frames.iter().any(|l| l.starts_with("ssm view: counted hard [")), "hard not counted when shown: {frames:#?}");
     assert!(viewer.0.try_wait().expect("polling the viewer").is_none(), "ssm view exited");
     let _ = std::fs::remove_dir_all(&out);
 }

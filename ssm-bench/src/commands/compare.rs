@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer, TechniqueKind};
 
-use super::{Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
+use super::{CountWorkArg, Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
 use crate::{charts, check_debug_outputs, debug_outputs_for, registry, report, requirements_of, write_positions};
 
 /// `ssm compare`'s arguments.
@@ -36,6 +36,8 @@ pub(super) struct CompareArgs {
     /// shows what each technique offers; `all`: every one).
     #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
     debug_outputs: Vec<String>,
+    #[command(flatten)]
+    work: CountWorkArg,
     /// `text`: the report's table on stdout; `json`: the rows as one JSON document (for scripts).
     #[arg(long, value_enum, default_value = "text")]
     format: Format,
@@ -101,8 +103,9 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
     let mut visibilities = Vec::new();
     // The overlays always: the HTML report draws them over the visibility.
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, true)).collect();
+    let count_work = args.work.count_work;
     let jobs: Vec<report::MeasureJob<'_>> =
-        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
+        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug, count_work }).collect();
     progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
     let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     for measured in measured {
@@ -127,7 +130,13 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
         })
         .collect();
     let chart_title = format!("{} at {}x{}: GPU time per pass", args.scene, args.size.width, args.size.height);
-    let pass_chart = match charts::pass_chart(&bars, &chart_title, &args.out.join("passes.png"), &args.out.join("passes.svg")) {
+    let pass_chart = match charts::pass_chart(
+        &bars,
+        &chart_title,
+        charts::PassMeasure::MILLISECONDS,
+        &args.out.join("passes.png"),
+        &args.out.join("passes.svg"),
+    ) {
         Ok(()) => Some("passes.svg"),
         // Without timestamps there are no passes to chart: the report says nothing of them.
         Err(error) => {
@@ -135,6 +144,7 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
             None
         }
     };
+    let work_charts = if count_work { work_charts(args, &rows) } else { Vec::new() };
     let context = report::ReportContext {
         scene: &args.scene,
         adapter: &adapter,
@@ -144,6 +154,8 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
         reference_cost: &reference_cost,
         skipped: &skipped,
         pass_chart,
+        count_work,
+        work_charts: &work_charts,
     };
     let write = |name: &str, text: String| {
         std::fs::write(args.out.join(name), text).with_context(|| format!("writing {}", args.out.join(name).display()))
@@ -177,4 +189,44 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The per-pass work charts (`passes-reads.*`: texel reads, `passes-invocations.*`: vertex,
+/// fragment and compute invocations), each of the techniques that counted it, as
+/// (the viewer's name for it, the SVG's file name).
+fn work_charts(args: &CompareArgs, rows: &[report::Row]) -> Vec<(&'static str, &'static str)> {
+    use crate::work::Totals;
+    type Count = fn(&Totals) -> Option<u64>;
+    let kinds: [(&str, &str, &str, charts::PassMeasure, Count); 2] = [
+        ("reads", "passes-reads.png", "passes-reads.svg", charts::PassMeasure::TEXEL_READS, |t| t.texel_reads),
+        ("invocations", "passes-invocations.png", "passes-invocations.svg", charts::PassMeasure::INVOCATIONS, Totals::invocations),
+    ];
+    let mut drawn = Vec::new();
+    for (unit, png, svg, measure, count) in kinds {
+        let bars: Vec<(String, Vec<(String, f64)>)> = rows
+            .iter()
+            .filter(|r| r.light.is_none())
+            .filter_map(|r| {
+                let work = r.work.as_ref()?;
+                let prefix = format!("{}_", r.technique.replace('-', "_"));
+                let passes = work
+                    .passes
+                    .iter()
+                    .map(|pass| {
+                        let amount = count(&Totals::of_passes(work, std::slice::from_ref(pass)))?;
+                        Some((pass.name.strip_prefix(&prefix).unwrap_or(&pass.name).to_owned(), amount as f64))
+                    })
+                    .collect::<Option<Vec<_>>>()?;
+                Some((r.technique.clone(), passes))
+            })
+            .collect();
+        let what = measure.share_of.trim_start_matches("share of the frame's ").trim_end_matches(", %");
+        let title = format!("{} at {}x{}: {what} per pass", args.scene, args.size.width, args.size.height);
+        match charts::pass_chart(&bars, &title, measure, &args.out.join(png), &args.out.join(svg)) {
+            Ok(()) => drawn.push((unit, svg)),
+            // No technique counted it (no statistics on this adapter, no shader counts yet).
+            Err(error) => eprintln!("note: no per-pass chart of {what}: {error:#}"),
+        }
+    }
+    drawn
 }

@@ -50,6 +50,10 @@ pub(super) fn run(args: &MergeArgs) -> Result<()> {
         x_axis: &identity.x_axis,
         specs: &identity.varies,
         error,
+        cost: <crate::work::Cost as clap::ValueEnum>::from_str(&identity.cost, true)
+            .map_err(|e| anyhow::anyhow!("the shards' cost `{}`: {e}", identity.cost))?,
+        work_unit: <crate::work::WorkUnit as clap::ValueEnum>::from_str(&identity.work_unit, true)
+            .map_err(|e| anyhow::anyhow!("the shards' work unit `{}`: {e}", identity.work_unit))?,
         format: args.format,
     };
     eprintln!("merged {} shards of {} runs", args.shards.len(), identity.runs);

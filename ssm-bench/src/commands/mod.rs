@@ -98,6 +98,17 @@ struct ImageSize {
     height: u32,
 }
 
+/// `--count-work`, as every rendering command takes it.
+#[derive(clap::Args, Clone, Copy)]
+struct CountWorkArg {
+    /// After each technique's timed frames, render one extra, untimed frame that counts its work,
+    /// per pass and per frame: vertex, fragment and compute invocations and primitives (pipeline
+    /// statistics), texel reads, atomics and storage bytes (as its shaders count them) and bytes
+    /// stored to render targets. Times are unaffected; the ground truth (CPU) is not counted.
+    #[arg(long)]
+    count_work: bool,
+}
+
 /// How the timed frames of several techniques (or sweep points) are ordered.
 #[derive(clap::Args, Clone, Copy)]
 struct FrameOrderArgs {

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer};
 
-use super::{Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
-use crate::{check_debug_outputs, debug_outputs_for, registry, report, requirements_of, write_positions, write_run};
+use super::{CountWorkArg, Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
+use crate::{check_debug_outputs, debug_outputs_for, registry, report, requirements_of, work, write_positions, write_run};
 
 /// `ssm render`'s arguments.
 #[derive(clap::Args)]
@@ -28,6 +28,8 @@ pub(super) struct RenderArgs {
     /// Frames timed after one warm-up frame; timings.json holds each and the median.
     #[arg(long, default_value_t = 1)]
     frames: u32,
+    #[command(flatten)]
+    work: CountWorkArg,
     /// Debug outputs to write beside each technique's visibility, comma-separated (`ssm list`
     /// shows what each technique offers; `all`: every one).
     #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
@@ -64,8 +66,9 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
     let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)));
     progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, false)).collect();
+    let count_work = args.work.count_work;
     let jobs: Vec<report::MeasureJob<'_>> =
-        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug }).collect();
+        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug, count_work }).collect();
     // Technique errors name the technique already.
     let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     progress.finish_and_clear();
@@ -81,6 +84,28 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
         if !run.diagnostics.is_empty() {
             let text: Vec<String> = run.diagnostics.iter().map(|(k, v)| format!("{k}={v:.4}")).collect();
             say!("{:<8} {}", "", text.join("  "));
+        }
+        if let Some(note) = run.work_note {
+            say!("{:<8} work: {note}", "");
+        }
+    }
+    // The counted work, per frame and per pass (as report.md's section), `-` where not counted.
+    let counted: Vec<(&str, &ssm_core::FrameWork)> = measured.iter().filter_map(|m| m.work.as_ref().map(|w| (m.info.name, w))).collect();
+    if !counted.is_empty() {
+        let pixels = u64::from(args.size.width) * u64::from(args.size.height);
+        let lines = |header: &[&str], rows: Vec<[String; 12]>| -> Vec<String> {
+            std::iter::once(header.join("\t")).chain(rows.iter().map(|row| row.join("\t"))).collect()
+        };
+        say!("counted work per frame (every light):");
+        for line in lines(&work::FRAME_HEADER, work::frame_table(&counted, pixels)) {
+            say!("  {line}");
+        }
+        say!("counted work per pass:");
+        for line in lines(&work::PASS_HEADER, work::pass_table(&counted)) {
+            say!("  {line}");
+        }
+        for note in work::notes(&counted) {
+            say!("note: {note}");
         }
     }
     say!("adapter: {}", gpu.describe());

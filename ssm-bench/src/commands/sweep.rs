@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer, TechniqueInfo, TechniqueKind};
 
-use super::{Format, FrameOrderArgs, load_scene, params_for, parse_setting, progress_bar};
+use super::{CountWorkArg, Format, FrameOrderArgs, load_scene, params_for, parse_setting, progress_bar};
 use crate::shard::{Shard, ShardRecord, SweepIdentity, Varied};
-use crate::{charts, check_debug_outputs, debug_outputs_for, registry, report, requirements_of, sweep};
+use crate::{charts, check_debug_outputs, debug_outputs_for, registry, report, requirements_of, sweep, work};
 
 /// A sweep's image size: a preset may carry its paper's.
 #[derive(clap::Args, Clone, Copy)]
@@ -59,6 +59,17 @@ pub(super) struct SweepArgs {
     /// Frames timed per point after one warm-up.
     #[arg(long, default_value_t = 3)]
     frames: u32,
+    #[command(flatten)]
+    work: CountWorkArg,
+    /// What error is weighed against for the Pareto front of the lines printed (`*`) and of the
+    /// JSON (`pareto`): `time`, or `work`, which counts every point's work (as --count-work).
+    /// Whenever work is counted, sweep-work.png and .svg plot it: error against work where the
+    /// plot is against time, else work in place of the plot's time or error.
+    #[arg(long, value_enum, default_value = "time")]
+    cost: work::Cost,
+    /// The unit of counted work in the work plot and the `--cost work` front.
+    #[arg(long, value_enum, default_value = "reads-and-invocations")]
+    work_unit: work::WorkUnit,
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
     pixels: Option<report::PixelSet>,
@@ -80,6 +91,13 @@ pub(super) struct SweepArgs {
     /// Output directory: sweep.csv, sweep.md (a Markdown table), sweep.png, sweep.svg.
     #[arg(long, required_unless_present = "list_presets")]
     out: Option<PathBuf>,
+}
+
+impl SweepArgs {
+    /// Whether every point's work is counted: `--count-work`, or `--cost work`.
+    fn counts_work(&self) -> bool {
+        self.work.count_work || self.cost == work::Cost::Work
+    }
 }
 
 /// What a sweep measured: its rows and, per row, its run's number and varied values.
@@ -120,6 +138,11 @@ fn list_presets(registry: &ssm_core::Registry) -> Result<()> {
 /// The error axis as `--error` spells it.
 fn sweep_axis_name(axis: sweep::ErrorAxis) -> String {
     clap::ValueEnum::to_possible_value(&axis).map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+/// A value as its option spells it.
+pub(super) fn sweep_name(value: impl clap::ValueEnum) -> String {
+    value.to_possible_value().map_or_else(String::new, |v| v.get_name().to_owned())
 }
 
 /// The pixel set as `--pixels` spells it.
@@ -215,7 +238,12 @@ fn run_sweep(
         let jobs: Vec<report::MeasureJob<'_>> = points
             .iter()
             .zip(&debug)
-            .map(|(&point, debug)| report::MeasureJob { info: plan.points[point].0, params: &plan.points[point].1, debug })
+            .map(|(&point, debug)| report::MeasureJob {
+                info: plan.points[point].0,
+                params: &plan.points[point].1,
+                debug,
+                count_work: args.counts_work(),
+            })
             .collect();
         progress.set_message(format!("{} points of {scene_name}", jobs.len()));
         let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
@@ -250,6 +278,10 @@ pub(super) struct SweepOutput<'a> {
     /// Every `--vary` specification (to find the parameters that vary in step with the x axis).
     pub(super) specs: &'a [String],
     pub(super) error: sweep::ErrorAxis,
+    /// What the printed Pareto front weighs error against.
+    pub(super) cost: work::Cost,
+    /// The unit of the work plot.
+    pub(super) work_unit: work::WorkUnit,
     pub(super) format: Format,
 }
 
@@ -266,6 +298,7 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
         .map(|(row, values)| {
             let own = format!("{}.", row.technique);
             let point: Vec<String> = values.iter().filter_map(|(k, v)| k.strip_prefix(&own).map(|k| format!("{k}={v}"))).collect();
+            let totals = row.work.as_ref().map(work::Totals::of);
             sweep::MarkdownRow {
                 scene: row.scene.clone(),
                 technique: row.technique.clone(),
@@ -273,6 +306,8 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 ms: sweep::time_of(row),
                 mae_penumbra: row.metrics.mae_penumbra,
                 psnr: row.metrics.psnr,
+                texel_reads: totals.and_then(|t| t.texel_reads),
+                invocations: totals.and_then(|t| t.invocations()),
             }
         })
         .collect();
@@ -317,7 +352,15 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
     };
     let title = format!("{} at {}x{} on {}", output.scene_spec, output.size.0, output.size.1, output.adapter);
     charts::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
-    let front = if axes.pareto { sweep::pareto_front(&plot_points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>()) } else { Vec::new() };
+    let work_plot = if rows.iter().any(|r| r.work.is_some()) { write_work_plot(output, rows, &plot_points, &axes)? } else { None };
+    let front_of = |points: &[charts::PlotPoint]| sweep::pareto_front(&points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>());
+    let front = match (&work_plot, output.cost) {
+        (Some((points, work_axes)), work::Cost::Work) if work_axes.pareto => front_of(points),
+        (_, work::Cost::Time) if axes.pareto => front_of(&plot_points),
+        _ => Vec::new(),
+    };
+    let pareto = !front.is_empty();
+    let work_of = |row: &report::Row| row.work.as_ref().and_then(|w| output.work_unit.of(w));
     if output.format == Format::Json {
         let json: Vec<serde_json::Value> = rows
             .iter()
@@ -328,23 +371,24 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 value["varied"] =
                     values.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>().into();
                 value["pareto"] = front.contains(&index).into();
+                value["work"] = work_of(row).map_or(serde_json::Value::Null, serde_json::Value::from);
                 value
             })
             .collect();
         say!("{}", serde_json::to_string_pretty(&json)?);
-        eprintln!(
-            "wrote {}, {}, {} and {}",
-            out.join("sweep.csv").display(),
-            out.join("sweep.md").display(),
-            out.join("sweep.png").display(),
-            out.join("sweep.svg").display()
-        );
+        eprintln!("wrote {}", written(out, work_plot.is_some()));
         return Ok(());
     }
     for (index, (row, values)) in rows.iter().zip(varied).enumerate() {
         let mark = if front.contains(&index) { "*" } else { " " };
+        // The work in the plot's unit, `-` where a count it needs was not made.
+        let counted = match (&row.work, work_of(row)) {
+            (None, _) => String::new(),
+            (Some(_), Some(amount)) => format!("  {} work", work::short(amount)),
+            (Some(_), None) => "  - work".to_owned(),
+        };
         say!(
-            "{mark} {:<10} {:<40} {:>9.3} ms  {} {:.4}",
+            "{mark} {:<10} {:<40} {:>9.3} ms{counted}  {} {:.4}",
             row.technique,
             sweep::point_label(values),
             sweep::time_of(row),
@@ -352,17 +396,70 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
             error.of(row)
         );
     }
-    if axes.pareto {
-        say!("(* on the Pareto front)");
+    if pareto {
+        say!("(* on the Pareto front of {})", if output.cost == work::Cost::Work { "work" } else { "time" });
     }
-    say!(
-        "wrote {}, {}, {} and {}",
-        out.join("sweep.csv").display(),
-        out.join("sweep.md").display(),
-        out.join("sweep.png").display(),
-        out.join("sweep.svg").display()
-    );
+    if work_plot.is_some() {
+        say!("work: {}", output.work_unit.label());
+    }
+    say!("wrote {}", written(out, work_plot.is_some()));
     Ok(())
+}
+
+/// The files a sweep wrote, for its last line.
+fn written(out: &Path, work_plot: bool) -> String {
+    let mut files = vec!["sweep.csv", "sweep.md", "sweep.png", "sweep.svg"];
+    if work_plot {
+        files.extend(["sweep-work.png", "sweep-work.svg"]);
+    }
+    let paths: Vec<String> = files.iter().map(|f| out.join(f).display().to_string()).collect();
+    format!("{} and {}", paths[..paths.len() - 1].join(", "), paths[paths.len() - 1])
+}
+
+/// `sweep-work.png` and `.svg`: the sweep's plot with counted work (in `--work-unit`) in place of
+/// time: error against work where the time plot is error against time (its Pareto front marked),
+/// else work on the y axis against the same x axis (the papers' timing figures in work).
+/// Returns the points and axes drawn, or `None` (with a note) when no point has the work counted
+/// in that unit (a technique that does not count texel reads in its shaders has no
+/// reads-and-invocations).
+fn write_work_plot(
+    output: &SweepOutput<'_>,
+    rows: &[report::Row],
+    time_points: &[charts::PlotPoint],
+    time_axes: &charts::PlotAxes,
+) -> Result<Option<(Vec<charts::PlotPoint>, charts::PlotAxes)>> {
+    let unit = output.work_unit;
+    let amounts: Vec<f64> = rows.iter().map(|r| r.work.as_ref().and_then(|w| unit.of(w)).unwrap_or(f64::NAN)).collect();
+    let missing: Vec<&str> = rows.iter().zip(&amounts).filter(|(_, a)| a.is_nan()).map(|(r, _)| r.technique.as_str()).collect();
+    if !missing.is_empty() {
+        let mut names = missing.clone();
+        names.dedup();
+        eprintln!(
+            "note: the work plot leaves out {} points whose {} was not counted ({}): see --work-unit",
+            missing.len(),
+            unit.name(),
+            names.join(", ")
+        );
+    }
+    if amounts.iter().all(|a| a.is_nan()) {
+        return Ok(None);
+    }
+    let against_time = output.x_axis == "time";
+    let points: Vec<charts::PlotPoint> = time_points
+        .iter()
+        .zip(&amounts)
+        .map(|(point, amount)| {
+            if against_time { charts::PlotPoint { x: *amount, ..point.clone() } } else { charts::PlotPoint { y: *amount, ..point.clone() } }
+        })
+        .collect();
+    let axes = if against_time {
+        charts::PlotAxes { x_label: format!("{} (log)", unit.label()), ..time_axes.clone() }
+    } else {
+        charts::PlotAxes { y_label: format!("{} (log)", unit.label()), pareto: false, ..time_axes.clone() }
+    };
+    let title = format!("{} at {}x{}: counted work", output.scene_spec, output.size.0, output.size.1);
+    charts::plot(&points, &axes, &title, &output.out.join("sweep-work.png"), &output.out.join("sweep-work.svg"))?;
+    Ok(Some((points, axes)))
 }
 
 /// Resolves the sweep (preset defaults under the command line's choices), measures its points
@@ -392,6 +489,9 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
             pixels: sweep_pixels_name(sweep.pixels),
             x_axis: sweep.x_axis.clone(),
             error: sweep_axis_name(sweep.error),
+            count_work: args.counts_work(),
+            cost: sweep_name(args.cost),
+            work_unit: args.work_unit.name(),
             runs: sweep.plan.scene_points.len() * sweep.plan.points.len(),
         };
         let record = ShardRecord { identity, shard, adapter: gpu.info.name.clone(), rows: runs.clone() };
@@ -408,6 +508,8 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
         x_axis: &sweep.x_axis,
         specs: &sweep.specs,
         error: sweep.error,
+        cost: args.cost,
+        work_unit: args.work_unit,
         format: args.format,
     };
     write_sweep(&output, &rows, &varied)

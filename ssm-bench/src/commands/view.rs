@@ -20,6 +20,10 @@ pub(super) struct ViewArgs {
     /// Starting parameter `<technique>.<param>=<value>`; repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
+    /// Start with "count work" on (the W key switches it): the panel shows the selected
+    /// technique's counted work per pass, counted once per technique and setting.
+    #[arg(long)]
+    count_work: bool,
 }
 
 /// Resolves the techniques (in key order) and their starting parameters, then opens the window.
@@ -52,5 +56,6 @@ pub(super) fn run(args: &ViewArgs) -> Result<()> {
         techniques,
         width: args.size.width,
         height: args.size.height,
+        count_work: args.count_work,
     })
 }
