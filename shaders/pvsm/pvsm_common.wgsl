@@ -32,6 +32,12 @@ struct PvsmSettings {
     predicted_stride: u32,
     // With antialiasing off: texels per pixel, along each axis, for a shadow sharper than a pixel.
     hard_texels: f32,
+    // 1: the filter reads every texel under it (filter_walk = texels); 0: it walks the tile's min/max
+    // pyramid (filter_walk = hierarchy), the same sum.
+    texel_walk: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // Every screen-space pass binds the camera and the settings first in its own group.
@@ -74,8 +80,8 @@ const COUNTERS: u32 = 4u;
 const COUNTER_FILTERED: u32 = 0u;
 // Pixels skipped as fully lit (no blocker in the conservative map).
 const COUNTER_LIT: u32 = 1u;
-// Pixels whose filter was read at every k-th texel in some tile (wider than MAX_TEXELS_PER_AXIS).
-const COUNTER_DECIMATED: u32 = 2u;
+// Pixels whose filter's walk stopped at MAX_WALK_STEPS in some tile (pvsm_filter.wgsl).
+const COUNTER_CAPPED: u32 = 2u;
 // Pixels with a filter that no tile covered (resolved as lit).
 const COUNTER_UNCOVERED: u32 = 3u;
 

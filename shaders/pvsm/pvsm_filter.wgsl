@@ -4,8 +4,16 @@
 // half-axis is the map's, and each one-texel-wide column of the parallelogram is taken as an
 // axis-aligned box, as Sec. 4.2 does). The pixel's accumulator gets the visible covered area Σ c·o
 // and the covered area Σ c, so that tiles sharing a filter merge exactly (Sec. 5.2's V·A and A).
+//
+// Eq. 2's sum is walked top-down over the tile's min/max depth pyramid (pvsm_tile_pyramid.wgsl):
+// a block whose depths are all at or behind the receiver's (every texel lit) or all in front of it
+// (every texel occluding) adds its exact covered area in one step, and only mixed blocks descend to
+// their four children; texels are the leaves. The sum is the per-texel one (filter_walk = texels),
+// within f32 summation order, and its cost follows the penumbra's boundary texels, not the
+// filter's area.
 
 // #import pvsm/pvsm_common.wgsl
+// #import common/read_counts.wgsl
 
 struct TileSettings {
     // The tile's rectangle of the light frame's shadow-map coordinates.
@@ -20,98 +28,412 @@ struct TileSettings {
 @group(2) @binding(2) var<storage, read> kernels: array<Kernel>;
 // Per pixel: (Σ c·o, Σ c).
 @group(2) @binding(3) var<storage, read_write> accumulated: array<vec2<f32>>;
-// Per pixel: 1 once its filter was decimated in some tile (cleared per light).
-@group(2) @binding(4) var<storage, read_write> decimated: array<u32>;
-// COUNTER_* of pvsm_common.wgsl (the resolve pass adds the decimated and uncovered pixels).
+// Per pixel: 1 once its walk hit MAX_WALK_STEPS in some tile (cleared per light).
+@group(2) @binding(4) var<storage, read_write> capped: array<u32>;
+// COUNTER_* of pvsm_common.wgsl (the resolve pass adds the capped and uncovered pixels).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_FILTER.
+@group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
+// The tile map's min/max depth pyramid: mip m holds level m + 1 (blocks of 2^(m+1) texels a side),
+// (nearest, farthest) depth; only the tile's region, from the top-left corner, is written.
+@group(3) @binding(3) var tile_pyramid: texture_2d<f32>;
 
-// Most texel columns (and rows) one filter integrates: wider filters take every k-th texel, each
-// standing for a k×k block (the fixed-resolution mode and huge lights).
-const MAX_TEXELS_PER_AXIS: f32 = 96.0;
+// The ReadCounts counter of this pass (PvsmReadCounter::TileFilter in src/lib.rs).
+const READ_COUNTER_TILE_FILTER: u32 = 6u;
 
-// Smallest half-axis of a filter, in texels of the tile (see integrate).
+// Smallest half-axis of a filter, in texels of the tile (see texel_filter).
 const MIN_HALF_TEXELS: f32 = 1e-3;
 
-// (Σ c·o, Σ c, decimated) of the filter (u, v_height) centred on `centre` (shadow-map
-// coordinates) over this tile (decimated: 1 when the filter spans more than MAX_TEXELS_PER_AXIS
-// texels and is read at every k-th), for a receiver at light depth `depth` with tangent plane
-// (`position`, `normal`). With settings.predicted_stride, a tile finer than the pixel's predicted
-// texel size `predicted` (a neighbour in the tile needed more) is read at every k-th texel, k the
-// ratio: the prediction says that many texels suffice, and a pixel's cost stays about ρ² whatever
-// the tile's resolution.
-fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> vec3<f32> {
-    let extent = tile.uv_max - tile.uv_min;
-    let scale = tile.size / extent;
-    // The filter in the tile's texel units. A filter narrower than a texel weighs the texels under
-    // it by area (Eq. 2), which tends to the texel under the point as it shrinks: the hard shadow
-    // test. Its half-axes are floored at MIN_HALF_TEXELS only so that a filter of zero size (a
-    // point light with antialiasing off) is that test, not an empty integral; a floor of half a
-    // texel made it a one-texel box centred on the point, which blurs a hard edge over a texel.
-    // Point samples (classic PCF) need a texel centre inside: a filter at least one texel wide.
+// The most steps (loop iterations: texels and columns, or blocks and climbs) of one filter's walk over
+// one tile: a bound on a pixel's cost whatever its filter spans, about 180² texels per-texel, and for
+// the hierarchy a penumbra boundary of several thousand texels inside the filter (each boundary
+// texel costs its 2×2 block's four reads and its share of the ancestors'). A walk that reaches it
+// stops early, reported (pvsm_capped_pixels), never silently: the texel walk integrates what it read
+// so far, the hierarchy counts each block still mixed as half lit. Half of 65,536: llvmpipe (Mesa
+// 22.3) leaves a shader's loops silently after 65,535 iterations, counted together over nested loops
+// and over its SIMD lanes (a loop runs while any lane needs it), so each walk is one flat loop and
+// this cap comes first.
+const MAX_WALK_STEPS: u32 = 32768u;
+
+// The unit roundoff of f32 (2^-24).
+const F32_ROUNDOFF: f32 = 5.9604645e-8;
+
+// One pixel's filter h laid out in the tile's texel units (what integrate and both walks read).
+struct TexelFilter {
+    // The filter's centre.
+    centre: vec2<f32>,
+    // The columns it spans, clipped to the tile: [x_low, x_high).
+    x_low: f32,
+    x_high: f32,
+    // Half-height of each column's box (Sec. 4.2: each one-texel-wide column of the parallelogram
+    // taken as an axis-aligned box at its middle's height), and the slope of those middles.
+    half_height: f32,
+    slope: f32,
+    // The rows any column reaches, clipped to the tile: [y_low, y_high).
+    y_low: f32,
+    y_high: f32,
+};
+
+// What a walk returns, in texel areas: Σ c·o, Σ c, whether it hit MAX_WALK_STEPS, and the texels
+// it read (each textureLoad of the tile map or of its pyramid is one: ssm-core's ReadCounts
+// convention, one texel fetched).
+struct FilterSums {
+    visible: f32,
+    covered: f32,
+    capped: bool,
+    reads: u32,
+};
+
+// Shadow-map coordinates of texel position `texel` of the tile (a texel's centre is its index + 0.5).
+fn tile_uv(texel: vec2<f32>, scale: vec2<f32>) -> vec2<f32> {
+    return tile.uv_min + texel / scale;
+}
+
+// The filter (u, v_height) centred on `centre` (shadow-map coordinates) in this tile's texels;
+// x_low >= x_high where it misses the tile. A filter narrower than a texel weighs the texels under
+// it by area (Eq. 2), which tends to the texel under the point as it shrinks: the hard shadow test.
+// Its half-axes are floored at MIN_HALF_TEXELS only so that a filter of zero size (a point light
+// with antialiasing off) is that test, not an empty integral; a floor of half a texel made it a
+// one-texel box centred on the point, which blurs a hard edge over a texel. Point samples (classic
+// PCF) need a texel centre inside: a filter at least one texel wide.
+fn texel_filter(centre: vec2<f32>, u: vec2<f32>, v_height: f32, scale: vec2<f32>) -> TexelFilter {
     let floor_half = select(MIN_HALF_TEXELS, 0.5, settings.point_samples != 0u);
     let c = (centre - tile.uv_min) * scale;
     let ux = max(abs(u.x) * scale.x, floor_half);
     let uy = select(u.y, -u.y, u.x < 0.0) * scale.y;
     let vy = max(v_height * scale.y, floor_half);
-    let x_low = max(c.x - ux, 0.0);
-    let x_high = min(c.x + ux, tile.size.x);
     let reach_y = abs(uy) + vy;
-    if (x_low >= x_high || c.y + reach_y <= 0.0 || c.y - reach_y >= tile.size.y) {
-        return vec3<f32>(0.0);
+    var shape: TexelFilter;
+    shape.centre = c;
+    shape.x_low = max(c.x - ux, 0.0);
+    shape.x_high = min(c.x + ux, tile.size.x);
+    shape.half_height = vy;
+    shape.slope = select(0.0, uy / ux, ux > 1e-6);
+    shape.y_low = max(c.y - reach_y, 0.0);
+    shape.y_high = min(c.y + reach_y, tile.size.y);
+    if (shape.y_low >= shape.y_high) {
+        shape.x_high = shape.x_low;
     }
-    let stride = max(vec2<f32>(1.0), select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u));
-    let step = max(stride, ceil(vec2<f32>(2.0 * ux, 2.0 * reach_y) / MAX_TEXELS_PER_AXIS));
-    let slope = select(0.0, uy / ux, ux > 1e-6);
-    // What each texel is compared with (the settings' receiver model), prepared once.
-    let receiver = receiver_tap_plane(frame, position, normal, depth, settings.receiver_plane != 0u);
-    var visible = 0.0;
-    var covered = 0.0;
-    var column = floor(x_low / step.x) * step.x;
+    return shape;
+}
+
+// The height of the rows [j0, j1) inside the column box centred at height `y_centre`.
+fn column_height(shape: TexelFilter, y_centre: f32, j0: f32, j1: f32) -> f32 {
+    return max(0.0, min(j1, y_centre + shape.half_height) - max(j0, y_centre - shape.half_height));
+}
+
+// The covered area of the one column `column` of the filter within rows [j0, j1): the column's
+// part inside [x_low, x_high) times its box's height there, the box at the middle of that part
+// (as the per-texel walk weighs it).
+fn partial_column_area(shape: TexelFilter, column: f32, j0: f32, j1: f32) -> f32 {
+    let left = max(column, shape.x_low);
+    let right = min(column + 1.0, shape.x_high);
+    if (right <= left) {
+        return 0.0;
+    }
+    let y_centre = shape.centre.y + (0.5 * (left + right) - shape.centre.x) * shape.slope;
+    return (right - left) * column_height(shape, y_centre, j0, j1);
+}
+
+// The covered area of the whole columns [lo, hi) (each inside [x_low, x_high)) within rows [j0, j1),
+// in closed form. Column i's box is centred at a + b i (a the centre's height at column 0's middle,
+// b the slope), and its height in the rows is column_height, a trapezoid in the box's centre, linear
+// between the four breakpoints j0 ± half_height, j1 ± half_height. The columns whose centres lie
+// between two consecutive breakpoints form a run of integers, over which the sum of a linear
+// function is the run's length times its value at the run's mean. Outside the outer two breakpoints
+// the height is 0: three runs.
+fn whole_columns_area(shape: TexelFilter, lo: f32, hi: f32, j0: f32, j1: f32) -> f32 {
+    if (hi <= lo) {
+        return 0.0;
+    }
+    let b = shape.slope;
+    let a = shape.centre.y + (0.5 - shape.centre.x) * b;
+    if (b == 0.0) {
+        return (hi - lo) * column_height(shape, a, j0, j1);
+    }
+    let h = shape.half_height;
+    // The first column at or past each breakpoint's crossing.
+    let crossings = clamp(ceil((vec4<f32>(j0 - h, j0 + h, j1 - h, j1 + h) - a) / b), vec4<f32>(lo), vec4<f32>(hi));
+    // In order: a five-comparison sorting network.
+    let low_pair = min(crossings.xz, crossings.yw);
+    let high_pair = max(crossings.xz, crossings.yw);
+    let first = min(low_pair.x, low_pair.y);
+    let last = max(high_pair.x, high_pair.y);
+    let middle_a = max(low_pair.x, low_pair.y);
+    let middle_b = min(high_pair.x, high_pair.y);
+    let cuts = vec4<f32>(first, min(middle_a, middle_b), max(middle_a, middle_b), last);
+    var bounds = array<f32, 4>(cuts.x, cuts.y, cuts.z, cuts.w);
+    var area = 0.0;
+    for (var k = 0u; k < 3u; k++) {
+        let start = bounds[k];
+        let end = bounds[k + 1u];
+        if (end > start) {
+            area += (end - start) * column_height(shape, a + b * 0.5 * (start + end - 1.0), j0, j1);
+        }
+    }
+    return area;
+}
+
+// The filter's covered area in the block of texels [lo, hi) (columns x, rows y): Eq. 2's Σ c over
+// the block's texels, the same weights as the per-texel walk's, in a bounded number of steps.
+fn block_area(shape: TexelFilter, lo: vec2<f32>, hi: vec2<f32>) -> f32 {
+    let first_column = floor(shape.x_low);
+    let last_column = floor(shape.x_high);
+    let first_whole = ceil(shape.x_low);
+    var area = whole_columns_area(shape, max(lo.x, first_whole), min(hi.x, last_column), lo.y, hi.y);
+    // The partial columns at the filter's ends (one column if both ends fall in it).
+    let first_partial = shape.x_low > first_column;
+    if (first_partial && first_column >= lo.x && first_column < hi.x) {
+        area += partial_column_area(shape, first_column, lo.y, hi.y);
+    }
+    let last_partial = shape.x_high > last_column && (last_column > first_column || !first_partial);
+    if (last_partial && last_column >= lo.x && last_column < hi.x) {
+        area += partial_column_area(shape, last_column, lo.y, hi.y);
+    }
+    return area;
+}
+
+// Bounds (lowest, highest) of what tap_plane_depth(receiver, uv) returns at the texel centres of the
+// rectangle [uv_low, uv_high] (shadow-map coordinates of its first and last centres), as f32
+// evaluates it, so that a block classified from them is classified as each of its texels would be.
+// The plane's depth along a tap's ray is numerator / (c.x + c.y u + c.z v): the denominator is
+// affine in uv, so its extremes over the rectangle are at its corners, and where it keeps one sign
+// (and is no nearer 0 than tap_plane_depth's 1e-6) the depth is monotone in it. Slack: the f32
+// evaluation of the denominator at a texel and at a corner each err by a few roundoffs of the sum of
+// the terms' magnitudes (uv's own rounding included), so the denominator's range is widened by 8 of
+// them, and the quotient by 4 relative roundoffs. Where the denominator can come within 1e-6 of 0 or
+// change sign, a texel may get the fallback or a depth arbitrarily far: the bounds are then
+// (min(fallback, 0), NO_SURFACE), with which no block but one with no surface at all (lit whatever the
+// receiver) is decided without descending.
+fn compared_bounds(receiver: TapPlane, uv_low: vec2<f32>, uv_high: vec2<f32>) -> vec2<f32> {
+    let c = receiver.coefficients;
+    let along_u = vec2<f32>(c.y * uv_low.x, c.y * uv_high.x);
+    let along_v = vec2<f32>(c.z * uv_low.y, c.z * uv_high.y);
+    let lowest = c.x + min(along_u.x, along_u.y) + min(along_v.x, along_v.y);
+    let highest = c.x + max(along_u.x, along_u.y) + max(along_v.x, along_v.y);
+    let magnitude = abs(c.x) + max(abs(along_u.x), abs(along_u.y)) + max(abs(along_v.x), abs(along_v.y));
+    let slack = 8.0 * F32_ROUNDOFF * magnitude;
+    let denominator = vec2<f32>(lowest - slack, highest + slack);
+    let n = receiver.numerator;
+    let positive = denominator.x >= 1e-6 && n > 0.0;
+    let negative = denominator.y <= -1e-6 && n < 0.0;
+    if (!(positive || negative)) {
+        return vec2<f32>(min(receiver.fallback, 0.0), NO_SURFACE);
+    }
+    let ends = vec2<f32>(n / denominator.x, n / denominator.y);
+    let relative = 4.0 * F32_ROUNDOFF;
+    return vec2<f32>(min(ends.x, ends.y) * (1.0 - relative), max(ends.x, ends.y) * (1.0 + relative));
+}
+
+// Eq. 2 texel by texel: every texel under the filter read and weighed (filter_walk = texels), or with
+// `stride` > 1 every stride-th texel, each standing for a stride×stride block (filter_texels =
+// predicted, not the paper's); with point_samples, classic PCF. At most MAX_WALK_STEPS texels.
+fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride: vec2<f32>) -> FilterSums {
+    var sums = FilterSums(0.0, 0.0, false, 0u);
+    var steps = 0u;
+    var column = floor(shape.x_low / stride.x) * stride.x;
+    // One loop over columns and their rows, a texel or a new column per iteration (see
+    // MAX_WALK_STEPS: llvmpipe counts the iterations of nested loops together, over its SIMD lanes).
+    var in_column = false;
+    var row = 0.0;
+    var width = 0.0;
+    var y_centre = 0.0;
+    var bottom = 0.0;
+    var top = 0.0;
     loop {
-        if (column >= x_high) {
+        if (column >= shape.x_high) {
             break;
         }
-        let left = max(column, x_low);
-        let right = min(column + step.x, x_high);
-        let width = right - left;
-        if (width > 0.0) {
-            // This column of h, taken as an axis-aligned box at its middle's height.
-            let middle = 0.5 * (left + right);
-            let y_centre = c.y + (middle - c.x) * slope;
-            let bottom = max(y_centre - vy, 0.0);
-            let top = min(y_centre + vy, tile.size.y);
-            var row = floor(bottom / step.y) * step.y;
-            loop {
-                if (row >= top) {
+        if (steps >= MAX_WALK_STEPS) {
+            sums.capped = true;
+            break;
+        }
+        steps += 1u;
+        if (!in_column) {
+            // The next column of h, taken as an axis-aligned box at its middle's height.
+            let left = max(column, shape.x_low);
+            let right = min(column + stride.x, shape.x_high);
+            width = right - left;
+            y_centre = shape.centre.y + (0.5 * (left + right) - shape.centre.x) * shape.slope;
+            bottom = max(y_centre - shape.half_height, 0.0);
+            top = min(y_centre + shape.half_height, tile.size.y);
+            row = floor(bottom / stride.y) * stride.y;
+            in_column = width > 0.0;
+            if (!in_column) {
+                column += stride.x;
+            }
+            continue;
+        }
+        if (row >= top) {
+            in_column = false;
+            column += stride.x;
+            continue;
+        }
+        var height = min(row + stride.y, top) - max(row, bottom);
+        let texel = vec2<f32>(column, row) + 0.5 * stride;
+        if (settings.point_samples != 0u) {
+            // Classic PCF: the whole texel when its centre is inside the filter, else nothing.
+            let inside = texel.x >= shape.x_low && texel.x < shape.x_high && texel.y >= y_centre - shape.half_height
+                && texel.y < y_centre + shape.half_height;
+            height = select(0.0, stride.y, inside);
+        }
+        if (height > 0.0) {
+            let z = textureLoad(tile_map, vec2<i32>(min(texel, tile.size - vec2<f32>(0.5))), 0).x;
+            sums.reads += 1u;
+            let compared = tap_plane_depth(receiver, tile_uv(texel, scale));
+            let area = select(width, stride.x, settings.point_samples != 0u) * height;
+            // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2); the
+            // tile map's depths carry the depth bias already.
+            sums.visible += select(0.0, area, compared <= z);
+            sums.covered += area;
+        }
+        row += stride.y;
+    }
+    return sums;
+}
+
+// Eq. 2 over the tile's min/max pyramid, top-down (filter_walk = hierarchy): from the (at most 2×2)
+// blocks of the coarsest level that hold the filter's rows and columns, a block the filter does not
+// cover is skipped unread; one whose nearest depth is no nearer than the receiver's farthest
+// compared depth over it (every texel lit, o = 1) or whose farthest depth is nearer than the
+// receiver's nearest (every texel occluding, o = 0) adds its covered area (block_area) at once; a
+// mixed one descends to its four children; a texel is tested as the per-texel walk tests it. The
+// same weights and the same tests: the per-texel sum, in another order. The walk is depth-first and
+// needs no stack: after a block, the next is its next sibling, or its parent's (climbing while it
+// is the fourth child), so that the state is one block and its level.
+fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> FilterSums {
+    var sums = FilterSums(0.0, 0.0, false, 0u);
+    var steps = 0u;
+    let first = vec2<u32>(vec2<f32>(floor(shape.x_low), floor(shape.y_low)));
+    let last = vec2<u32>(vec2<f32>(ceil(shape.x_high), ceil(shape.y_high))) - 1u;
+    // The finest level at which the filter's texels span at most two blocks along each axis (at
+    // most 14 for tiles of 16384 texels).
+    var top_level = 0u;
+    while (top_level < 15u && any((last >> vec2<u32>(top_level)) - (first >> vec2<u32>(top_level)) > vec2<u32>(1u))) {
+        top_level += 1u;
+    }
+    let low = first >> vec2<u32>(top_level);
+    let high = last >> vec2<u32>(top_level);
+    let pyramid_levels = textureNumLevels(tile_pyramid);
+    let pyramid_base = textureDimensions(tile_pyramid, 0);
+    // One loop, a block or a climb to its parent per iteration (see MAX_WALK_STEPS: llvmpipe counts
+    // the iterations of nested loops together, over its SIMD lanes). `next` set: the current block
+    // is done, move on to its next sibling or its parent's; at the top level, to the next start block.
+    var start = 0u;
+    var block = low;
+    var level = top_level;
+    var next = false;
+    loop {
+        if (steps >= MAX_WALK_STEPS + 256u) {
+            // Past the cap no block descends, and the siblings left (at most three per level) end the
+            // walk well within this bound, which only guards it.
+            sums.capped = true;
+            break;
+        }
+        steps += 1u;
+        if (next) {
+            if (level >= top_level) {
+                start += 1u;
+                if (start >= 4u) {
                     break;
                 }
-                var height = min(row + step.y, top) - max(row, bottom);
-                let texel = vec2<f32>(column, row) + 0.5 * step;
-                if (settings.point_samples != 0u) {
-                    // Classic PCF: the whole texel when its centre is inside the filter, else nothing.
-                    let inside = texel.x >= x_low && texel.x < x_high && texel.y >= y_centre - vy && texel.y < y_centre + vy;
-                    height = select(0.0, step.y, inside);
-                }
-                if (height > 0.0) {
-                    let z = textureLoad(tile_map, vec2<i32>(min(texel, tile.size - vec2<f32>(0.5))), 0).x;
-                    let uv = tile.uv_min + texel / scale;
-                    let compared = tap_plane_depth(receiver, uv);
-                    let area = select(width, step.x, settings.point_samples != 0u) * height;
-                    // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2); the
-                    // tile map's depths carry the depth bias already.
-                    visible += select(0.0, area, compared <= z);
-                    covered += area;
-                }
-                row += step.y;
+                block = low + vec2<u32>(start & 1u, start >> 1u);
+                next = any(block > high);
+            } else if ((block.x & 1u) == 0u) {
+                block.x += 1u;
+                next = false;
+            } else if ((block.y & 1u) == 0u) {
+                block = vec2<u32>(block.x - 1u, block.y + 1u);
+                next = false;
+            } else {
+                block = block >> vec2<u32>(1u);
+                level += 1u;
             }
+            continue;
         }
-        column += step.x;
+        next = true;
+        let lo = vec2<f32>(block << vec2<u32>(level));
+        let hi = min(vec2<f32>((block + 1u) << vec2<u32>(level)), tile.size);
+        let area = block_area(shape, lo, hi);
+        if (area <= 0.0) {
+            continue;
+        }
+        sums.reads += 1u;
+        // (nearest, farthest) depth of the block's texels, and the bounds of what they are compared
+        // with; a texel is a block whose bounds are its own test's values, never mixed. Loads are
+        // clamped to the texture: a real walk never leaves it. (A mip's size from the base's:
+        // textureDimensions with a level returns the base level's size on llvmpipe.)
+        var depths: vec2<f32>;
+        var compared: vec2<f32>;
+        if (level == 0u) {
+            let z = textureLoad(tile_map, min(vec2<i32>(block), vec2<i32>(tile.size) - 1), 0).x;
+            depths = vec2<f32>(z);
+            compared = vec2<f32>(tap_plane_depth(receiver, tile_uv(lo + 0.5, scale)));
+        } else {
+            let mip = min(level - 1u, pyramid_levels - 1u);
+            let mip_size = max(pyramid_base >> vec2<u32>(mip), vec2<u32>(1u));
+            depths = textureLoad(tile_pyramid, vec2<i32>(min(block, mip_size - 1u)), i32(mip)).xy;
+            compared = compared_bounds(receiver, tile_uv(lo + 0.5, scale), tile_uv(hi - 0.5, scale));
+        }
+        if (compared.y <= depths.x) {
+            // Every texel at or behind the receiver: lit (o = 1, Eq. 2).
+            sums.visible += area;
+            sums.covered += area;
+        } else if (compared.x > depths.y) {
+            // Every texel in front of the receiver: occluding.
+            sums.covered += area;
+        } else if (steps >= MAX_WALK_STEPS) {
+            // The cap (reported): the block counted half lit rather than walked further.
+            sums.capped = true;
+            sums.visible += 0.5 * area;
+            sums.covered += area;
+        } else {
+            // Mixed: its first child next.
+            level -= 1u;
+            block = 2u * block;
+            next = false;
+        }
+    }
+    return sums;
+}
+
+// Eq. 2 for the filter (u, v_height) centred on `centre` (shadow-map coordinates) over this tile,
+// for a receiver at light depth `depth` with tangent plane (`position`, `normal`): (Σ c·o, Σ c) in
+// shadow-map area, whether the walk was capped, and the texels it read. With
+// settings.predicted_stride, a tile finer than the pixel's predicted texel size `predicted` (a
+// neighbour in the tile needed more) is read at every k-th texel, k the ratio: the prediction says
+// that many texels suffice, and a pixel's cost stays about ρ² whatever the tile's resolution.
+fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, position: vec3<f32>, normal: vec3<f32>, predicted: vec2<f32>) -> FilterSums {
+    let scale = tile.size / (tile.uv_max - tile.uv_min);
+    let shape = texel_filter(centre, u, v_height, scale);
+    if (shape.x_low >= shape.x_high) {
+        return FilterSums(0.0, 0.0, false, 0u);
+    }
+    // What each texel is compared with (the settings' receiver model), prepared once.
+    let receiver = receiver_tap_plane(frame, position, normal, depth, settings.receiver_plane != 0u);
+    let stride = max(vec2<f32>(1.0), select(vec2<f32>(1.0), floor(predicted * scale), settings.predicted_stride != 0u));
+    var sums: FilterSums;
+    if (settings.texel_walk != 0u || settings.point_samples != 0u || any(stride > vec2<f32>(1.0))) {
+        sums = walk_texels(shape, receiver, scale, stride);
+    } else {
+        sums = walk_hierarchy(shape, receiver, scale);
     }
     // In shadow-map coordinates, not texels: tiles of different resolutions merge by true area.
     let texel_area = 1.0 / (scale.x * scale.y);
-    return vec3<f32>(vec2<f32>(visible, covered) * texel_area, select(0.0, 1.0, any(step > stride)));
+    sums.visible *= texel_area;
+    sums.covered *= texel_area;
+    return sums;
+}
+
+// Records one filter evaluation's texel reads (with COUNT_READS, the settings' count_reads).
+fn record_filter_reads(pixel: vec2<u32>, reads: u32) {
+    if (COUNT_READS) {
+        let word = read_count_word(READ_COUNTER_TILE_FILTER, vec2<i32>(pixel));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+    }
 }
 
 @compute @workgroup_size(8, 8)
@@ -141,15 +463,18 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
         let lookup = offset_point(point.position, point.normal, offset);
         let uvd = light_uv_depth(frame, lookup);
         let sums = integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, lookup, point.normal, kernel.texel);
-        accumulated[index] += sums.xy;
-        if (sums.z > 0.0) {
-            decimated[index] = 1u;
+        accumulated[index] += vec2<f32>(sums.visible, sums.covered);
+        if (sums.capped) {
+            capped[index] = 1u;
         }
+        record_filter_reads(id.xy, sums.reads);
         return;
     }
     // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
     // each filtered on its own; their sums add up, as their filters have the same area.
-    var sum = vec3<f32>(0.0);
+    var sum = vec2<f32>(0.0);
+    var any_capped = false;
+    var reads = 0u;
     for (var j = 0u; j < k; j++) {
         for (var i = 0u; i < k; i++) {
             let pixel = vec2<f32>(id.xy) + (vec2<f32>(f32(i), f32(j)) + 0.5) / f32(k);
@@ -159,13 +484,17 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let sub_lookup = offset_point(hit.xyz, point.normal, offset);
             let uvd = light_uv_depth(frame, sub_lookup);
-            sum += integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, sub_lookup, point.normal, kernel.texel);
+            let sums = integrate(uvd.xy, kernel.u_axis, kernel.v_height, uvd.z, sub_lookup, point.normal, kernel.texel);
+            sum += vec2<f32>(sums.visible, sums.covered);
+            any_capped = any_capped || sums.capped;
+            reads += sums.reads;
         }
     }
-    accumulated[index] += sum.xy;
-    if (sum.z > 0.0) {
-        decimated[index] = 1u;
+    accumulated[index] += sum;
+    if (any_capped) {
+        capped[index] = 1u;
     }
+    record_filter_reads(id.xy, reads);
 }
 
 // The final visibility (Sec. 5.2's merge: V = Σ V·A / Σ A) into the framework's target.
@@ -184,15 +513,15 @@ fn pvsm_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         value = 0.0;
     } else if (kernel.flags == KERNEL_ACTIVE) {
         let sums = accumulated[index];
-        // No tile under the filter. Every grid cell a filter can read asks for a tile, so this is a
+        // No tile under the shape. Every grid cell a filter can read asks for a tile, so this is a
         // lookup point that the normal offset moved into a cell no pixel asked for, or one outside
         // the light frame. Read as lit, and counted (pvsm_uncovered_pixels).
         value = select(1.0, clamp(sums.x / sums.y, 0.0, 1.0), sums.y > 0.0);
         if (sums.y <= 0.0) {
             atomicAdd(&counters[COUNTER_UNCOVERED], 1u);
         }
-        if (decimated[index] != 0u) {
-            atomicAdd(&counters[COUNTER_DECIMATED], 1u);
+        if (capped[index] != 0u) {
+            atomicAdd(&counters[COUNTER_CAPPED], 1u);
         }
     }
     textureStore(visibility, vec2<i32>(id.xy), vec4<f32>(value));

@@ -12,6 +12,7 @@
 //   finest: the maximum of texels per unit, by atomicMax on the float's bits).
 
 // #import pvsm/pvsm_common.wgsl
+// #import common/read_counts.wgsl
 
 @group(2) @binding(2) var low_res_map: texture_2d<f32>;
 @group(2) @binding(3) var<storage, read_write> kernels: array<Kernel>;
@@ -19,6 +20,26 @@
 @group(2) @binding(4) var<storage, read_write> grid: array<atomic<u32>>;
 // COUNTER_* of pvsm_common.wgsl.
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_KERNEL_SHAPE (texel reads) and
+// READ_COUNTER_KERNEL_SHAPE_ATOMICS (atomic operations).
+@group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
+const READ_COUNTER_KERNEL_SHAPE: u32 = 1u;
+const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 2u;
+
+// Records one pixel's texel reads (one per textureLoad of the low-resolution map, ReadCounts'
+// convention) and atomics, with COUNT_READS (the settings' count_reads).
+fn record_kernel_work(pixel: vec2<u32>, reads: u32, atomics: u32) {
+    if (COUNT_READS) {
+        let word = read_count_word(READ_COUNTER_KERNEL_SHAPE, vec2<i32>(pixel));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
+        let atomics_word = read_count_word(READ_COUNTER_KERNEL_SHAPE_ATOMICS, vec2<i32>(pixel));
+        atomicAdd(&read_counts[atomics_word], 1u);
+        atomicAdd(&read_counts[atomics_word + 1u], atomics);
+    }
+}
 
 // How much the pixel's tangent plane's depth changes over `half_texel` (shadow-map coordinates)
 // along both axes: the receiver's own depth spread within a texel of that size.
@@ -94,6 +115,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     // edge still finds it (the parallel-square test's penumbra error rises from 0.0175 to 0.0197
     // without it).
     let nearest = textureLoad(low_res_map, vec2<i32>(0), i32(levels - 1u)).x;
+    var reads = 1u;
     let search = light_half_extent_uv(frame, clamp(0.98 * nearest, frame.projection.z, d), d);
     let n = max(settings.blocker_kernel, 1u);
     let span = max(2.0 * search * base_size, vec2<f32>(1.0));
@@ -127,6 +149,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var y = max(low.y, 0); y <= min(high.y, limit.y); y++) {
         for (var x = max(low.x, 0); x <= min(high.x, limit.x); x++) {
             let depth = textureLoad(low_res_map, vec2<i32>(x, y), i32(level)).x;
+            reads += 1u;
             let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / level_size;
             if (depth < tap_plane_depth(receiver, uv) - coarse_tolerance) {
                 coarse_sum += depth;
@@ -145,6 +168,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var y = fine_low.y; y <= fine_high.y; y++) {
             for (var x = fine_low.x; x <= fine_high.x; x++) {
                 let depth = textureLoad(low_res_map, vec2<i32>(x, y), 0).x;
+                reads += 1u;
                 let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / base_size;
                 if (depth < tap_plane_depth(receiver, uv) - fine_tolerance) {
                     let area = texel_area_in(region, vec2<i32>(x, y));
@@ -158,6 +182,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var i = 0u; i < n; i++) {
                 let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
                 let depth = shadow_map_depth(low_res_map, uv);
+                // shadow_map_depth reads a texel only inside the map.
+                reads += select(0u, 1u, all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)));
                 if (depth < tap_plane_depth(receiver, uv) - fine_tolerance) {
                     sum += depth;
                     count += 1.0;
@@ -174,6 +200,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         kernel.flags = KERNEL_LIT;
         kernels[index] = kernel;
         atomicAdd(&counters[COUNTER_LIT], 1u);
+        record_kernel_work(id.xy, reads, 1u);
         return;
     }
     // With prediction = fixed the pixel is still filtered (the single map decides), with no penumbra
@@ -206,6 +233,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
 
     // Eqs. 4 and 5 (pvsm_common.wgsl's predicted_texels): the texel size each axis needs.
     var texel_size = vec2<f32>(1.0 / settings.fixed_size);
+    var atomics = 1u;
     if (settings.prediction != 3u) {
         // Without antialiasing, one pixel's size at the point, in shadow-map coordinates at its depth.
         let pixel_texel = pixel_world_size(point.position, pixel) / (2.0 * d * frame.projection.xy * settings.hard_texels);
@@ -225,6 +253,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
                 let cell = u32(y) * settings.grid_size + u32(x);
                 atomicMax(&grid[2u * cell], bitcast<u32>(resolution.x));
                 atomicMax(&grid[2u * cell + 1u], bitcast<u32>(resolution.y));
+                atomics += 2u;
             }
         }
     }
@@ -240,4 +269,5 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     kernel.flags = KERNEL_ACTIVE;
     kernels[index] = kernel;
     atomicAdd(&counters[COUNTER_FILTERED], 1u);
+    record_kernel_work(id.xy, reads, atomics);
 }

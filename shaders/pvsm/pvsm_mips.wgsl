@@ -4,8 +4,15 @@
 // texels wide, and still see every occluder the conservative map holds (Sec. 5.2: a pixel with
 // no occluder there is fully lit, and skipped).
 
+// #import common/read_counts.wgsl
+
 @group(0) @binding(0) var finer: texture_2d<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d<r32float, write>;
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_LOW_RES_MIPS.
+@group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// The ReadCounts counter of this pass (PvsmReadCounter in src/lib.rs).
+const READ_COUNTER_LOW_RES_MIPS: u32 = 0u;
 
 @compute @workgroup_size(8, 8)
 fn pvsm_low_res_mip(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -25,4 +32,11 @@ fn pvsm_low_res_mip(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest));
+    if (COUNT_READS) {
+        // One read per textureLoad (ReadCounts' convention), the first texel's twice as the code reads it.
+        let span = high - low + 1;
+        let word = read_count_word(READ_COUNTER_LOW_RES_MIPS, vec2<i32>(id.xy));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], 1u + u32(span.x * span.y));
+    }
 }

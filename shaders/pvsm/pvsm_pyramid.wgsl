@@ -3,6 +3,8 @@
 // cells of the one below, down to a single cell. The whole pyramid is then read back for the
 // kd-tree.
 
+// #import common/read_counts.wgsl
+
 struct PyramidSettings {
     // Side of level 0, a power of two.
     grid_size: u32,
@@ -15,14 +17,22 @@ struct PyramidSettings {
 @group(0) @binding(1) var<storage, read> grid: array<u32>;
 // Every level, level 0 first, as resolutions along u and v.
 @group(0) @binding(2) var<storage, read_write> pyramid: array<vec2<f32>>;
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_SMTG_PYRAMID.
+@group(0) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// The ReadCounts counter of this pass (PvsmReadCounter in src/lib.rs).
+const READ_COUNTER_SMTG_PYRAMID: u32 = 3u;
 
 const THREADS: u32 = 256u;
 
 @compute @workgroup_size(256)
 fn pvsm_pyramid(@builtin(local_invocation_index) thread: u32) {
     var side = pyramid_settings.grid_size;
+    // Cells read, each one storage element of a map of cells (ReadCounts' convention: one texel).
+    var reads = 0u;
     for (var cell = thread; cell < side * side; cell += THREADS) {
         pyramid[cell] = vec2<f32>(bitcast<f32>(grid[2u * cell]), bitcast<f32>(grid[2u * cell + 1u]));
+        reads += 1u;
     }
     var below = 0u;
     loop {
@@ -38,8 +48,14 @@ fn pvsm_pyramid(@builtin(local_invocation_index) thread: u32) {
             let y = cell / half;
             let at = below + 2u * y * side + 2u * x;
             pyramid[above + cell] = max(max(pyramid[at], pyramid[at + 1u]), max(pyramid[at + side], pyramid[at + side + 1u]));
+            reads += 4u;
         }
         below = above;
         side = half;
+    }
+    if (COUNT_READS) {
+        let word = read_count_word(READ_COUNTER_SMTG_PYRAMID, vec2<i32>(i32(thread), 0));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], reads);
     }
 }

@@ -16,9 +16,10 @@
 //!    diagnostic);
 //! 6. the kd-tree on the CPU (`pvsm_kdtree`, [`kdtree`]);
 //! 7. per tile, a shadow map of the predicted resolution (`pvsm_tile_map`);
-//! 8. per tile, the texel-as-quad filtering of the pixels whose filter
-//!    reaches it (`pvsm_tile_filter`), merged per pixel, then the ratio
-//!    (`pvsm_resolve`).
+//! 8. per tile, the min/max depth pyramid of its map (`pvsm_tile_pyramid`)
+//!    and the texel-as-quad filtering of the pixels whose filter reaches it,
+//!    walked top-down over that pyramid (`pvsm_tile_filter`), merged per
+//!    pixel, then the ratio (`pvsm_resolve`).
 
 pub mod kdtree;
 pub mod prediction;
@@ -31,6 +32,7 @@ use ssm_core::passes::{
     bind_group, bind_group_layout, compute_pipeline, readback_buffer, storage_buffer, storage_entry, texture_entry, uniform_buffer,
     uniform_entry, visibility_storage_entry, write_storage_texture_entry,
 };
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
     Choice, DebugOutput, DepthBiasUniform, Error, ExtraImage, Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc,
@@ -58,6 +60,22 @@ const MIPS_SHADER: &str = ssm_shaders::pvsm::PVSM_MIPS;
 const FILTER_SHADER: &str = ssm_shaders::pvsm::PVSM_FILTER;
 /// Step 7's culling to the tile.
 const CULL_SHADER: &str = ssm_shaders::pvsm::PVSM_CULL;
+/// Step 8's min/max pyramid of a tile's map.
+const TILE_PYRAMID_SHADER: &str = ssm_shaders::pvsm::PVSM_TILE_PYRAMID;
+
+/// The work the passes count with `count_reads` ([`ReadCounts`]), in the order the shaders index
+/// them: `(WGSL constant, shader, pass, unit)`. A texel read is one texel fetched (a `textureLoad`,
+/// or one element of a storage array read as a map's texel); the tile maps' texels written are
+/// the `pvsm_texels_rendered` diagnostic, counted on the CPU from the tiles' sizes.
+const READ_COUNTERS: [(&str, &str, &str, &str); 7] = [
+    ("READ_COUNTER_LOW_RES_MIPS", MIPS_SHADER, "pvsm_low_res_mips", "reads"),
+    ("READ_COUNTER_KERNEL_SHAPE", KERNEL_SHADER, "pvsm_kernel_shape", "reads"),
+    ("READ_COUNTER_KERNEL_SHAPE_ATOMICS", KERNEL_SHADER, "pvsm_kernel_shape", "atomics"),
+    ("READ_COUNTER_SMTG_PYRAMID", PYRAMID_SHADER, "pvsm_smtg_pyramid", "reads"),
+    ("READ_COUNTER_TILE_PYRAMID", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "reads"),
+    ("READ_COUNTER_TILE_PYRAMID_BYTES", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "storage_bytes"),
+    ("READ_COUNTER_TILE_FILTER", FILTER_SHADER, "pvsm_tile_filter", "reads"),
+];
 
 /// How the low-resolution map is rasterised conservatively (step 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
@@ -84,12 +102,23 @@ pub enum Integration {
 /// Which texels of a tile a pixel's filter reads (step 8).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
 pub enum FilterTexels {
-    /// Every texel under the filter, at the tile's resolution (the paper); at most 96 per axis.
+    /// Every texel under the filter, at the tile's resolution (the paper), walked as `filter_walk` says.
     Tile,
     /// Every k-th, each standing for a k×k block, k the ratio of the pixel's predicted texel to the
     /// tile's: a pixel's cost stays about ρ² in a tile a neighbour made finer, but occluders thinner
-    /// than a block can fall between the samples.
+    /// than a block can fall between the samples. Always read sample by sample.
     Predicted,
+}
+
+/// How the filter's Eq. 2 sum over a tile's texels is walked (step 8); both give the same sum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum FilterWalk {
+    /// Top-down over the tile's min/max depth pyramid: a block entirely in front of or behind the
+    /// receiver adds its covered area at once, only mixed blocks descend; the cost follows the
+    /// penumbra's boundary texels.
+    Hierarchy,
+    /// Every texel under the filter read and weighed; the cost follows the filter's area in texels.
+    Texels,
 }
 
 /// Settings of [`PredictedVirtualShadowMaps`]: its parameters.
@@ -131,6 +160,12 @@ pub struct PvsmSettings {
     /// Which texels of a tile the filter reads: tile (every one, the paper) or predicted (every k-th, k the ratio of the pixel's predicted texel to the tile's; cheaper where a neighbour made the tile finer).
     #[param(choice, default = "tile")]
     pub filter_texels: FilterTexels,
+    /// How the filter walks a tile's texels (Eq. 2, the same sum either way): hierarchy (top-down over the tile's min/max depth pyramid; blocks entirely in front of or behind the receiver count at once) or texels (every texel under the filter, one by one). Point samples and filter_texels = predicted always read texel by texel.
+    #[param(choice, default = "hierarchy")]
+    pub filter_walk: FilterWalk,
+    /// Count the texels each pass reads per pixel, its atomics and bytes written (diagnostics `<pass>_<unit>_per_pixel`, `pvsm_texels_filtered`); the atomics cost time, so off when timing.
+    #[param(default = false)]
+    pub count_reads: bool,
     /// k: the filter evaluated at k×k points of each pixel and averaged (Fig. 11's supersampling; set antialiasing=false).
     #[param(default = 1, min = 1, max = 32)]
     pub supersampling: u32,
@@ -161,6 +196,18 @@ pub struct PvsmSettingsUniform {
     point_samples: u32,
     predicted_stride: u32,
     hard_texels: f32,
+    texel_walk: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+impl PvsmSettings {
+    /// Whether step 8 walks the tiles' min/max pyramids (and so builds them): the paper's quads at
+    /// the tile's resolution with `filter_walk = hierarchy`.
+    fn walks_hierarchy(&self) -> bool {
+        self.filter_walk == FilterWalk::Hierarchy && self.integration == Integration::Quads && self.filter_texels == FilterTexels::Tile
+    }
 }
 
 impl From<&PvsmSettings> for PvsmSettingsUniform {
@@ -178,6 +225,10 @@ impl From<&PvsmSettings> for PvsmSettingsUniform {
             point_samples: u32::from(settings.integration == Integration::Points),
             predicted_stride: u32::from(settings.filter_texels == FilterTexels::Predicted),
             hard_texels: settings.hard_texels as f32,
+            texel_walk: u32::from(settings.filter_walk == FilterWalk::Texels),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 }
@@ -202,6 +253,16 @@ pub struct PyramidSettingsUniform {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+}
+
+/// `PyramidLevel` of `shaders/pvsm/pvsm_tile_pyramid.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+pub struct TilePyramidLevelUniform {
+    level: u32,
+    from_map: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 /// `CullSettings` of `shaders/pvsm/pvsm_cull.wgsl`.
@@ -250,7 +311,7 @@ struct LowResMap {
 }
 
 impl LowResMap {
-    fn new(device: &wgpu::Device, side: u32, mip_layout: &wgpu::BindGroupLayout) -> Self {
+    fn new(device: &wgpu::Device, side: u32, mip_layout: &wgpu::BindGroupLayout, read_counts: &ReadCounts) -> Self {
         let levels = side.max(1).ilog2() + 1;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("pvsm_low_res_map"),
@@ -279,7 +340,11 @@ impl LowResMap {
                     device,
                     &format!("pvsm_low_res_mip{level}_bind_group"),
                     mip_layout,
-                    &[wgpu::BindingResource::TextureView(&level_view(level - 1)), wgpu::BindingResource::TextureView(&level_view(level))],
+                    &[
+                        wgpu::BindingResource::TextureView(&level_view(level - 1)),
+                        wgpu::BindingResource::TextureView(&level_view(level)),
+                        read_counts.buffer().as_entire_binding(),
+                    ],
                 );
                 (group, (side >> level).max(1))
             })
@@ -327,9 +392,9 @@ impl KernelRecord {
     }
 }
 
-/// The `COUNTER_*` slots of `pvsm_common.wgsl`, in order: pixels filtered, skipped as lit, decimated,
-/// and not covered by any tile.
-const COUNTER_NAMES: [&str; 4] = ["COUNTER_FILTERED", "COUNTER_LIT", "COUNTER_DECIMATED", "COUNTER_UNCOVERED"];
+/// The `COUNTER_*` slots of `pvsm_common.wgsl`, in order: pixels filtered, skipped as lit, whose
+/// filter's walk reached its cap, and not covered by any tile.
+const COUNTER_NAMES: [&str; 4] = ["COUNTER_FILTERED", "COUNTER_LIT", "COUNTER_CAPPED", "COUNTER_UNCOVERED"];
 /// Bytes of the counters buffer.
 const COUNTER_BYTES: u64 = COUNTER_NAMES.len() as u64 * 4;
 
@@ -343,8 +408,99 @@ struct TileSlot {
     bias: wgpu::Buffer,
     bias_group: wgpu::BindGroup,
     settings: wgpu::Buffer,
-    /// One per tile map size (`tile_maps`): the tile's settings and that map.
+    /// The tile's settings alone, for the pyramid's passes.
+    pyramid_group: wgpu::BindGroup,
+    /// One per tile map size (`tile_maps`): the tile's settings, that map and the pyramid.
     filter_groups: Vec<wgpu::BindGroup>,
+}
+
+/// Step 8's min/max depth pyramid of the current tile's map: mip m holds level m + 1 (blocks of
+/// 2^(m+1) texels a side) as (nearest, farthest), for the tile's region only. One texture serves
+/// every tile, rebuilt before each tile's filter; its side is half the largest tile map's side
+/// rounded up to a power of two, so that level l holds ceil(size / 2^l) texels of any region.
+struct TilePyramid {
+    /// Every mip, for the filter.
+    view: wgpu::TextureView,
+    /// Per tile map size: level 1's group, reading that map.
+    first_level: Vec<wgpu::BindGroup>,
+    /// Levels 2, 3...: each reading the mip below.
+    upper_levels: Vec<wgpu::BindGroup>,
+}
+
+impl TilePyramid {
+    /// The pyramid for maps up to `largest` texels a side, and its level groups; a 1×1 texture that
+    /// no pass reads when the filter does not walk it (`built` false).
+    fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        maps: &[LightDepthMap],
+        read_counts: &ReadCounts,
+        largest: u32,
+        built: bool,
+    ) -> Self {
+        let side = if built { (largest.next_power_of_two() / 2).max(1) } else { 1 };
+        let mips = side.ilog2() + 1;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("pvsm_tile_pyramid"),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            mip_level_count: mips,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+            view_formats: &[],
+        });
+        let mip_view = |mip: u32| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(&format!("pvsm_tile_pyramid_mip{mip}_view")),
+                base_mip_level: mip,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let level_uniform = |level: u32, from_map: bool| {
+            let value = TilePyramidLevelUniform { level, from_map: u32::from(from_map), _pad0: 0, _pad1: 0 };
+            uniform_buffer(device, &format!("pvsm_tile_pyramid_level{level}_uniform"), &value)
+        };
+        let (first_level, upper_levels) = if built {
+            let first_uniform = level_uniform(1, true);
+            let first = maps
+                .iter()
+                .map(|map| {
+                    bind_group(
+                        device,
+                        &format!("pvsm_tile_pyramid_level1_bind_group_{}", map.linear_depth.width()),
+                        layout,
+                        &[
+                            first_uniform.as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&map.linear_depth_view),
+                            wgpu::BindingResource::TextureView(&mip_view(0)),
+                            read_counts.buffer().as_entire_binding(),
+                        ],
+                    )
+                })
+                .collect();
+            let upper = (2..=mips)
+                .map(|level| {
+                    bind_group(
+                        device,
+                        &format!("pvsm_tile_pyramid_level{level}_bind_group"),
+                        layout,
+                        &[
+                            level_uniform(level, false).as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&mip_view(level - 2)),
+                            wgpu::BindingResource::TextureView(&mip_view(level - 1)),
+                            read_counts.buffer().as_entire_binding(),
+                        ],
+                    )
+                })
+                .collect();
+            (first, upper)
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Self { view: ssm_core::passes::labelled_view(&texture, "pvsm_tile_pyramid_all_levels"), first_level, upper_levels }
+    }
 }
 
 /// The pipelines, made once.
@@ -356,14 +512,15 @@ struct Pipelines {
     filter: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
     cull: wgpu::ComputePipeline,
+    tile_pyramid: wgpu::ComputePipeline,
 }
 
 /// The buffers of the screen-space and grid passes.
 struct Buffers {
     kernels: wgpu::Buffer,
     accumulated: wgpu::Buffer,
-    /// Per pixel, a u32: 1 once its filter was decimated in some tile.
-    decimated: wgpu::Buffer,
+    /// Per pixel, a u32: 1 once its filter's walk reached its cap in some tile.
+    capped: wgpu::Buffer,
     grid: wgpu::Buffer,
     /// `COUNTER_*` of `pvsm_common.wgsl`, summed over the lights of the last frame.
     counters: wgpu::Buffer,
@@ -403,6 +560,12 @@ pub struct PredictedVirtualShadowMaps {
     /// Tile maps of sides 64, 128, 256... up to the largest tile: a tile is rendered into the
     /// smallest that holds it, so that clearing a map costs what the tile needs.
     tile_maps: Vec<LightDepthMap>,
+    /// Step 8's min/max pyramid of the current tile's map.
+    tile_pyramid: TilePyramid,
+    /// The passes' counted work, with `count_reads` or the framework's counting frame.
+    read_counts: ReadCounts,
+    /// Whether the shaders count (`count_reads`, or `TechniqueSetup::count_work`).
+    counting: bool,
     atlas_side: u32,
     triangle_count: u32,
     width: u32,
@@ -436,9 +599,14 @@ impl PredictedVirtualShadowMaps {
             Conservative::Auto => gpu.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION),
         };
         let layouts = Layouts::new(device);
-        let low_res = LowResMap::new(device, settings.low_res_size, &layouts.mip);
-        let groups = StepGroups::new(setup, &settings, &layouts, &buffers, &low_res, hardware);
+        let counters: Vec<(&'static str, &'static str)> = READ_COUNTERS.iter().map(|(_, _, pass, unit)| (*pass, *unit)).collect();
+        let counting = settings.count_reads || setup.count_work;
+        let read_counts = ReadCounts::with_units(device, "pvsm_read_counts", &counters, counting);
+        let low_res = LowResMap::new(device, settings.low_res_size, &layouts.mip, &read_counts);
+        let groups = StepGroups::new(setup, &settings, &layouts, &buffers, &low_res, &read_counts, hardware);
         let tile_maps = Self::tile_maps(setup, atlas_side)?;
+        let tile_pyramid =
+            TilePyramid::new(device, &layouts.tile_pyramid_level, &tile_maps, &read_counts, atlas_side, settings.walks_hierarchy());
         let range = tile_maps.first().map_or(0..0, LightDepthMap::index_range);
         let cull_triangles = (range.end - range.start) / 3;
         let cull_settings = CullSettingsUniform { first_index: range.start, triangle_count: cull_triangles, _pad0: 0, _pad1: 0 };
@@ -455,10 +623,10 @@ impl PredictedVirtualShadowMaps {
             ],
         );
         let slots = (0..setup.scene.light_count())
-            .map(|light| Self::tile_slots(gpu, &layouts.tile, &tile_maps, light, settings.max_tiles))
+            .map(|light| Self::tile_slots(gpu, &layouts, &tile_maps, &tile_pyramid, light, settings.max_tiles))
             .collect();
         let resolve_groups = Self::resolve_groups(setup, &layouts.resolve);
-        let pipelines = Pipelines::new(setup, &layouts, &gbuffer.layout, hardware)?;
+        let pipelines = Pipelines::new(setup, &layouts, &gbuffer.layout, &read_counts, hardware)?;
         Ok(Self {
             settings,
             pipelines,
@@ -474,6 +642,9 @@ impl PredictedVirtualShadowMaps {
             resolve_groups,
             common_group: groups.common,
             tile_maps,
+            tile_pyramid,
+            read_counts,
+            counting,
             atlas_side,
             triangle_count: setup.scene.triangle_count,
             width,
@@ -540,7 +711,7 @@ impl PredictedVirtualShadowMaps {
         Buffers {
             kernels: storage_buffer(device, "pvsm_kernel_buffer", pixels * KERNEL_BYTES),
             accumulated: storage_buffer(device, "pvsm_accumulated_buffer", pixels * 8),
-            decimated: storage_buffer(device, "pvsm_decimated_buffer", pixels * 4),
+            capped: storage_buffer(device, "pvsm_capped_buffer", pixels * 4),
             grid: storage_buffer(device, "pvsm_smtg_buffer", cells * 8),
             counters: storage_buffer(device, "pvsm_counters_buffer", COUNTER_BYTES),
             pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * 8),
@@ -567,7 +738,14 @@ impl PredictedVirtualShadowMaps {
     /// The uniforms and bind groups of `max_tiles` tiles of one light. Each light has its own:
     /// the writes of a tile's uniforms land before the next submission, and a light's tiles are
     /// recorded before the next light's readback submits them.
-    fn tile_slots(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, maps: &[LightDepthMap], light: usize, max_tiles: u32) -> Vec<TileSlot> {
+    fn tile_slots(
+        gpu: &GpuContext,
+        layouts: &Layouts,
+        maps: &[LightDepthMap],
+        pyramid: &TilePyramid,
+        light: usize,
+        max_tiles: u32,
+    ) -> Vec<TileSlot> {
         let device = &gpu.device;
         (0..max_tiles)
             .map(|k| {
@@ -584,15 +762,28 @@ impl PredictedVirtualShadowMaps {
                         &[frame.as_entire_binding()],
                     ),
                     bias_group: bind_group(device, &format!("{label}_bias_bind_group"), gpu.uniform_layout(), &[bias.as_entire_binding()]),
+                    pyramid_group: bind_group(
+                        device,
+                        &format!("{label}_pyramid_bind_group"),
+                        &layouts.tile_pyramid_tile,
+                        &[settings.as_entire_binding()],
+                    ),
                     filter_groups: maps
                         .iter()
                         .map(|map| {
-                            bind_group(
-                                device,
-                                &format!("{label}_filter_bind_group_{}", map.linear_depth.width()),
-                                layout,
-                                &[settings.as_entire_binding(), wgpu::BindingResource::TextureView(&map.linear_depth_view)],
-                            )
+                            // Binding 2 of the group is the resolve pass's target (the same module).
+                            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                                label: Some(&format!("{label}_filter_bind_group_{}", map.linear_depth.width())),
+                                layout: &layouts.tile,
+                                entries: &[
+                                    wgpu::BindGroupEntry { binding: 0, resource: settings.as_entire_binding() },
+                                    wgpu::BindGroupEntry {
+                                        binding: 1,
+                                        resource: wgpu::BindingResource::TextureView(&map.linear_depth_view),
+                                    },
+                                    wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&pyramid.view) },
+                                ],
+                            })
                         })
                         .collect(),
                     frame,
@@ -625,6 +816,29 @@ impl PredictedVirtualShadowMaps {
         pass.set_bind_group(0, tile_frame, &[]);
         pass.set_bind_group(1, &self.cull_group, &[]);
         pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+    }
+
+    /// Step 8's min/max pyramid of the tile map of size class `class`, over the tile's `size`
+    /// texels: levels 1 to ceil(log2 of the longer side), each a pass reading the one below.
+    fn build_tile_pyramid(&self, frame: &mut Frame<'_>, slot: &TileSlot, class: usize, size: UVec2) -> Result<()> {
+        let levels = size.max_element().max(2).next_power_of_two().ilog2();
+        for level in 1..=levels {
+            let group =
+                if level == 1 { self.tile_pyramid.first_level.get(class) } else { self.tile_pyramid.upper_levels.get(level as usize - 2) };
+            let Some(group) = group else {
+                return Err(Error::Technique {
+                    technique: NAME.into(),
+                    message: format!("no tile pyramid level {level} for a tile of {size}"),
+                });
+            };
+            let texels = (size + UVec2::splat((1 << level) - 1)) >> level;
+            let mut pass = frame.compute_pass("pvsm_tile_pyramid");
+            pass.set_pipeline(&self.pipelines.tile_pyramid);
+            pass.set_bind_group(0, &slot.pyramid_group, &[]);
+            pass.set_bind_group(1, group, &[]);
+            pass.dispatch_workgroups(texels.x.div_ceil(8), texels.y.div_ceil(8), 1);
+        }
+        Ok(())
     }
 
     /// Steps 5 and 6: the pyramid, its readback, the kd-tree.
@@ -696,6 +910,7 @@ impl StepGroups {
         layouts: &Layouts,
         buffers: &Buffers,
         low_res: &LowResMap,
+        read_counts: &ReadCounts,
         hardware: bool,
     ) -> Self {
         let device = &setup.gpu.device;
@@ -729,6 +944,7 @@ impl StepGroups {
                 buffers.kernels.as_entire_binding(),
                 buffers.grid.as_entire_binding(),
                 buffers.counters.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
             ],
         );
         let pyramid_settings = PyramidSettingsUniform { grid_size: settings.grid_size, _pad0: 0, _pad1: 0, _pad2: 0 };
@@ -740,6 +956,7 @@ impl StepGroups {
                 uniform_buffer(device, "pvsm_pyramid_uniform", &pyramid_settings).as_entire_binding(),
                 buffers.grid.as_entire_binding(),
                 buffers.pyramid.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
             ],
         );
         let common = bind_group(
@@ -751,8 +968,9 @@ impl StepGroups {
                 settings_buffer.as_entire_binding(),
                 buffers.kernels.as_entire_binding(),
                 buffers.accumulated.as_entire_binding(),
-                buffers.decimated.as_entire_binding(),
+                buffers.capped.as_entire_binding(),
                 buffers.counters.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
             ],
         );
         Self { low_res: low_res_group, kernel, pyramid, common }
@@ -769,6 +987,9 @@ struct Layouts {
     tile: wgpu::BindGroupLayout,
     resolve: wgpu::BindGroupLayout,
     cull: wgpu::BindGroupLayout,
+    /// The tile pyramid's passes: the tile's settings, and one level's resources.
+    tile_pyramid_tile: wgpu::BindGroupLayout,
+    tile_pyramid_level: wgpu::BindGroupLayout,
 }
 
 impl Layouts {
@@ -778,7 +999,7 @@ impl Layouts {
             mip: bind_group_layout(
                 device,
                 "pvsm_low_res_mip_layout",
-                &[texture_entry(0), write_storage_texture_entry(1, LightDepthMap::FORMAT)],
+                &[texture_entry(0), write_storage_texture_entry(1, LightDepthMap::FORMAT), ReadCounts::layout_entry(2)],
             ),
             kernel: bind_group_layout(
                 device,
@@ -790,9 +1011,14 @@ impl Layouts {
                     storage_entry(3, false),
                     storage_entry(4, false),
                     storage_entry(5, false),
+                    ReadCounts::layout_entry(6),
                 ],
             ),
-            pyramid: bind_group_layout(device, "pvsm_pyramid_layout", &[uniform_entry(0), storage_entry(1, true), storage_entry(2, false)]),
+            pyramid: bind_group_layout(
+                device,
+                "pvsm_pyramid_layout",
+                &[uniform_entry(0), storage_entry(1, true), storage_entry(2, false), ReadCounts::layout_entry(3)],
+            ),
             common: bind_group_layout(
                 device,
                 "pvsm_filter_common_layout",
@@ -803,9 +1029,21 @@ impl Layouts {
                     storage_entry(3, false),
                     storage_entry(4, false),
                     storage_entry(5, false),
+                    ReadCounts::layout_entry(6),
                 ],
             ),
-            tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1)]),
+            tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1), texture_entry(3)]),
+            tile_pyramid_tile: bind_group_layout(device, "pvsm_tile_pyramid_tile_layout", &[uniform_entry(0)]),
+            tile_pyramid_level: bind_group_layout(
+                device,
+                "pvsm_tile_pyramid_level_layout",
+                &[
+                    uniform_entry(0),
+                    texture_entry(1),
+                    write_storage_texture_entry(2, wgpu::TextureFormat::Rg32Float),
+                    ReadCounts::layout_entry(3),
+                ],
+            ),
             cull: bind_group_layout(
                 device,
                 "pvsm_tile_cull_layout",
@@ -821,8 +1059,16 @@ impl Layouts {
 }
 
 impl Pipelines {
-    fn new(setup: &TechniqueSetup<'_>, layouts: &Layouts, gbuffer_layout: &wgpu::BindGroupLayout, hardware: bool) -> Result<Self> {
+    fn new(
+        setup: &TechniqueSetup<'_>,
+        layouts: &Layouts,
+        gbuffer_layout: &wgpu::BindGroupLayout,
+        read_counts: &ReadCounts,
+        hardware: bool,
+    ) -> Result<Self> {
         let gpu = setup.gpu;
+        // COUNT_READS: the counting code compiled in only with count_reads.
+        let counting = read_counts.pipeline_constants();
         let device = &gpu.device;
         let module = |label: &str, source: &str| create_shader_with_imports(gpu, label, source, LOCAL_SHADERS);
         let conservative = module("pvsm_conservative_shader", CONSERVATIVE_SHADER)?;
@@ -858,25 +1104,26 @@ impl Pipelines {
         let filter_module = module("pvsm_filter_shader", FILTER_SHADER)?;
         let mip_module = module("pvsm_mips_shader", MIPS_SHADER)?;
         let cull_module = module("pvsm_cull_shader", CULL_SHADER)?;
+        let tile_pyramid_module = module("pvsm_tile_pyramid_shader", TILE_PYRAMID_SHADER)?;
         Ok(Self {
             low_res,
-            mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip], &[]),
+            mip: compute_pipeline(device, "pvsm_low_res_mip_pipeline", &mip_module, "pvsm_low_res_mip", &[&layouts.mip], &counting),
             kernel: compute_pipeline(
                 device,
                 "pvsm_kernel_pipeline",
                 &kernel_module,
                 "pvsm_kernel",
                 &[screen[0], screen[1], &layouts.kernel],
-                &[],
+                &counting,
             ),
-            pyramid: compute_pipeline(device, "pvsm_pyramid_pipeline", &pyramid_module, "pvsm_pyramid", &[&layouts.pyramid], &[]),
+            pyramid: compute_pipeline(device, "pvsm_pyramid_pipeline", &pyramid_module, "pvsm_pyramid", &[&layouts.pyramid], &counting),
             filter: compute_pipeline(
                 device,
                 "pvsm_tile_filter_pipeline",
                 &filter_module,
                 "pvsm_tile_filter",
                 &[screen[0], screen[1], &layouts.common, &layouts.tile],
-                &[],
+                &counting,
             ),
             resolve: compute_pipeline(
                 device,
@@ -894,6 +1141,14 @@ impl Pipelines {
                 &[gpu.uniform_layout(), &layouts.cull],
                 &[],
             ),
+            tile_pyramid: compute_pipeline(
+                device,
+                "pvsm_tile_pyramid_pipeline",
+                &tile_pyramid_module,
+                "pvsm_tile_pyramid",
+                &[&layouts.tile_pyramid_tile, &layouts.tile_pyramid_level],
+                &counting,
+            ),
         })
     }
 }
@@ -908,8 +1163,9 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             frame.clear_buffer("pvsm_clear_counters", &self.buffers.counters, 0, None);
             self.last.readback_wait_ms = 0.0;
         }
+        self.read_counts.clear(frame, light);
         frame.clear_buffer("pvsm_clear_accumulated", &self.buffers.accumulated, 0, None);
-        frame.clear_buffer("pvsm_clear_decimated", &self.buffers.decimated, 0, None);
+        frame.clear_buffer("pvsm_clear_capped", &self.buffers.capped, 0, None);
         // Step 2: the conservative low-resolution map.
         {
             let light_group = &frame.scene.light_bind_groups[light];
@@ -969,6 +1225,9 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             } else {
                 map.encode_region(frame, &slot.frame_group, &slot.bias_group, region, "pvsm_tile_map");
             }
+            if self.settings.walks_hierarchy() {
+                self.build_tile_pyramid(frame, slot, class, tile.size)?;
+            }
             self.dispatch(frame, "pvsm_tile_filter", &self.pipelines.filter, &[&self.common_group, filter_group], light);
         }
         self.dispatch(frame, "pvsm_resolve", &self.pipelines.resolve, &[&self.common_group, &resolve_group], light);
@@ -979,15 +1238,17 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         Ok(())
     }
 
-    /// Tiles, their resolutions and texels, the finest tile's resolution, the cap; over the frame's
-    /// lights, the pixels filtered, the share skipped as fully lit, the pixels whose filter was
-    /// decimated and those no tile covered, and the mid-frame readbacks' wait for the GPU.
+    /// Tiles, their resolutions and the texels rendered into them, the finest tile's resolution,
+    /// the cap; over the frame's lights, the pixels filtered, the share skipped as fully lit, the
+    /// pixels whose filter's walk reached its cap and those no tile covered, and the mid-frame
+    /// readbacks' wait for the GPU; with `count_reads`, each pass's counted work per pixel and the
+    /// texels the filter read (`pvsm_texels_filtered`).
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
         let tiles: Vec<&Tile> = self.last.tilings.iter().flat_map(|t| &t.tiles).collect();
         let texels: f64 = tiles.iter().map(|t| f64::from(t.size.x) * f64::from(t.size.y)).sum();
         let mut out = vec![
             ("pvsm_tiles".to_owned(), tiles.len() as f64),
-            ("pvsm_texels".to_owned(), texels),
+            ("pvsm_texels_rendered".to_owned(), texels),
             ("pvsm_largest_tile".to_owned(), tiles.iter().map(|t| f64::from(t.size.max_element())).fold(0.0, f64::max)),
             ("pvsm_tile_cap_reached".to_owned(), f64::from(u8::from(self.last.tilings.iter().any(|t| t.cap_reached)))),
             ("pvsm_clamped_tiles".to_owned(), tiles.iter().filter(|t| t.clamped).count() as f64),
@@ -998,13 +1259,13 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         }
         if let Ok(bytes) = ssm_core::readback::read_buffer(gpu, &self.buffers.counters, COUNTER_BYTES, "PVSM counters") {
             let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-            if let [filtered, lit, decimated, uncovered] = counts[..] {
+            if let [filtered, lit, capped, uncovered] = counts[..] {
                 let total = f64::from(filtered) + f64::from(lit);
                 if total > 0.0 {
                     out.push(("pvsm_lit_skipped".to_owned(), f64::from(lit) / total));
                 }
                 out.push(("pvsm_filtered_pixels".to_owned(), f64::from(filtered)));
-                out.push(("pvsm_decimated_pixels".to_owned(), f64::from(decimated)));
+                out.push(("pvsm_capped_pixels".to_owned(), f64::from(capped)));
                 out.push(("pvsm_uncovered_pixels".to_owned(), f64::from(uncovered)));
             }
         }
@@ -1022,7 +1283,33 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
                 out.push(("pvsm_last_tile_triangle_share".to_owned(), f64::from(*indices) / 3.0 / f64::from(self.cull_triangles)));
             }
         }
+        let counted = self.read_counts.diagnostics(gpu);
+        // The filter's reads over the frame: its reads per evaluation times its evaluations (a
+        // pixel's filter is evaluated once per tile it reaches); 0 when no pixel was filtered.
+        let per_evaluation = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_reads_per_pixel").map(|(_, v)| *v);
+        let evaluations = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_pixels").map(|(_, v)| *v);
+        if self.counting {
+            out.push(("pvsm_texels_filtered".to_owned(), (per_evaluation.unwrap_or(0.0) * evaluations.unwrap_or(0.0)).round()));
+        }
+        out.extend(counted);
         out
+    }
+
+    /// The shaders' counts (`READ_COUNTERS`), and the tile maps' texels: step 7 renders
+    /// `pvsm_texels_rendered` texels, each one 4-byte linear depth written (the paper's measure of
+    /// the tiles' cost, Fig. 10), counted from the tiles' sizes as `pvsm_tile_map`'s storage bytes.
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
+        let Some(mut work) = self.read_counts.work(gpu)? else {
+            return Ok(None);
+        };
+        let texels: u64 = self.last.tilings.iter().flat_map(|t| &t.tiles).map(|t| u64::from(t.size.x) * u64::from(t.size.y)).sum();
+        work.push(ssm_core::ShaderWork {
+            pass: "pvsm_tile_map".to_owned(),
+            invocations: texels,
+            storage_bytes: 4 * texels,
+            ..ssm_core::ShaderWork::default()
+        });
+        Ok(Some(work))
     }
 
     /// `tiles`: each pixel shaded by the tile its filter's centre falls in (Fig. 10's inset), of the
@@ -1102,7 +1389,7 @@ fn requirements(params: &ParamValues) -> Result<Requirements> {
 const PRESETS: &[Preset] = &[
     Preset {
         name: "pvsm-fig10",
-        summary: "Shen et al., Fig. 10: tiles, texels and frame time as the light grows from nearly a point (softer shadows need fewer tiles and render faster); plot with --error time, or read pvsm_tiles and pvsm_texels in sweep.csv",
+        summary: "Shen et al., Fig. 10: tiles, texels and frame time as the light grows from nearly a point (softer shadows need fewer tiles and render faster); plot with --error time, or read pvsm_tiles, pvsm_texels_rendered and (with pvsm.count_reads=true) pvsm_texels_filtered in sweep.csv",
         scenes: &["leaves"],
         varies: &["scene.light_scale=0.02,0.1,0.25,0.5,1,2", "pvsm.prediction=dynamic"],
         x_axis: "scene.light_scale",
@@ -1173,6 +1460,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         UniformCheck { wgsl_struct: "PyramidSettings", wgsl_source: PYRAMID_SHADER, imports: &[], rust: PyramidSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_SHADER, imports: LOCAL_SHADERS, rust: TileSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "CullSettings", wgsl_source: CULL_SHADER, imports: &[], rust: CullSettingsUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "PyramidLevel", wgsl_source: TILE_PYRAMID_SHADER, imports: &[], rust: TilePyramidLevelUniform::LAYOUT },
+        UniformCheck { wgsl_struct: "TileSettings", wgsl_source: TILE_PYRAMID_SHADER, imports: &[], rust: TileSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "Kernel", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: KernelRecord::LAYOUT },
     ],
     limits: &[],
@@ -1187,6 +1476,15 @@ mod tests {
     fn the_shaders_smallest_tile_is_the_kd_trees() {
         let line = format!("const MIN_TILE_SIZE: f32 = {}.0;", super::kdtree::MIN_TILE_SIZE);
         assert!(super::KERNEL_SHADER.contains(&line), "pvsm_kernel.wgsl lacks `{line}`");
+    }
+
+    /// Each shader indexes its ReadCounts counters as `READ_COUNTERS` orders them.
+    #[test]
+    fn the_read_counters_are_numbered_as_the_shaders_number_them() {
+        for (index, (name, shader, _, _)) in super::READ_COUNTERS.iter().enumerate() {
+            let line = format!("const {name}: u32 = {index}u;");
+            assert!(shader.contains(&line), "the shader counting {name} lacks `{line}`");
+        }
     }
 
     /// The diagnostics read the counters in the order the WGSL numbers them.

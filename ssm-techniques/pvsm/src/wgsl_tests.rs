@@ -1,23 +1,26 @@
 //! The paper's formulas as the shaders compute them. A few test entry points, appended to the filter
 //! pass's own module (`pvsm_filter.wgsl` with `pvsm_common.wgsl`), evaluate its WGSL functions on
 //! the GPU for given inputs; the tests compare them with values worked out by hand from the paper
-//! (the appendix's convolution, Eqs. 4 and 5, Eq. 2's texels as quads) and with the CPU twins in
-//! [`crate::prediction`] (ρ).
+//! (the appendix's convolution, Eqs. 4 and 5, Eq. 2's texels as quads), with the CPU twins in
+//! [`crate::prediction`] (ρ), and the hierarchical walk of Eq. 2 (over the min/max pyramid that the
+//! real `pvsm_tile_pyramid.wgsl` builds) with the per-texel sum.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use ssm_core::passes::{bind_group_layout, storage_entry, texture_entry, uniform_entry};
+use ssm_core::passes::{bind_group_layout, storage_entry, texture_entry, uniform_entry, write_storage_texture_entry};
 use ssm_core::{GpuContext, LightFrameUniform, Settings};
 
 use crate::prediction::{self, DYNAMIC_PEAK, Prediction};
-use crate::{FILTER_SHADER, LOCAL_SHADERS, PvsmSettings, PvsmSettingsUniform, TileSettingsUniform};
+use crate::{
+    FILTER_SHADER, LOCAL_SHADERS, PvsmSettings, PvsmSettingsUniform, TILE_PYRAMID_SHADER, TilePyramidLevelUniform, TileSettingsUniform,
+};
 
-/// The test entry points. Inputs and outputs are `vec4<f32>`s; group 3's bindings 3 and 4 are free in
-/// the filter module (0 and 1 hold the tile, 2 the resolve pass's target).
+/// The test entry points. Inputs and outputs are `vec4<f32>`s; group 3's bindings 5 and 6 are free in
+/// the filter module (0, 1 and 3 hold the tile, its map and its pyramid, 2 the resolve pass's target).
 const TEST_ENTRY_POINTS: &str = r"
-@group(3) @binding(3) var<storage, read> test_in: array<vec4<f32>>;
-@group(3) @binding(4) var<storage, read_write> test_out: array<vec4<f32>>;
+@group(3) @binding(5) var<storage, read> test_in: array<vec4<f32>>;
+@group(3) @binding(6) var<storage, read_write> test_out: array<vec4<f32>>;
 
 // (model, n, x, -) -> (texels_needed(model, n), rho_dynamic(x), rho_static(x), 0)
 @compute @workgroup_size(1)
@@ -43,23 +46,29 @@ fn test_predicted(@builtin(global_invocation_id) id: vec3<u32>) {
     test_out[id.x] = predicted_texels(u32(a.x), a.yzw, b.xy, c.xy, c.zw, b.zw);
 }
 
-// (centre, u), (v_height, depth, -, -) -> (visible, covered, decimated, 0) over the bound tile
+// (centre, u), (v_height, depth, -, -), (position, -), (normal, -) -> (visible, covered, capped,
+// texels read) over the bound tile
 @compute @workgroup_size(1)
 fn test_integrate(@builtin(global_invocation_id) id: vec3<u32>) {
-    let a = test_in[2u * id.x];
-    let b = test_in[2u * id.x + 1u];
-    let sums = integrate(a.xy, a.zw, b.x, b.y, vec3<f32>(0.0), vec3<f32>(0.0, 1.0, 0.0), vec2<f32>(0.0));
-    test_out[id.x] = vec4<f32>(sums, 0.0);
+    let a = test_in[4u * id.x];
+    let b = test_in[4u * id.x + 1u];
+    let position = test_in[4u * id.x + 2u].xyz;
+    let normal = test_in[4u * id.x + 3u].xyz;
+    let sums = integrate(a.xy, a.zw, b.x, b.y, position, normal, vec2<f32>(0.0));
+    test_out[id.x] = vec4<f32>(sums.visible, sums.covered, select(0.0, 1.0, sums.capped), f32(sums.reads));
 }
 ";
 
-/// A tile map and the settings [`evaluate`] binds for `integrate` (the other entry points ignore them).
+/// A tile map, its region and the settings [`evaluate`] binds for `integrate` (the other entry points
+/// ignore them).
 struct Tile {
     settings: PvsmSettingsUniform,
     uniform: TileSettingsUniform,
-    /// The map's side and its depths, row-major.
+    /// The map's side (a power of two) and its depths, row-major.
     side: u32,
     depths: Vec<f32>,
+    /// The light frame the tangent plane is taken in (zero: receiver_plane off).
+    frame: LightFrameUniform,
 }
 
 impl Tile {
@@ -71,15 +80,90 @@ impl Tile {
     /// A tile of `side`² texels covering the whole frame, with `depths`, under `settings` on top of
     /// the defaults, compared with the receiver's own depth (no tangent plane: no frame needed).
     fn new(side: u32, depths: Vec<f32>, settings: &[(&str, &str)]) -> Self {
-        let assignments = [("receiver_plane", "false")].into_iter().chain(settings.iter().copied());
-        let params = crate::INFO.params_from(assignments).unwrap();
-        let settings = PvsmSettingsUniform::from(&PvsmSettings::from_params(&params).unwrap());
         let uniform = TileSettingsUniform { uv_min: [0.0; 2], uv_max: [1.0; 2], size: [side as f32; 2], _pad0: 0.0, _pad1: 0.0 };
-        Self { settings, uniform, side, depths }
+        Self { settings: Self::settings(false, settings), uniform, side, depths, frame: bytemuck::Zeroable::zeroed() }
+    }
+
+    fn settings(receiver_plane: bool, settings: &[(&str, &str)]) -> PvsmSettingsUniform {
+        let plane = if receiver_plane { "true" } else { "false" };
+        let assignments = [("receiver_plane", plane)].into_iter().chain(settings.iter().copied());
+        let params = crate::INFO.params_from(assignments).unwrap();
+        PvsmSettingsUniform::from(&PvsmSettings::from_params(&params).unwrap())
+    }
+
+    /// The same tile with a region of `size` texels (the top-left of the map) spanning `uv_min` to
+    /// `uv_max` of the light frame, compared with the receiver's tangent plane in `frame`, under
+    /// `settings`.
+    fn region(mut self, size: [f32; 2], uv: [[f32; 2]; 2], frame: LightFrameUniform, settings: &[(&str, &str)]) -> Self {
+        self.uniform.size = size;
+        self.uniform.uv_min = uv[0];
+        self.uniform.uv_max = uv[1];
+        self.frame = frame;
+        self.settings = Self::settings(true, settings);
+        self
     }
 }
 
-/// Runs test entry point `entry` once per output on `inputs`, with `tile` bound.
+/// Builds `tile`'s min/max pyramid with `pvsm_tile_pyramid.wgsl`, as the technique does before each
+/// tile's filter: levels 1 to ceil(log2 of the region's longer side).
+fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid: &wgpu::Texture) {
+    let device = &gpu.device;
+    let module = ssm_core::shader::create_shader_with_imports(gpu, "pvsm_test_pyramid_module", TILE_PYRAMID_SHADER, LOCAL_SHADERS).unwrap();
+    let tile_layout = bind_group_layout(device, "pvsm_test_pyramid_tile_layout", &[uniform_entry(0)]);
+    let level_layout = bind_group_layout(
+        device,
+        "pvsm_test_pyramid_level_layout",
+        &[
+            uniform_entry(0),
+            texture_entry(1),
+            write_storage_texture_entry(2, wgpu::TextureFormat::Rg32Float),
+            ssm_core::read_counts::ReadCounts::layout_entry(3),
+        ],
+    );
+    let pipeline =
+        ssm_core::passes::compute_pipeline(device, "pvsm_test_pyramid", &module, "pvsm_tile_pyramid", &[&tile_layout, &level_layout], &[]);
+    let counts = ssm_core::read_counts::ReadCounts::new(device, "pvsm_test_pyramid_counts", &["pyramid"], false);
+    let tile_uniform = ssm_core::passes::uniform_buffer(device, "pvsm_test_pyramid_tile", &tile.uniform);
+    let tile_group =
+        ssm_core::passes::bind_group(device, "pvsm_test_pyramid_tile_group", &tile_layout, &[tile_uniform.as_entire_binding()]);
+    let mip = |level: u32| {
+        pyramid.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("pvsm_test_pyramid_mip"),
+            base_mip_level: level,
+            mip_level_count: Some(1),
+            ..Default::default()
+        })
+    };
+    let longer = tile.uniform.size[0].max(tile.uniform.size[1]) as u32;
+    let levels = longer.max(2).next_power_of_two().ilog2();
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pvsm_test_pyramid_encoder") });
+    for level in 1..=levels {
+        let value = TilePyramidLevelUniform { level, from_map: u32::from(level == 1), _pad0: 0, _pad1: 0 };
+        let uniform = ssm_core::passes::uniform_buffer(device, "pvsm_test_pyramid_level", &value);
+        let finer = if level == 1 { map.clone() } else { mip(level - 2) };
+        let group = ssm_core::passes::bind_group(
+            device,
+            "pvsm_test_pyramid_level_group",
+            &level_layout,
+            &[
+                uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&finer),
+                wgpu::BindingResource::TextureView(&mip(level - 1)),
+                counts.buffer().as_entire_binding(),
+            ],
+        );
+        let texels = (longer + (1 << level) - 1) >> level;
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pvsm_test_pyramid_pass"), timestamp_writes: None });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &tile_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.dispatch_workgroups(texels.div_ceil(8), texels.div_ceil(8), 1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+}
+
+/// Runs test entry point `entry` once per output on `inputs`, with `tile` bound (its pyramid built).
 fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, tile: &Tile) -> Vec<[f32; 4]> {
     let device = &gpu.device;
     let source = format!("{FILTER_SHADER}\n{TEST_ENTRY_POINTS}");
@@ -90,7 +174,7 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
     let tile_layout = bind_group_layout(
         device,
         "pvsm_test_tile_layout",
-        &[uniform_entry(0), texture_entry(1), storage_entry(3, true), storage_entry(4, false)],
+        &[uniform_entry(0), texture_entry(1), texture_entry(3), storage_entry(5, true), storage_entry(6, false)],
     );
     let pipeline = ssm_core::passes::compute_pipeline(
         device,
@@ -103,9 +187,7 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
     let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
         wgpu::util::DeviceExt::create_buffer_init(device, &wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
     };
-    // The frame is read only through the tangent plane, which these tests turn off.
-    let frame =
-        init("pvsm_test_frame", bytemuck::bytes_of(&<LightFrameUniform as bytemuck::Zeroable>::zeroed()), wgpu::BufferUsages::UNIFORM);
+    let frame = init("pvsm_test_frame", bytemuck::bytes_of(&tile.frame), wgpu::BufferUsages::UNIFORM);
     let settings = init("pvsm_test_settings", bytemuck::bytes_of(&tile.settings), wgpu::BufferUsages::UNIFORM);
     let tile_uniform = init("pvsm_test_tile", bytemuck::bytes_of(&tile.uniform), wgpu::BufferUsages::UNIFORM);
     let input = init("pvsm_test_inputs", bytemuck::cast_slice(inputs), wgpu::BufferUsages::STORAGE);
@@ -127,6 +209,22 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
         bytemuck::cast_slice(&tile.depths),
     );
     let view = ssm_core::passes::labelled_view(&texture, "pvsm_test_tile_map_view");
+    // The pyramid as the technique sizes it: half the map's side, one mip per level.
+    let pyramid_side = (tile.side / 2).max(1);
+    let pyramid = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("pvsm_test_tile_pyramid"),
+        size: wgpu::Extent3d { width: pyramid_side, height: pyramid_side, depth_or_array_layers: 1 },
+        mip_level_count: pyramid_side.ilog2() + 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rg32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+        view_formats: &[],
+    });
+    if tile.side > 1 {
+        build_pyramid(gpu, tile, &view, &pyramid);
+    }
+    let pyramid_view = ssm_core::passes::labelled_view(&pyramid, "pvsm_test_tile_pyramid");
     let group = |label: &str, layout: &wgpu::BindGroupLayout, entries: &[(u32, wgpu::BindingResource<'_>)]| {
         let entries: Vec<wgpu::BindGroupEntry<'_>> =
             entries.iter().map(|(binding, resource)| wgpu::BindGroupEntry { binding: *binding, resource: resource.clone() }).collect();
@@ -142,8 +240,9 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
             &[
                 (0, tile_uniform.as_entire_binding()),
                 (1, wgpu::BindingResource::TextureView(&view)),
-                (3, input.as_entire_binding()),
-                (4, output.as_entire_binding()),
+                (3, wgpu::BindingResource::TextureView(&pyramid_view)),
+                (5, input.as_entire_binding()),
+                (6, output.as_entire_binding()),
             ],
         ),
     ];
@@ -284,9 +383,17 @@ fn step_edge(settings: &[(&str, &str)]) -> Tile {
 /// half-width in texels along x, three texels tall, on the tile's middle row.
 fn box_visibility(gpu: &GpuContext, tile: &Tile, boxes: &[(f32, f32)]) -> Vec<[f32; 4]> {
     let texel = 1.0 / 8.0;
-    let inputs: Vec<[f32; 4]> =
-        boxes.iter().flat_map(|(centre, half)| [[centre * texel, 4.0 * texel, half * texel, 0.0], [1.5 * texel, 1.0, 0.0, 0.0]]).collect();
+    let inputs: Vec<[f32; 4]> = boxes
+        .iter()
+        .flat_map(|(centre, half)| filter_input(*centre * texel, 4.0 * texel, [*half * texel, 0.0], 1.5 * texel, 1.0))
+        .collect();
     evaluate(gpu, "test_integrate", &inputs, boxes.len(), tile)
+}
+
+/// `test_integrate`'s input for a filter of half-axis `u` and half-height `v_height` centred on
+/// (x, y), shadow-map coordinates, for a receiver at `depth` compared with its own depth.
+fn filter_input(x: f32, y: f32, u: [f32; 2], v_height: f32, depth: f32) -> [[f32; 4]; 4] {
+    [[x, y, u[0], u[1]], [v_height, depth, 0.0, 0.0], [0.0; 4], [0.0, 1.0, 0.0, 0.0]]
 }
 
 /// Eq. 2, texels as quads: a texel's weight is the area of its intersection with the filter. Over
@@ -300,7 +407,7 @@ fn a_half_covered_texel_counts_half() {
     for (got, (visibility, covered)) in out.iter().zip([(0.5f32, 3.0f32), (0.75, 6.0)]) {
         assert!(close(got[0] / got[1], visibility, F32_TOLERANCE), "{got:?}: V {} against {visibility}", got[0] / got[1]);
         assert!(close(got[1], covered / 64.0, F32_TOLERANCE), "{got:?}: covered {} against {}", got[1], covered / 64.0);
-        assert_eq!(got[2], 0.0, "a filter this small is not decimated");
+        assert_eq!(got[2], 0.0, "a filter this small is not capped");
     }
 }
 
@@ -336,27 +443,207 @@ fn a_filter_of_zero_size_reads_the_texel_under_the_point() {
     assert_eq!(visibility, [0.0, 1.0, 0.0, 1.0], "{out:?}");
 }
 
-/// A filter spanning more than MAX_TEXELS_PER_AXIS texels is read at every k-th texel, each sample
-/// standing for a k×k block, and says so. A box 200 texels wide over a step edge at 128 is read in
-/// blocks of k = ceil(200 / 96) = 3 from column 27; the block [126, 129) reads texel 127, occluding,
-/// so 101 of the 200 columns count as occluded: V = 99 / 200. A box 80 texels wide reads every
-/// texel: V = 1/2.
-#[test]
-fn a_filter_wider_than_96_texels_is_decimated_and_reported() {
-    let gpu = ssm_testing::gpu();
-    // 256 texels, the left half occluding: a box 200 texels wide centred on the edge.
-    let depths = (0..256 * 256).map(|i| if i % 256 < 128 { 0.5 } else { ssm_core::NO_SURFACE }).collect();
-    let tile = Tile::new(256, depths, &[]);
-    let texel = 1.0 / 256.0;
-    let inputs = [
-        [128.0 * texel, 128.0 * texel, 100.0 * texel, 0.0],
-        [1.5 * texel, 1.0, 0.0, 0.0],
-        [128.0 * texel, 128.0 * texel, 40.0 * texel, 0.0],
-        [1.5 * texel, 1.0, 0.0, 0.0],
-    ];
-    let out = evaluate(&gpu, "test_integrate", &inputs, 2, &tile);
-    assert_eq!((out[0][2], out[1][2]), (1.0, 0.0), "200 texels wide: decimated; 80: not ({out:?})");
-    for (sums, visibility) in out.iter().zip([99.0 / 200.0, 0.5]) {
-        assert!(close(sums[0] / sums[1], visibility, F32_TOLERANCE), "{sums:?}: V against {visibility}");
+/// A small deterministic generator (xorshift32) for the random cases: uniform in [0, 1).
+struct Random(u32);
+
+impl Random {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
     }
+
+    fn range(&mut self, low: f32, high: f32) -> f32 {
+        low + (high - low) * self.next()
+    }
+}
+
+/// A 64² map of depths with every kind of block: a far background with no surface, rectangles of
+/// constant depth in front of every receiver (0.6), behind every receiver (3) and between (1 to 2),
+/// a ramp crossing the receivers' depths, and a patch of per-texel noise (mixed at every level).
+fn mixed_depths(random: &mut Random) -> Vec<f32> {
+    let side = 64usize;
+    let mut depths = vec![ssm_core::NO_SURFACE; side * side];
+    for index in 0..14 {
+        let depth = match index % 3 {
+            0 => 0.6,
+            1 => 3.0,
+            _ => random.range(1.0, 2.0),
+        };
+        let (x, y) = ((random.next() * 56.0) as usize, (random.next() * 56.0) as usize);
+        let (w, h) = (1 + (random.next() * 24.0) as usize, 1 + (random.next() * 24.0) as usize);
+        for row in y..(y + h).min(side) {
+            for column in x..(x + w).min(side) {
+                depths[row * side + column] = depth;
+            }
+        }
+    }
+    for row in 40..64 {
+        for column in 0..20 {
+            depths[row * side + column] = 1.0 + column as f32 / 20.0;
+        }
+    }
+    for row in 4..20 {
+        for column in 44..60 {
+            depths[row * side + column] = random.range(0.5, 2.5);
+        }
+    }
+    depths
+}
+
+/// A light frame looking down -y from the origin with 45° half-angles (tan = 1), as `tap_plane`
+/// reads it: a point at shadow-map coordinates (u, v) and depth d is d (2u − 1, −1, 2v − 1).
+fn test_frame() -> LightFrameUniform {
+    let mut frame: LightFrameUniform = bytemuck::Zeroable::zeroed();
+    frame.centre = [0.0, 0.0, 0.0, 1.0];
+    frame.u_axis = [1.0, 0.0, 0.0, 0.5];
+    frame.v_axis = [0.0, 0.0, 1.0, 0.5];
+    frame.normal = [0.0, -1.0, 0.0, 1.0];
+    frame.projection = [1.0, 1.0, 0.01, 10.0];
+    frame
+}
+
+/// Random filters over [`mixed_depths`], for receivers compared with their tangent planes: centres
+/// from a tenth of the region outside it to a tenth past it (filters straddling the tile's edges),
+/// half-widths from nothing (the texel under the point) to 40 texels, sheared as antialiasing makes
+/// them, receivers at depths 1 to 2 tilted up to about 60° from the light (some nearly edge-on, where
+/// the plane's depth is unbounded over a block).
+fn random_filters(random: &mut Random, count: usize, texel: [f32; 2]) -> Vec<[f32; 4]> {
+    let mut inputs = Vec::new();
+    for index in 0..count {
+        let (u, v) = (random.range(-0.1, 1.1), random.range(-0.1, 1.1));
+        let depth = random.range(1.0, 2.0);
+        let half = if index % 7 == 0 { 0.0 } else { random.range(0.0, 40.0) };
+        let shear = if index % 2 == 0 { 0.0 } else { random.range(-0.5, 0.5) * half };
+        let height = if index % 7 == 0 { 0.0 } else { random.range(0.0, 40.0) };
+        let tilt = if index % 11 == 0 { 1.55 } else { random.range(0.0, 1.0) };
+        let turn = random.range(0.0, std::f32::consts::TAU);
+        let normal = [tilt.sin() * turn.cos(), tilt.cos(), tilt.sin() * turn.sin()];
+        let position = [depth * (2.0 * u - 1.0), -depth, depth * (2.0 * v - 1.0)];
+        inputs.extend([
+            [u, v, half * texel[0], shear * texel[1]],
+            [height * texel[1], depth, 0.0, 0.0],
+            [position[0], position[1], position[2], 0.0],
+            [normal[0], normal[1], normal[2], 0.0],
+        ]);
+    }
+    inputs
+}
+
+/// The hierarchical walk sums what the per-texel walk sums. Both weigh each texel by the same
+/// covered area and test it the same way (a block is decided at once only when bounds that hold for
+/// every texel's f32 test put all of them on one side); they differ only in the order of the sums
+/// and in adding a block's area in closed form. Each walk's sums add N terms of at most one texel's
+/// area (N: the texels under the filter, which the per-texel walk reads), so in f32 each is within
+/// (N − 1) u Σ c of the exact sum (Higham's bound for recursive summation, u = 2⁻²⁴), and a closed-form
+/// block area errs by a few u of itself: the two walks agree within 2 (N + 10) u Σ c; and a sheared
+/// filter's column centres, a + b i here and c.y + (x − c.x) b there, are off by a few u of the texel
+/// coordinates' magnitude M (under 128) times 1 + |b|, which moves each of at most N columns' clipped
+/// heights by twice that: 12 u M (1 + |b|) N more (none with b = 0, where both compute c.y
+/// exactly). 300 random
+/// filters on two regions: the whole 64² map, and a 50 × 37 region (anisotropic texels, a pyramid
+/// whose blocks run past the region's edges) of a smaller rectangle of the frame. The hierarchy
+/// reads fewer texels overall.
+#[test]
+fn the_hierarchy_sums_what_every_texel_sums() {
+    let gpu = ssm_testing::gpu();
+    let mut random = Random(0x9e37_79b9);
+    let depths = mixed_depths(&mut random);
+    let regions = [([64.0f32, 64.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([50.0, 37.0], [[0.2, 0.3], [0.7, 0.8]])];
+    let (mut hierarchy_reads, mut texel_reads) = (0.0, 0.0);
+    for (size, uv) in regions {
+        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
+        let mut inputs = random_filters(&mut random, 300, texel);
+        // The random centres spread over the region's rectangle of the frame.
+        for case in inputs.chunks_mut(4) {
+            case[0][0] = uv[0][0] + case[0][0] * (uv[1][0] - uv[0][0]);
+            case[0][1] = uv[0][1] + case[0][1] * (uv[1][1] - uv[0][1]);
+            let depth = case[1][1];
+            case[2] = [depth * (2.0 * case[0][0] - 1.0), -depth, depth * (2.0 * case[0][1] - 1.0), 0.0];
+        }
+        let tile = |walk: &str| Tile::new(64, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
+        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
+        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
+        let mut decided = [0usize; 3];
+        for (index, (h, t)) in walked.iter().zip(&every).enumerate() {
+            let texels = t[3];
+            let u = f32::EPSILON / 2.0;
+            let (half, shear) = (inputs[4 * index][2] / texel[0], inputs[4 * index][3] / texel[1]);
+            let slope = shear.abs() / half.abs().max(1e-3);
+            let texel_area = texel[0] * texel[1];
+            let sheared = if shear == 0.0 { 0.0 } else { 12.0 * u * 128.0 * (1.0 + slope) * texels * texel_area };
+            let tolerance = 2.0 * (texels + 10.0) * u * t[1].max(h[1]) + sheared;
+            assert!(
+                (h[0] - t[0]).abs() <= tolerance && (h[1] - t[1]).abs() <= tolerance,
+                "region {size:?}, filter {index} ({:?}): hierarchy (Σ c·o, Σ c) = ({}, {}), every texel ({}, {}); {texels} texels, tolerance {tolerance}",
+                &inputs[4 * index..4 * index + 4],
+                h[0],
+                h[1],
+                t[0],
+                t[1],
+            );
+            assert_eq!((h[2], t[2]), (0.0, 0.0), "no walk this small reaches the cap");
+            hierarchy_reads += h[3];
+            texel_reads += texels;
+            if t[1] > 0.0 {
+                decided[usize::from(t[0] > 0.0) + usize::from(t[0] >= t[1])] += 1;
+            }
+        }
+        println!("region {size:?}: {} filters in umbra, {} in penumbra, {} lit", decided[0], decided[1], decided[2]);
+        assert!(decided.iter().all(|count| *count >= 3), "every kind of filter is exercised: {decided:?}");
+    }
+    println!("texels read: hierarchy {hierarchy_reads}, every texel {texel_reads}");
+    assert!(hierarchy_reads < texel_reads, "{hierarchy_reads} against {texel_reads}");
+}
+
+/// The hierarchy's cost follows the penumbra's boundary, by hand. A 64² tile, a filter covering
+/// texels [2, 62)² (start level 5: the four 32² blocks): with every texel occluding, each of the four
+/// blocks is decided at once (4 reads, V = 0). With an edge between columns 32 and 33 (texels x ≤ 32
+/// occluding), the blocks holding both columns are mixed at every level l (one column of blocks, at
+/// most ceil(62 / 2^l) + 1 of them), and each mixed block reads its four children: at most
+/// 4 + 4 Σ_{l=1..5} (ceil(62 / 2^l) + 1) = 4 + 4 (32 + 17 + 9 + 5 + 3) = 268 reads against the 3,600
+/// texels under the filter; V = 29 / 60 exactly (columns 33 to 61 lit).
+#[test]
+fn a_decided_block_costs_one_read_and_an_edge_its_boundary() {
+    let gpu = ssm_testing::gpu();
+    let texel = 1.0 / 64.0;
+    let input = filter_input(32.0 * texel, 32.0 * texel, [30.0 * texel, 0.0], 30.0 * texel, 1.0);
+    let occluding = Tile::new(64, vec![0.5; 64 * 64], &[]);
+    let edge = Tile::new(64, (0..64 * 64).map(|i| if i % 64 <= 32 { 0.5 } else { ssm_core::NO_SURFACE }).collect(), &[]);
+    let uniform = evaluate(&gpu, "test_integrate", &input, 1, &occluding)[0];
+    let stepped = evaluate(&gpu, "test_integrate", &input, 1, &edge)[0];
+    println!("uniform: {} reads; edge: {} reads, V = {}", uniform[3], stepped[3], stepped[0] / stepped[1]);
+    assert_eq!((uniform[0], uniform[3]), (0.0, 4.0), "{uniform:?}");
+    assert!(stepped[3] <= 268.0, "{stepped:?}");
+    assert!(close(stepped[0] / stepped[1], 29.0 / 60.0, F32_TOLERANCE), "{stepped:?}: V against {}", 29.0 / 60.0);
+}
+
+/// The walks are bounded whatever the map: past MAX_WALK_STEPS = 32,768 loop iterations a walk stops
+/// and says so (pvsm_capped_pixels). On a 512² checkerboard of occluding and empty texels (every
+/// block mixed down to the texels), a filter 400 texels square (160,000 texels): the per-texel walk
+/// reads 400 of every 401 steps (one per column), so 32,768 × 400 / 401 − 400 to 32,768 texels; the
+/// hierarchy stops descending after 32,768 steps (blocks and climbs to a parent) and counts the
+/// blocks left, at most three siblings per level (under 256 more steps). The same filter over a
+/// uniform map: 4 reads, not capped. (llvmpipe leaves a loop silently
+/// after 65,535 iterations: a cap above that was never reached there, and the walk ended unflagged.)
+#[test]
+fn a_walk_past_its_cap_stops_and_says_so() {
+    let gpu = ssm_testing::gpu();
+    let side = 512usize;
+    let checkerboard: Vec<f32> =
+        (0..side * side).map(|i| if (i % side + i / side).is_multiple_of(2) { 0.5 } else { ssm_core::NO_SURFACE }).collect();
+    let texel = 1.0 / side as f32;
+    let input = filter_input(256.0 * texel, 256.0 * texel, [200.0 * texel, 0.0], 200.0 * texel, 1.0);
+    let run = |depths: &[f32], walk: &str| {
+        evaluate(&gpu, "test_integrate", &input, 1, &Tile::new(512, depths.to_vec(), &[("filter_walk", walk)]))[0]
+    };
+    let texels = run(&checkerboard, "texels");
+    let hierarchy = run(&checkerboard, "hierarchy");
+    let uniform = run(&vec![0.5; side * side], "hierarchy");
+    println!("checkerboard: texels {texels:?}, hierarchy {hierarchy:?}; uniform {uniform:?}");
+    assert!(texels[2] == 1.0 && texels[3] >= 32_768.0 * 400.0 / 401.0 - 400.0 && texels[3] <= 32_768.0, "{texels:?}");
+    assert!(hierarchy[2] == 1.0 && hierarchy[3] <= 32_768.0 + 256.0, "{hierarchy:?}");
+    assert!(close(hierarchy[1], uniform[1], F32_TOLERANCE), "a capped walk still covers the whole filter: {hierarchy:?}");
+    assert_eq!((uniform[2], uniform[3]), (0.0, 4.0));
 }

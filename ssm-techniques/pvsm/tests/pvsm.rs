@@ -59,7 +59,7 @@ fn the_normal_offset_of_anisotropic_tiles_moves_no_penumbra() {
     let size = (320, 240);
     let (offset, diagnostics, _) = run(&scene, &[], size);
     let (none, _, _) = run(&scene, &[("normal_offset", "0")], size);
-    let (side, texels) = (value(&diagnostics, "pvsm_tile0_size"), value(&diagnostics, "pvsm_texels"));
+    let (side, texels) = (value(&diagnostics, "pvsm_tile0_size"), value(&diagnostics, "pvsm_texels_rendered"));
     let largest = offset.visibility.iter().zip(&none.visibility).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     println!("long thin light: a tile of {side} × {} texels; largest change from the offset {largest:.3}", texels / side);
     assert!(largest <= 0.25, "{largest}");
@@ -72,31 +72,78 @@ fn image<'a>(extra: &'a [ssm_core::ExtraImage], name: &str) -> &'a ssm_core::Ext
 /// The costs and departures the diagnostics report. On parallel-square at the predicted resolution
 /// every filtered pixel's filter is covered by a tile, and the mid-frame readback's wait for the GPU
 /// is reported (it includes steps 2 to 5's run); with one fixed 4096² map and twice the light, the
-/// penumbra's filters span hundreds of texels and are decimated (read at every k-th texel), counted
-/// per pixel, and there is no readback.
+/// penumbra's filters span hundreds of texels (they were read at every k-th texel before the
+/// hierarchy), and the hierarchy walks every one of them within its cap (no pixel capped), reading
+/// (`count_reads`) fewer texels per filter than the 96² the decimation allowed; there is no readback.
 #[test]
-fn the_diagnostics_count_decimated_and_uncovered_pixels_and_time_the_readback_wait() {
+fn the_diagnostics_count_capped_and_uncovered_pixels_and_time_the_readback_wait() {
     let mut scene = builtin("parallel-square").unwrap().build();
     let (_, predicted, _) = run(&scene, &[], SIZE);
     scene.lights[0].half_size *= 2.0;
-    let (_, fixed, _) = run(&scene, &[("prediction", "fixed")], SIZE);
+    let (_, fixed, _) = run(&scene, &[("prediction", "fixed"), ("count_reads", "true")], SIZE);
     let count = |d: &[(String, f64)], key: &str| value(d, key);
     println!(
-        "predicted: {} filtered, {} decimated, {} uncovered, readback wait {:.2} ms; fixed 4096²: {} filtered, {} decimated, {} uncovered",
+        "predicted: {} filtered, {} capped, {} uncovered, readback wait {:.2} ms; fixed 4096²: {} filtered, {} capped, {} uncovered, {:.1} texels read per filter",
         count(&predicted, "pvsm_filtered_pixels"),
-        count(&predicted, "pvsm_decimated_pixels"),
+        count(&predicted, "pvsm_capped_pixels"),
         count(&predicted, "pvsm_uncovered_pixels"),
         count(&predicted, "pvsm_smtg_readback_wait_ms"),
         count(&fixed, "pvsm_filtered_pixels"),
-        count(&fixed, "pvsm_decimated_pixels"),
+        count(&fixed, "pvsm_capped_pixels"),
         count(&fixed, "pvsm_uncovered_pixels"),
+        count(&fixed, "pvsm_tile_filter_reads_per_pixel"),
     );
     assert_eq!(count(&predicted, "pvsm_uncovered_pixels"), 0.0);
+    assert_eq!(count(&predicted, "pvsm_capped_pixels"), 0.0);
     assert!(count(&predicted, "pvsm_smtg_readback_wait_ms") > 0.0);
+    assert!(!predicted.iter().any(|(key, _)| key == "pvsm_texels_filtered"), "counted only with count_reads");
     assert!(!fixed.iter().any(|(key, _)| key == "pvsm_smtg_readback_wait_ms"), "no readback with one fixed map");
-    let (filtered, decimated) = (count(&fixed, "pvsm_filtered_pixels"), count(&fixed, "pvsm_decimated_pixels"));
-    assert!(decimated > 0.1 * filtered && decimated <= filtered, "{decimated} of {filtered}");
+    assert_eq!(count(&fixed, "pvsm_capped_pixels"), 0.0);
     assert_eq!(count(&fixed, "pvsm_uncovered_pixels"), 0.0);
+    let per_filter = count(&fixed, "pvsm_tile_filter_reads_per_pixel");
+    assert!(per_filter > 0.0 && per_filter < 96.0 * 96.0, "{per_filter}");
+    let total = count(&fixed, "pvsm_tile_filter_reads_per_pixel") * count(&fixed, "pvsm_tile_filter_pixels");
+    assert!((count(&fixed, "pvsm_texels_filtered") - total).abs() <= 0.5, "pvsm_texels_filtered is the filter's reads");
+}
+
+/// The hierarchical walk gives the per-texel sum on whole frames, through the real tile maps and the
+/// pyramid pass: on parallel-square under twice its light (wide filters), under a twentieth of it in
+/// tiles of at most 64² (four tiles, filters straddling them) and on the thin bars, no pixel differs by more
+/// than the f32 summation bound of `the_hierarchy_sums_what_every_texel_sums` at the walks' cap:
+/// each sum within 2 (N + 10) u Σ c with N at most MAX_WALK_STEPS = 32,768 texels (no pixel capped,
+/// asserted), so V within twice that, 0.0078. The hierarchy reads fewer texels on each.
+#[test]
+fn the_hierarchy_gives_the_per_texel_sum_on_whole_frames() {
+    let mut wide = builtin("parallel-square").unwrap().build();
+    wide.lights[0].half_size *= 2.0;
+    let mut tiled = builtin("parallel-square").unwrap().build();
+    tiled.lights[0].half_size *= 0.05;
+    let bars = scene_from_manifest(include_str!("../doc/thin-bars.toml"));
+    type Case<'a> = (&'a str, &'a Scene, &'a [(&'a str, &'a str)]);
+    let cases: [Case<'_>; 3] = [
+        ("parallel-square, twice its light", &wide, &[]),
+        ("parallel-square, a twentieth of its light, tiles of at most 64²", &tiled, &[("max_tile_size", "64")]),
+        ("thin bars", &bars, &[]),
+    ];
+    let bound = 2.0 * 2.0 * (32_768.0 + 10.0) * f32::EPSILON / 2.0;
+    for (name, scene, settings) in cases {
+        let with = |walk: &'static str| {
+            let mut all: Vec<(&str, &str)> = settings.to_vec();
+            all.extend([("filter_walk", walk), ("count_reads", "true")]);
+            run(scene, &all, SIZE)
+        };
+        let (hierarchy, h, _) = with("hierarchy");
+        let (texels, t, _) = with("texels");
+        let largest = hierarchy.visibility.iter().zip(&texels.visibility).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        let (h_reads, t_reads) = (value(&h, "pvsm_texels_filtered"), value(&t, "pvsm_texels_filtered"));
+        let tiles = value(&h, "pvsm_tiles");
+        println!(
+            "{name}: {tiles} tiles, largest difference {largest:.2e}; texels read by the filter: hierarchy {h_reads}, every texel {t_reads}"
+        );
+        assert_eq!((value(&h, "pvsm_capped_pixels"), value(&t, "pvsm_capped_pixels")), (0.0, 0.0), "{name}");
+        assert!(largest <= bound, "{name}: {largest} > {bound}");
+        assert!(h_reads < t_reads, "{name}: {h_reads} against {t_reads}");
+    }
 }
 
 /// Step 3's average occluder depth on parallel-square, where every blocker is the square at depth
@@ -235,7 +282,7 @@ fn softer_shadows_need_fewer_texels_and_tiles() {
     large.lights[0].half_size *= 2.0;
     let measure = |scene: &Scene| {
         let diagnostics = run(scene, &[("max_tile_size", "64")], (320, 240)).1;
-        (value(&diagnostics, "pvsm_texels"), value(&diagnostics, "pvsm_tiles"))
+        (value(&diagnostics, "pvsm_texels_rendered"), value(&diagnostics, "pvsm_tiles"))
     };
     let ((small_texels, small_tiles), (large_texels, large_tiles)) = (measure(&small), measure(&large));
     println!(
