@@ -1,18 +1,21 @@
 //! Counted work (`--count-work`): for every registered technique, one counting frame
 //! ([`Renderer::count_work`]) gives each pass's invocations from pipeline statistics (lavapipe has
-//! them, so they must be there), and leaves the same visibility as a timed frame: counting changes
-//! no result. Where the work is known by hand it is asserted exactly.
+//! them, so they must be there) and, for every technique of the workspace, the texel reads its
+//! shaders count; and it leaves the same visibility as a timed frame: counting changes no result.
+//! Where the work is known by hand it is asserted exactly.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use ssm_core::{Renderer, Requirements, TechniqueKind};
-use ssm_integration_tests::{missing_must_run, registry, render_or_refusal};
+use ssm_integration_tests::{MUST_RUN_ON_LAVAPIPE, missing_must_run, registry, render_or_refusal};
 use ssm_scene::builtin;
 use ssm_testing::gpu;
 
 const WIDTH: u32 = 64;
 const HEIGHT: u32 = 48;
+/// How far two renders of the same inputs may differ (tests/multi_light.rs's tolerance).
+const RERENDER_TOLERANCE: f32 = 1e-5;
 
 #[test]
 fn every_technique_counts_its_passes_and_counting_changes_no_result() {
@@ -43,12 +46,20 @@ fn every_technique_counts_its_passes_and_counting_changes_no_result() {
         if invocations == 0 {
             failures.push(format!("{}: no fragment or compute invocation counted", info.name));
         }
+        // Every technique of the workspace counts its texel reads in its shaders (issue 40: "texel
+        // reads, for every technique"); one registered from elsewhere may leave them unknown.
+        if MUST_RUN_ON_LAVAPIPE.contains(&info.name) && !(work.shader_counts && work.total(|p| p.texel_reads) > 0) {
+            failures.push(format!("{}: its shaders count no texel reads", info.name));
+        }
         if let Some(pass) = work.passes.iter().find(|p| p.runs == 0) {
             failures.push(format!("{}: pass {} counted without running", info.name, pass.name));
         }
-        let differs = visibility.iter().zip(&counted_visibility).filter(|(a, b)| a != b).count();
-        if differs > 0 {
-            failures.push(format!("{}: counting changed {differs} pixels", info.name));
+        // Counting must change no result; the tolerance is multi_light.rs's for re-rendering the
+        // same inputs: atty and wedges append lists with atomics, so the order of their additive
+        // blends, and its f32 rounding, varies from frame to frame (1.2e-7 seen between two timed frames).
+        let largest = visibility.iter().zip(&counted_visibility).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        if largest > RERENDER_TOLERANCE {
+            failures.push(format!("{}: counting changed a pixel by {largest}", info.name));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");

@@ -10,6 +10,7 @@
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
 // #import atty/atty_geometry.wgsl
+// #import atty/atty_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 // The micro-patches that can hide anything (atty_patches.wgsl), one instance each.
@@ -19,6 +20,8 @@
 // receiver map itself.
 @group(1) @binding(1) var receivers: texture_2d<f32>;
 @group(1) @binding(2) var<uniform> settings: AttySettings;
+// This side's accumulation counter (atty_counts.wgsl): 0, texel reads (one receiver texel per fragment).
+@group(1) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 struct MicroPatch {
     @builtin(position) clip: vec4<f32>,
@@ -62,6 +65,7 @@ fn atty_patch_vertex(@builtin(vertex_index) corner: u32, @builtin(instance_index
 fn atty_patch_fragment(in: MicroPatch) -> @location(0) f32 {
     let texel = vec2<i32>(in.clip.xy);
     let receiver = textureLoad(receivers, texel, 0);
+    record_count(0u, texel, 1u);
     let receiver_depth = receiver.x;
     // No receiver here, or the receiver is not behind this patch (beyond the tolerance that keeps a
     // surface in both maps from shadowing itself): nothing hidden.

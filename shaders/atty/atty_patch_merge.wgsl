@@ -5,9 +5,12 @@
 // micro-patch (atty_accumulate.wgsl).
 
 // #import common/shadow_map.wgsl
+// #import atty/atty_counts.wgsl
 
 @group(0) @binding(0) var finer: texture_2d<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d<rg32float, write>;
+// This pyramid's counters (atty_counts.wgsl): 0, texel reads; 1, bytes stored (8 per Rg32Float texel).
+@group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 @compute @workgroup_size(8, 8, 1)
 fn atty_merge_base(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -17,6 +20,8 @@ fn atty_merge_base(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let depth = textureLoad(finer, vec2<i32>(id.xy), 0).x;
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(depth, depth, 0.0, 0.0));
+    record_count(0u, vec2<i32>(id.xy), 1u);
+    record_count(1u, vec2<i32>(id.xy), 8u);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -33,4 +38,6 @@ fn atty_merge_reduce(@builtin(global_invocation_id) id: vec3<u32>) {
         farthest = max(farthest, range.y);
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest, farthest, 0.0, 0.0));
+    record_count(0u, vec2<i32>(id.xy), 4u);
+    record_count(1u, vec2<i32>(id.xy), 8u);
 }

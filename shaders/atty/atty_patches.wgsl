@@ -8,6 +8,7 @@
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
 // #import atty/atty_geometry.wgsl
+// #import atty/atty_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var occluder_map: texture_2d<f32>;
@@ -19,6 +20,12 @@
 @group(1) @binding(4) var<storage, read_write> patches: array<MicroPatchRecord>;
 // The accumulation's indirect draw: (4 vertices, patch count, 0, 0).
 @group(1) @binding(5) var<storage, read_write> draw_arguments: array<atomic<u32>, 4>;
+// This pass's counters (atty_counts.wgsl): 0, texel reads; 1, atomics (one per patch listed);
+// 2, bytes written to storage (one 32-byte record per patch listed).
+@group(1) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texel reads of this invocation (textureLoad calls), for the counts.
+var<private> reads: u32;
 
 // The deepest receiver among the SSM texels whose centres lie in the rectangle [low, high] (SSM
 // coordinates, [-1, 1]), from the max-pyramid at the finest level where the texels span at most
@@ -44,6 +51,7 @@ fn deepest_receiver(low: vec2<f32>, high: vec2<f32>) -> f32 {
     let level_last = max(vec2<i32>(i32(size) >> level) - 1, vec2<i32>(0));
     let a = min(first >> vec2<u32>(level), level_last);
     let b = min(last >> vec2<u32>(level), level_last);
+    reads += 4u;
     let lower = max(textureLoad(receiver_bounds, a, level).x, textureLoad(receiver_bounds, vec2<i32>(b.x, a.y), level).x);
     let upper = max(textureLoad(receiver_bounds, vec2<i32>(a.x, b.y), level).x, textureLoad(receiver_bounds, b, level).x);
     return max(lower, upper);
@@ -73,6 +81,7 @@ fn merged_block(texel: vec2<u32>, depth: f32) -> vec2<f32> {
             break;
         }
         let range = textureLoad(patch_merge, vec2<i32>(block), i32(level + 1u)).xy;
+        reads += 1u;
         let width = 2.0 * range.x * tan_half / settings.occluder_map_size;
         if (range.y >= NO_SURFACE || range.y - range.x > settings.merge_tolerance * width) {
             break;
@@ -93,6 +102,7 @@ fn neighbour_depth(texel: vec2<i32>) -> f32 {
         return -1.0;
     }
     let depth = textureLoad(occluder_map, texel, 0).x;
+    reads += 1u;
     return select(depth, -1.0, depth >= NO_SURFACE);
 }
 
@@ -118,17 +128,26 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id.xy >= vec2<u32>(n))) {
         return;
     }
-    let texel = id.xy;
+    let listed = u32(list_patch(id.xy));
+    let texel = vec2<i32>(id.xy);
+    record_count(0u, texel, reads);
+    record_count(1u, texel, listed);
+    record_count(2u, texel, 32u * listed);
+}
+
+// The micro-patch of occluder texel `texel`: appends it to the list, and says whether it did.
+fn list_patch(texel: vec2<u32>) -> bool {
     let depth = textureLoad(occluder_map, vec2<i32>(texel), 0).x;
+    reads = 1u;
     if (depth >= NO_SURFACE || depth <= 0.0) {
-        return;
+        return false;
     }
     let tan_half = frame.projection.xy;
     // The aligned block of 2^level texels starting at this one that is drawn as one micro-patch.
     let merged = merged_block(texel, depth);
     if (merged.x < 0.0) {
         // Another texel of its block draws it.
-        return;
+        return false;
     }
     let span = exp2(merged.x);
     let patch_depth = merged.y;
@@ -160,7 +179,7 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
             let deepest = deepest_receiver(texel_ndc - half_extent, texel_ndc + half_extent);
             // No receiver behind the patch under its rectangle: it hides nothing anywhere.
             if (deepest <= patch_depth + self_shadow_depth) {
-                return;
+                return false;
             }
             bound = min(bound, deepest);
         }
@@ -168,4 +187,5 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
     let half_ndc = penumbra_half_ndc(light_half, tan_half, half_size, patch_depth, bound);
     let slot = atomicAdd(&draw_arguments[1], 1u);
     patches[slot] = MicroPatchRecord(texel_ndc, half_ndc, patch_depth, self_shadow_depth, span, depth_spread);
+    return true;
 }

@@ -7,6 +7,7 @@
 // #import common/shadow_map.wgsl
 // #import atty/atty_settings.wgsl
 // #import atty/atty_geometry.wgsl
+// #import atty/atty_counts.wgsl
 
 @group(2) @binding(0) var soft_shadow_front: texture_2d<f32>;
 @group(2) @binding(1) var soft_shadow_back: texture_2d<f32>;
@@ -14,6 +15,11 @@
 // (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the receiver map.
 @group(2) @binding(2) var receiver_map: texture_2d<f32>;
 @group(2) @binding(3) var<uniform> settings: AttySettings;
+// The projection's counter (atty_counts.wgsl): 0, texel reads.
+@group(2) @binding(4) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Texel reads of this invocation (textureLoad calls), for the counts.
+var<private> reads: u32;
 
 // Bilinear interpolation of an unfilterable float texture (R32Float needs a feature to be
 // filtered) that leaves out the texels whose receiver lies at another depth than the lookup's
@@ -37,7 +43,9 @@ fn receiver_bilinear(map: texture_2d<f32>, uv: vec2<f32>, depth: f32, tolerance:
         sum += weight * textureLoad(map, texel, 0).x;
         total += weight;
     }
+    reads += 8u;
     if (total <= 1e-6) {
+        reads += 1u;
         return textureLoad(map, clamp(vec2<i32>(uv * size), vec2<i32>(0), limit), 0).x;
     }
     return sum / total;
@@ -54,6 +62,7 @@ const PLANE_MARGIN_TEXELS: f32 = 0.05;
 // texel holds none.
 fn texel_plane_depth(texel: vec2<i32>, q: vec2<f32>) -> f32 {
     let receiver = textureLoad(receiver_map, texel, 0);
+    reads += 1u;
     if (receiver.x >= NO_SURFACE) {
         return NO_SURFACE;
     }
@@ -84,6 +93,7 @@ fn plane_bilinear(uvd: vec3<f32>, tolerance: f32) -> f32 {
         let texel = clamp(vec2<i32>(base) + step, vec2<i32>(0), limit);
         let gap = abs(texel_plane_depth(texel, q) - uvd.z);
         let value = vec2<f32>(textureLoad(soft_shadow_front, texel, 0).x, textureLoad(soft_shadow_back, texel, 0).x);
+        reads += 2u;
         let weights = select(1.0 - t, t, vec2<bool>(step == vec2<i32>(1)));
         let weight = select(0.0, weights.x * weights.y, gap <= tolerance);
         sum += weight * value;
@@ -99,7 +109,16 @@ fn plane_bilinear(uvd: vec3<f32>, tolerance: f32) -> f32 {
 
 @fragment
 fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
+    let visibility = project(in);
+    record_count(0u, vec2<i32>(in.clip.xy), reads);
+    return visibility;
+}
+
+// The visibility at the pixel of `in`.
+fn project(in: FullscreenVertex) -> f32 {
     let point = screen_point(in);
+    // The G-buffer's position and normal.
+    reads = 2u;
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         return trivial;
@@ -113,10 +132,6 @@ fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     if (any(uvd.xy < vec2<f32>(0.0)) || any(uvd.xy >= vec2<f32>(1.0))) {
         return 1.0;
     }
-    // The SSM holds the occlusion of the receiver nearest the light's centre in each texel. A point
-    // behind it (an object with the role `both` between it and the light) has no value of its own:
-    // count it as in umbra, as a hard shadow would.
-    let nearest = shadow_map_depth(receiver_map, uvd.xy);
     if (settings.receiver_plane != 0.0) {
         // Behind the nearest receiver's tangent plane along the lookup's own ray: the plane gives
         // that receiver's depth there, not at the texel's centre, so no depth tolerance is needed,
@@ -133,6 +148,11 @@ fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
         let occlusion = plane_bilinear(own, settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, own.z));
         return 1.0 - clamp(occlusion, 0.0, 1.0);
     }
+    // The SSM holds the occlusion of the receiver nearest the light's centre in each texel. A point
+    // behind it (an object with the role `both` between it and the light) has no value of its own:
+    // count it as in umbra, as a hard shadow would.
+    let nearest = shadow_map_depth(receiver_map, uvd.xy);
+    reads += 1u;
     // Depths within this of the lookup's count as the same receiver: a constant bias plus
     // `receiver_tolerance` texel footprints of the receiver map at this depth.
     let tolerance = scene_length(frame, settings.receiver_bias) + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);

@@ -4,9 +4,12 @@
 // under it instead of the frame's far plane (atty_accumulate.wgsl, `penumbra_bound`).
 
 // #import common/shadow_map.wgsl
+// #import atty/atty_counts.wgsl
 
 @group(0) @binding(0) var finer: texture_2d<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d<r32float, write>;
+// This pyramid's counters (atty_counts.wgsl): 0, texel reads; 1, bytes stored (4 per R32Float texel).
+@group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 // Level 0 from the receiver map (`finer`): NO_SURFACE becomes 0, below every patch.
 @compute @workgroup_size(8, 8, 1)
@@ -17,6 +20,8 @@ fn atty_bounds_base(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let depth = textureLoad(finer, vec2<i32>(id.xy), 0).x;
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(select(depth, 0.0, depth >= NO_SURFACE)));
+    record_count(0u, vec2<i32>(id.xy), 1u);
+    record_count(1u, vec2<i32>(id.xy), 4u);
 }
 
 // One level from the one below (`finer`). Mip sizes halve rounding down, so the last texel of a
@@ -38,4 +43,7 @@ fn atty_bounds_reduce(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(deepest));
+    let block = last - first + 1;
+    record_count(0u, vec2<i32>(id.xy), u32(block.x * block.y));
+    record_count(1u, vec2<i32>(id.xy), 4u);
 }

@@ -18,6 +18,7 @@
 
 // #import common/screen_pass.wgsl
 // #import wedges/wedges_common.wgsl
+// #import wedges/wedges_counts.wgsl
 
 @group(2) @binding(0) var silhouette_area: texture_2d<f32>;
 @group(2) @binding(1) var silhouette_rect0: texture_2d<f32>;
@@ -35,8 +36,13 @@
 @group(2) @binding(13) var<storage, read_write> final_rectangles1: array<vec4<f32>>;
 @group(2) @binding(14) var<storage, read_write> final_rectangles2: array<vec4<f32>>;
 @group(2) @binding(15) var<storage, read_write> final_rectangles3: array<vec4<f32>>;
+@group(2) @binding(16) var<storage, read_write> read_counts: array<atomic<u32>>;
 // Blending modes.
 const BLENDING_NONE: u32 = 0u;
+
+// Texels this invocation read and bytes it stored, for the counts (wedges_counts.wgsl).
+var<private> reads: u32;
+var<private> stored: u32;
 
 // A rectangle (xmin, xmax, ymin, ymax) from its stored form (1 - xmin, xmax, 1 - ymin, ymax);
 // the stored zero is the empty rectangle (1, 0, 1, 0), neutral for the union.
@@ -71,6 +77,7 @@ fn fill(area: f32, rect: vec4<f32>) -> f32 {
 
 // Radial part `part`'s stored rectangle at `pixel` in the final buffer.
 fn final_rectangle(part: u32, pixel: u32) -> vec4<f32> {
+    reads += 1u;
     switch (part) {
         case 0u: {
             return final_rectangles0[pixel];
@@ -87,19 +94,20 @@ fn final_rectangle(part: u32, pixel: u32) -> vec4<f32> {
     }
 }
 
-fn store_final_rectangle(part: u32, pixel: u32, stored: vec4<f32>) {
+fn store_final_rectangle(part: u32, pixel: u32, rectangle: vec4<f32>) {
+    stored += 16u;
     switch (part) {
         case 0u: {
-            final_rectangles0[pixel] = stored;
+            final_rectangles0[pixel] = rectangle;
         }
         case 1u: {
-            final_rectangles1[pixel] = stored;
+            final_rectangles1[pixel] = rectangle;
         }
         case 2u: {
-            final_rectangles2[pixel] = stored;
+            final_rectangles2[pixel] = rectangle;
         }
         default: {
-            final_rectangles3[pixel] = stored;
+            final_rectangles3[pixel] = rectangle;
         }
     }
 }
@@ -108,9 +116,12 @@ fn blend(texel: vec2<i32>, umbra: bool) {
     let area = textureLoad(silhouette_area, texel, 0);
     let inner01 = textureLoad(silhouette_inner01, texel, 0);
     let inner23 = textureLoad(silhouette_inner23, texel, 0);
+    reads += 3u;
     if (!umbra && max(max(area.x, area.y), max(area.z, area.w)) <= 0.0) {
         return;
     }
+    // The four rectangles and the final areas.
+    reads += 5u;
     var rects = array<vec4<f32>, 4>(
         textureLoad(silhouette_rect0, texel, 0),
         textureLoad(silhouette_rect1, texel, 0),
@@ -154,6 +165,7 @@ fn blend(texel: vec2<i32>, umbra: bool) {
         store_final_rectangle(i, pixel, encode(rect_union(final_bound, bound)));
     }
     final_areas[pixel] = final_area;
+    stored += 16u;
 }
 
 // One thread per pixel (dispatched only for buffers that hold anything).
@@ -167,8 +179,13 @@ fn wedges_blend(@builtin(global_invocation_id) id: vec3<u32>) {
     let shaded = u32(textureLoad(silhouette_shaded, texel, 0).x + 0.5);
     if (shaded > 0u) {
         fragment_counts[id.y * size.x + id.x] += shaded;
+        reads += 1u;
+        stored += 4u;
     }
     blend(texel, textureLoad(umbra_mask, texel, 0).x > 0.5);
+    // The shaded count and the umbra mask, besides what the blend read.
+    record_count(COUNTER_BLEND_READS, texel, reads + 2u);
+    record_count(COUNTER_BLEND_STORAGE_BYTES, texel, stored);
 }
 
 // The umbra mask: drawn over the whole view through the stencil test (non-zero count).
@@ -182,6 +199,8 @@ fn wedges_umbra_mask(in: FullscreenVertex) -> @location(0) vec4<f32> {
 fn wedges_resolve(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
     let trivial = trivial_visibility(point);
+    // The G-buffer's two texels, and the final areas where the pixel needs them.
+    record_count(COUNTER_RESOLVE_READS, point.texel, select(3u, 2u, trivial >= 0.0));
     if (trivial >= 0.0) {
         return trivial;
     }

@@ -10,6 +10,7 @@
 // #import common/light_frame.wgsl
 // #import common/camera.wgsl
 // #import wedges/wedges_common.wgsl
+// #import wedges/wedges_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var gbuffer_depth: texture_depth_2d;
@@ -17,12 +18,15 @@
 @group(1) @binding(2) var gbuffer_position: texture_2d<f32>;
 @group(1) @binding(3) var gbuffer_normal: texture_2d<f32>;
 @group(1) @binding(4) var<uniform> camera: Camera;
+@group(1) @binding(5) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 @fragment
 fn wedges_depth_copy(in: FullscreenVertex) -> @builtin(frag_depth) f32 {
     let texel = vec2<i32>(in.clip.xy);
     let depth = textureLoad(gbuffer_depth, texel, 0);
     let position = textureLoad(gbuffer_position, texel, 0);
+    // The depth and the position, and the normal where a surface covers the pixel.
+    record_count(COUNTER_DEPTH_COPY_READS, texel, select(2u, 3u, position.w >= 0.5));
     if (position.w < 0.5) {
         return depth;
     }

@@ -17,6 +17,7 @@
 
 // #import common/light_frame.wgsl
 // #import wedges/wedges_common.wgsl
+// #import wedges/wedges_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 
@@ -37,6 +38,18 @@
 @group(1) @binding(12) var<storage, read_write> winding: array<atomic<i32>>;
 // Per closed component, 1 when every edge of it is convex (CastingMesh::closed_convex).
 @group(1) @binding(13) var<storage, read> component_convex: array<u32>;
+@group(1) @binding(14) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Atomics this invocation did and bytes it stored, for the counts (wedges_counts.wgsl): every
+// entry point below is a wrapper that runs its step and records them, for every thread it runs.
+var<private> atomics: u32;
+var<private> stored: u32;
+
+fn record_silhouette_work(thread: u32) {
+    let texel = vec2<i32>(i32(thread), 0);
+    record_count(COUNTER_SILHOUETTE_ATOMICS, texel, atomics);
+    record_count(COUNTER_SILHOUETTE_STORAGE_BYTES, texel, stored);
+}
 
 // The indirect arguments: two dispatches (hook over records, jump over faces), then per group
 // four draws. Bound only in the passes that write them.
@@ -49,6 +62,11 @@ fn workgroups(count: u32) -> u32 {
 // Zeroes the counters, and lets the first label-propagation round run over everything.
 @compute @workgroup_size(1)
 fn wedges_reset() {
+    step_reset();
+    record_silhouette_work(0u);
+}
+
+fn step_reset() {
     atomicStore(&counters.changed, 0u);
     atomicStore(&counters.rounds, 0u);
     counters.regions = 0u;
@@ -56,7 +74,12 @@ fn wedges_reset() {
     counters.caps = 0u;
     atomicStore(&counters.fallback_wedges, 0u);
     counters.groups_used = 0u;
+    // Three atomic stores and four u32s above, eight u32s of indirect arguments below.
+    atomics = 3u;
+    stored = 4u * 4u + 8u * 4u;
     for (var g = 0u; g < MAX_SILHOUETTE_BUFFERS; g += 1u) {
+        atomics += 5u;
+        stored += 2u * 4u;
         atomicStore(&counters.edge_count[g], 0u);
         atomicStore(&counters.edge_cursor[g], 0u);
         atomicStore(&counters.cap_count[g], 0u);
@@ -93,6 +116,11 @@ fn faces_light(f: u32) -> bool {
 // and to zero around one outside (minus one turn if it is wound inwards).
 @compute @workgroup_size(256)
 fn wedges_winding(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_winding(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_winding(id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count) {
         return;
@@ -115,6 +143,7 @@ fn wedges_winding(@builtin(global_invocation_id) id: vec3<u32>) {
     // 4 pi steradians are WINDING_TURN units: a face's share is below half a turn, and
     // rounding errs by half a unit per face, far from the half turn the test below draws the line at.
     atomicAdd(&winding[face.component], i32(round(solid_angle * (WINDING_TURN / (4.0 * 3.14159265358979)))));
+    atomics = 1u;
 }
 
 // Step 1. A ray from the light's centre first crosses a closed component where
@@ -133,6 +162,11 @@ fn wedges_winding(@builtin(global_invocation_id) id: vec3<u32>) {
 // of every face's prism, whatever the mesh.
 @compute @workgroup_size(256)
 fn wedges_classify_faces(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_classify_faces(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_classify_faces(id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count) {
         return;
@@ -145,12 +179,15 @@ fn wedges_classify_faces(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         // Half a turn separates the winding numbers 0 (outside) and 1 (inside).
         let centre_inside = f32(atomicLoad(&winding[component])) > 0.5 * WINDING_TURN;
+        atomics += 1u;
         if (lit != centre_inside) {
             state = STATE_PARTICIPATES | select(0u, STATE_REVERSED, centre_inside);
         }
     }
     face_state[f] = state;
     atomicStore(&labels[f], select(NO_FACE, f, (state & STATE_PARTICIPATES) != 0u));
+    atomics += 1u;
+    stored += 4u;
 }
 
 fn participates(state: u32) -> bool {
@@ -173,6 +210,11 @@ fn joins(record: EdgeRecord) -> bool {
 // final labels are each region's smallest face whatever the order of threads.
 @compute @workgroup_size(256)
 fn wedges_hook(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_hook(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_hook(id: vec3<u32>) {
     let r = id.x;
     if (r >= mesh.record_count) {
         return;
@@ -183,40 +225,59 @@ fn wedges_hook(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let la = atomicLoad(&labels[record.face_a]);
     let lb = atomicLoad(&labels[record.face_b]);
+    atomics = 2u;
     if (la != lb) {
         atomicMin(&labels[max(la, lb)], min(la, lb));
         atomicStore(&counters.changed, 1u);
+        atomics += 2u;
     }
 }
 
 // Step 2, jump: every label points at its root.
 @compute @workgroup_size(256)
 fn wedges_jump(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_jump(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_jump(id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count) {
         return;
     }
     var label = atomicLoad(&labels[f]);
+    atomics = 1u;
     if (label == NO_FACE) {
         return;
     }
     for (var step = 0u; step < 1048576u; step += 1u) {
         let parent = atomicLoad(&labels[label]);
+        atomics += 1u;
         if (parent == label) {
             break;
         }
         label = parent;
     }
     atomicStore(&labels[f], label);
+    atomics += 1u;
 }
 
 // Step 2, control: the next round runs only if this one linked anything.
 @compute @workgroup_size(1)
 fn wedges_control() {
+    step_control();
+    record_silhouette_work(0u);
+}
+
+fn step_control() {
     let changed = atomicLoad(&counters.changed);
     atomicStore(&counters.changed, 0u);
+    // Two atomics, and two u32s of indirect arguments either way.
+    atomics = 2u;
+    stored = 2u * 4u;
     if (changed != 0u) {
         atomicAdd(&counters.rounds, 1u);
+        atomics += 1u;
         indirect[0] = workgroups(mesh.record_count);
         indirect[4] = workgroups(mesh.face_count);
     } else {
@@ -251,21 +312,33 @@ fn is_root(f: u32) -> u32 {
     if (f >= mesh.face_count) {
         return 0u;
     }
+    atomics += 1u;
     return select(0u, 1u, atomicLoad(&labels[f]) == f);
 }
 
 // Step 3a: roots per block of 256 faces.
 @compute @workgroup_size(256)
 fn wedges_rank_blocks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    step_rank_blocks(id, local, group);
+    record_silhouette_work(id.x);
+}
+
+fn step_rank_blocks(id: vec3<u32>, local: u32, group: vec3<u32>) {
     let total = workgroup_inclusive_scan(local, is_root(id.x));
     if (local == WORKGROUP - 1u) {
         block_sums[group.x] = total;
+        stored += 4u;
     }
 }
 
 // Step 3b: exclusive prefix sum of the block counts, in one workgroup, 256 blocks at a time.
 @compute @workgroup_size(256)
 fn wedges_rank_scan(@builtin(local_invocation_index) local: u32) {
+    step_rank_scan(local);
+    record_silhouette_work(local);
+}
+
+fn step_rank_scan(local: u32) {
     if (local == 0u) {
         scan_carry = 0u;
     }
@@ -281,6 +354,7 @@ fn wedges_rank_scan(@builtin(local_invocation_index) local: u32) {
         let inclusive = workgroup_inclusive_scan(local, value);
         if (i < mesh.rank_blocks) {
             block_sums[i] = carry + inclusive - value;
+            stored += 4u;
         }
         workgroupBarrier();
         if (local == WORKGROUP - 1u) {
@@ -290,22 +364,30 @@ fn wedges_rank_scan(@builtin(local_invocation_index) local: u32) {
     }
     if (local == 0u) {
         counters.regions = scan_carry;
+        stored += 4u;
     }
 }
 
 // Step 3c: each root's rank among the roots, in face order.
 @compute @workgroup_size(256)
 fn wedges_rank_faces(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    step_rank_faces(id, local, group);
+    record_silhouette_work(id.x);
+}
+
+fn step_rank_faces(id: vec3<u32>, local: u32, group: vec3<u32>) {
     let root = is_root(id.x);
     let inclusive = workgroup_inclusive_scan(local, root);
     if (root != 0u) {
         ranks[id.x] = block_sums[group.x] + inclusive - root;
+        stored += 4u;
     }
 }
 
 // The silhouette buffer of the region face `f` belongs to.
 fn group_of(f: u32) -> u32 {
     let root = atomicLoad(&labels[f]);
+    atomics += 1u;
     return ranks[root] % settings.silhouette_buffers;
 }
 
@@ -333,8 +415,11 @@ fn emissions(r: u32, out: ptr<function, array<Emission, 2>>) -> u32 {
         }
         return count;
     }
-    if (joins(record) && atomicLoad(&labels[record.face_a]) == atomicLoad(&labels[record.face_b])) {
-        return 0u;
+    if (joins(record)) {
+        atomics += 2u;
+        if (atomicLoad(&labels[record.face_a]) == atomicLoad(&labels[record.face_b])) {
+            return 0u;
+        }
     }
     if (participates(state_a)) {
         let reversed = (state_a & STATE_REVERSED) != 0u;
@@ -354,6 +439,11 @@ fn emissions(r: u32, out: ptr<function, array<Emission, 2>>) -> u32 {
 // Step 4a: count the half-edges of each silhouette buffer.
 @compute @workgroup_size(256)
 fn wedges_count_edges(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_count_edges(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_count_edges(id: vec3<u32>) {
     if (id.x >= mesh.record_count) {
         return;
     }
@@ -361,6 +451,7 @@ fn wedges_count_edges(@builtin(global_invocation_id) id: vec3<u32>) {
     let count = emissions(id.x, &out);
     for (var i = 0u; i < count; i += 1u) {
         atomicAdd(&counters.edge_count[group_of(out[i].face)], 1u);
+        atomics += 1u;
     }
 }
 
@@ -369,22 +460,36 @@ fn wedges_count_edges(@builtin(global_invocation_id) id: vec3<u32>) {
 // prisms (one region) hold a point at most once.
 @compute @workgroup_size(256)
 fn wedges_count_caps(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_count_caps(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_count_caps(id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count || !participates(face_state[f])) {
         return;
     }
     let g = group_of(f);
     atomicAdd(&counters.cap_count[g], 1u);
+    atomics += 1u;
     let component = faces[f].component;
     let convex = component != TWO_SIDED_COMPONENT && component_convex[component] != 0u;
+    // The label is loaded only for a convex component (`||` does not evaluate its right side otherwise).
+    atomics += select(0u, 1u, convex);
     if (!convex || atomicLoad(&labels[f]) == f) {
         atomicAdd(&counters.stencil_levels[g], 1u);
+        atomics += 1u;
     }
 }
 
 // Step 4b: each buffer's place in the lists, and its draws' arguments.
 @compute @workgroup_size(1)
 fn wedges_offsets() {
+    step_offsets();
+    record_silhouette_work(0u);
+}
+
+fn step_offsets() {
     var edges = 0u;
     var caps_total = 0u;
     var used = 0u;
@@ -393,6 +498,9 @@ fn wedges_offsets() {
         let cap_count = atomicLoad(&counters.cap_count[g]);
         counters.edge_offset[g] = edges;
         counters.cap_offset[g] = caps_total;
+        // Two offsets and sixteen u32s of draw arguments.
+        atomics += 2u;
+        stored += 18u * 4u;
         let base = DRAW_ARGUMENTS + g * GROUP_ARGUMENTS;
         // Shadow-volume sides.
         indirect[base + 0u] = SIDE_VERTICES * edge_count;
@@ -422,6 +530,7 @@ fn wedges_offsets() {
     counters.half_edges = edges;
     counters.caps = caps_total;
     counters.groups_used = used;
+    stored += 3u * 4u;
 }
 
 // A plane (unit normal, offset: dot(normal, x) = offset).
@@ -513,6 +622,7 @@ fn fallback_wedge(record: ptr<function, WedgeRecord>, a1: vec3<f32>, b1: vec3<f3
     }
     flag_record(record, WEDGE_FALLBACK | select(0u, WEDGE_PYRAMID, in_pyramid) | select(0u, WEDGE_APEX_B, apex_is_b));
     atomicAdd(&counters.fallback_wedges, 1u);
+    atomics += 1u;
 }
 
 // The plane that closes a wedge far from the light. Every receiver lies in the
@@ -705,6 +815,11 @@ fn build_wedge(a: vec3<f32>, b: vec3<f32>) -> WedgeRecord {
 // Step 4c: write each half-edge, with its wedge, into its buffer's list.
 @compute @workgroup_size(256)
 fn wedges_scatter_edges(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_scatter_edges(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_scatter_edges(id: vec3<u32>) {
     if (id.x >= mesh.record_count) {
         return;
     }
@@ -713,8 +828,10 @@ fn wedges_scatter_edges(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < count; i += 1u) {
         let g = group_of(out[i].face);
         let slot = counters.edge_offset[g] + atomicAdd(&counters.edge_cursor[g], 1u);
+        atomics += 1u;
         if (slot < mesh.half_edge_capacity) {
             half_edges[slot] = build_wedge(positions[out[i].a].xyz, positions[out[i].b].xyz);
+            stored += 96u;
         }
     }
 }
@@ -722,6 +839,11 @@ fn wedges_scatter_edges(@builtin(global_invocation_id) id: vec3<u32>) {
 // Step 4c: write each cap face into its buffer's list.
 @compute @workgroup_size(256)
 fn wedges_scatter_caps(@builtin(global_invocation_id) id: vec3<u32>) {
+    step_scatter_caps(id);
+    record_silhouette_work(id.x);
+}
+
+fn step_scatter_caps(id: vec3<u32>) {
     let f = id.x;
     if (f >= mesh.face_count || !participates(face_state[f])) {
         return;
@@ -729,4 +851,6 @@ fn wedges_scatter_caps(@builtin(global_invocation_id) id: vec3<u32>) {
     let g = group_of(f);
     let slot = counters.cap_offset[g] + atomicAdd(&counters.cap_cursor[g], 1u);
     caps[slot] = f;
+    atomics += 1u;
+    stored += 4u;
 }

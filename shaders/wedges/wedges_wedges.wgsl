@@ -33,12 +33,14 @@
 // #import common/light_frame.wgsl
 // #import common/camera.wgsl
 // #import wedges/wedges_common.wgsl
+// #import wedges/wedges_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 @group(1) @binding(0) var<uniform> camera: Camera;
 
 @group(2) @binding(0) var<storage, read> half_edges: array<WedgeRecord>;
 @group(2) @binding(1) var<uniform> settings: WedgesSettings;
+@group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 @group(3) @binding(0) var gbuffer_position: texture_2d<f32>;
 @group(3) @binding(1) var gbuffer_normal: texture_2d<f32>;
@@ -312,8 +314,16 @@ fn outside(plane: vec4<f32>, p: vec3<f32>, tolerance: f32) -> bool {
 
 @fragment
 fn wedges_wedge_fragment(in: WedgeVarying) -> WedgeTargets {
+    return wedge_fragment(in);
+}
+
+// The fragment of a wedge (the entry points wedges_wedge_fragment and, when counting,
+// wedges_wedges_counted.wgsl's).
+fn wedge_fragment(in: WedgeVarying) -> WedgeTargets {
     let texel = vec2<i32>(in.clip.xy);
     let position = textureLoad(gbuffer_position, texel, 0);
+    // The position, and the normal where a surface covers the pixel.
+    record_count(COUNTER_WEDGE_READS, texel, select(1u, 2u, position.w >= 0.5));
     if (position.w < 0.5) {
         discard;
     }

@@ -124,7 +124,11 @@ fn only_a_measurement_that_counts_renders_a_counting_frame() {
     let counted = measure_all(&mut renderer, &[job(true), job(false)], 1, FrameOrder::Interleaved, || {}).unwrap();
     assert_eq!(ssm_bench::work::counting_frames(), before + 1, "one counting frame, for the job that asked");
     assert!(counted[0].work.as_ref().is_some_and(|w| !w.passes.is_empty()) && counted[1].work.is_none());
-    assert_eq!(counted[0].visibility, plain[0].visibility, "counting after the timed frames changes no result");
+    // Counting changes no result, up to the f32 rounding of additive blends whose order atomics
+    // decide (atty, wedges): tests/multi_light.rs's re-render tolerance.
+    let largest =
+        counted[0].visibility.iter().flatten().zip(plain[0].visibility.iter().flatten()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+    assert!(largest <= 1e-5, "counting after the timed frames changed a pixel by {largest}");
     let truth = MeasureJob { info: reference, params: &reference_params, debug: &[], count_work: true };
     let traced = measure_all(&mut renderer, &[truth], 1, FrameOrder::Sequential, || {}).unwrap();
     assert_eq!(ssm_bench::work::counting_frames(), before + 1, "the ground truth has no GPU frame to count");

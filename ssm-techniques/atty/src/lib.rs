@@ -29,9 +29,11 @@ use ssm_core::passes::{
     bind_group, bind_group_layout, color_attachment, compute_pipeline, labelled_view, render_texture, storage_entry, texture_entry,
     uniform_buffer, uniform_entry, write_storage_texture_entry,
 };
+use ssm_core::read_counts::{READ_COUNT_BUCKETS, ReadCounts};
 use ssm_core::shader::create_shader_with_imports;
+use ssm_core::work::ShaderWork;
 use ssm_core::{
-    Choice, Error, Frame, Geometry, LightDepthMap, LightDepthMapDesc, ParamValues, Requirements, Result, ScreenPass, Settings,
+    Choice, Error, Frame, Geometry, GpuContext, LightDepthMap, LightDepthMapDesc, ParamValues, Requirements, Result, ScreenPass, Settings,
     ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
     register_technique,
 };
@@ -42,8 +44,11 @@ pub const NAME: &str = "atty";
 /// The micro-patch geometry the list pass and the accumulation evaluate, twin of [`geometry`].
 pub const GEOMETRY_SHADER: &str = ssm_shaders::atty::ATTY_GEOMETRY;
 /// WGSL files the Atty shaders import besides `common/`, as `(path under shaders/, text)`.
-pub const LOCAL_SHADERS: &[(&str, &str)] =
-    &[("atty/atty_settings.wgsl", ssm_shaders::atty::ATTY_SETTINGS), ("atty/atty_geometry.wgsl", GEOMETRY_SHADER)];
+pub const LOCAL_SHADERS: &[(&str, &str)] = &[
+    ("atty/atty_settings.wgsl", ssm_shaders::atty::ATTY_SETTINGS),
+    ("atty/atty_geometry.wgsl", GEOMETRY_SHADER),
+    ("atty/atty_counts.wgsl", ssm_shaders::atty::ATTY_COUNTS),
+];
 /// The accumulation of micro-patches into the SSM.
 const ACCUMULATE_SHADER: &str = ssm_shaders::atty::ATTY_ACCUMULATE;
 /// The projection of the SSM onto the screen.
@@ -172,6 +177,120 @@ impl From<&AttySettings> for AttySettingsUniform {
     }
 }
 
+/// One occluder side's maps and passes, by name (every pass label a counter can carry is static).
+struct Side {
+    /// The occluder map.
+    occluder_map: &'static str,
+    /// The occluder map's min-max pyramid pass.
+    patch_merge: &'static str,
+    /// The micro-patch list pass.
+    patches: &'static str,
+    /// The accumulation pass, and the soft shadow map's label stem.
+    accumulate: &'static str,
+    /// The faces culled from the occluder map, and whether it keeps the farthest surface.
+    cull: Option<wgpu::Face>,
+    farthest: bool,
+}
+
+/// One-sided: the nearest surface of every occluder face.
+const ONE_SIDED: &[Side] = &[Side {
+    occluder_map: "atty_occluder_map",
+    patch_merge: "atty_patch_merge",
+    patches: "atty_accumulate_patches",
+    accumulate: "atty_accumulate",
+    cull: None,
+    farthest: false,
+}];
+
+/// Two-sided (Sec. 3.5): the nearest front faces and the farthest back faces.
+const TWO_SIDED: &[Side] = &[
+    Side {
+        occluder_map: "atty_occluder_map_front",
+        patch_merge: "atty_patch_merge",
+        patches: "atty_accumulate_front_patches",
+        accumulate: "atty_accumulate_front",
+        cull: Some(wgpu::Face::Back),
+        farthest: false,
+    },
+    Side {
+        occluder_map: "atty_occluder_map_back",
+        patch_merge: "atty_patch_merge_back",
+        patches: "atty_accumulate_back_patches",
+        accumulate: "atty_accumulate_back",
+        cull: Some(wgpu::Face::Front),
+        farthest: true,
+    },
+];
+
+/// Bytes of one [`ReadCounts`] counter: [`READ_COUNT_BUCKETS`] (invocations, amount) pairs of u32.
+/// A multiple of 256, the largest `min_storage_buffer_offset_alignment` WebGPU allows, so every
+/// counter can start a binding.
+const COUNTER_BYTES: u64 = READ_COUNT_BUCKETS as u64 * 8;
+
+/// The counters of `--count-work` (issue #40; [`TechniqueSetup::count_work`]), one slice of
+/// consecutive counters per pass that counts, each bound to its pass's shader as its own
+/// `read_counts` (`atty_counts.wgsl`): the list pass and the accumulation run once per side with
+/// one pipeline, and the pyramids share their shaders, so a slice, not an index, tells them apart.
+/// Only the passes that run have counters (a counter of a pass never recorded would be work of a
+/// pass that did not run).
+struct CounterPlan {
+    counters: Vec<(&'static str, &'static str)>,
+    /// The receiver map's max-pyramid: reads, storage bytes (when it runs).
+    receiver_bounds: Option<u32>,
+    /// Per side: its occluder map's min-max pyramid (reads, storage bytes; when merging), its list
+    /// pass (reads, atomics, storage bytes) and its accumulation (reads).
+    sides: Vec<SideCounters>,
+    /// The projection: reads.
+    project: u32,
+}
+
+/// The first counter of each of one side's counting passes ([`CounterPlan`]).
+struct SideCounters {
+    patch_merge: Option<u32>,
+    patches: u32,
+    accumulate: u32,
+}
+
+/// Counters of a pyramid pass, a list pass and an accumulation or projection pass, in their
+/// shaders' order.
+const PYRAMID_UNITS: &[&str] = &["reads", "storage_bytes"];
+const PATCHES_UNITS: &[&str] = &["reads", "atomics", "storage_bytes"];
+const READS_ONLY: &[&str] = &["reads"];
+
+impl CounterPlan {
+    fn new(settings: &AttySettings, sides: &[Side]) -> Self {
+        let mut counters = Vec::new();
+        let mut add = |pass: &'static str, units: &[&'static str]| {
+            let first = counters.len() as u32;
+            counters.extend(units.iter().map(|unit| (pass, *unit)));
+            first
+        };
+        let receiver_bounds = (settings.penumbra_bound == PenumbraBound::Receivers).then(|| add(RECEIVER_BOUNDS.label, PYRAMID_UNITS));
+        let sides = sides
+            .iter()
+            .map(|side| SideCounters {
+                patch_merge: (settings.merge_tolerance > 0.0).then(|| add(side.patch_merge, PYRAMID_UNITS)),
+                patches: add(side.patches, PATCHES_UNITS),
+                accumulate: add(side.accumulate, READS_ONLY),
+            })
+            .collect();
+        let project = add(PROJECT_LABEL, READS_ONLY);
+        Self { counters, receiver_bounds, sides, project }
+    }
+}
+
+/// `count` counters of `read_counts` from counter `first`, as one binding.
+fn counter_slice(read_counts: &ReadCounts, first: u32, count: usize) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer: read_counts.buffer(),
+        offset: u64::from(first) * COUNTER_BYTES,
+        size: wgpu::BufferSize::new(count as u64 * COUNTER_BYTES),
+    })
+}
+
+/// The projection pass's label.
+const PROJECT_LABEL: &str = "atty_project";
+
 /// One soft shadow map and the pass that fills it from one occluder map.
 struct SideAccumulation {
     occluder_map: LightDepthMap,
@@ -180,7 +299,7 @@ struct SideAccumulation {
     /// The list pass's bind group (occluder map, settings, pyramids, patch list, draw arguments).
     patches_group: wgpu::BindGroup,
     /// The list pass's name, `<label>_patches`.
-    patches_label: String,
+    patches_label: &'static str,
     /// The occluder map's depth range per block, when micro-patches merge.
     patch_merge: Option<DepthPyramid>,
     soft_shadow_map: wgpu::TextureView,
@@ -221,8 +340,15 @@ const RECEIVER_BOUNDS: PyramidKind = PyramidKind {
 };
 
 impl DepthPyramid {
-    /// The pyramid of `kind` over `map`, `size`² texels at level 0 (1 where it is bound but not read).
-    fn new(setup: &TechniqueSetup<'_>, kind: &PyramidKind, label: &'static str, map: &wgpu::TextureView, size: u32) -> Result<Self> {
+    /// The pyramid of `kind` over `map`, `size`² texels at level 0 (1 where it is bound but not read),
+    /// counting into `counts` (its slice of `read_counts`: reads, storage bytes).
+    fn new(
+        setup: &TechniqueSetup<'_>,
+        (kind, label): (&PyramidKind, &'static str),
+        map: &wgpu::TextureView,
+        size: u32,
+        (read_counts, counts): (&ReadCounts, wgpu::BindingResource<'_>),
+    ) -> Result<Self> {
         let device = &setup.gpu.device;
         let level_count = u32::BITS - size.leading_zeros();
         let texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -235,8 +361,11 @@ impl DepthPyramid {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
             view_formats: &[],
         });
-        let layout =
-            bind_group_layout(device, &format!("{}_layout", kind.label), &[texture_entry(0), write_storage_texture_entry(1, kind.format)]);
+        let layout = bind_group_layout(
+            device,
+            &format!("{}_layout", kind.label),
+            &[texture_entry(0), write_storage_texture_entry(1, kind.format), ReadCounts::layout_entry(2)],
+        );
         let views: Vec<wgpu::TextureView> = (0..level_count)
             .map(|level| {
                 texture.create_view(&wgpu::TextureViewDescriptor {
@@ -256,14 +385,15 @@ impl DepthPyramid {
                     device,
                     &format!("{label}_level_{level}_bind_group"),
                     &layout,
-                    &[wgpu::BindingResource::TextureView(finer), wgpu::BindingResource::TextureView(view)],
+                    &[wgpu::BindingResource::TextureView(finer), wgpu::BindingResource::TextureView(view), counts.clone()],
                 );
                 (group, (size >> level).max(1))
             })
             .collect();
         let module = create_shader_with_imports(setup.gpu, &format!("{}_shader", kind.label), kind.shader, LOCAL_SHADERS)?;
-        let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout], &[]);
-        let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout], &[]);
+        let constants = read_counts.pipeline_constants();
+        let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout], &constants);
+        let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout], &constants);
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
             return Err(Error::Gpu { during: format!("building Atty's {label}"), messages });
@@ -417,6 +547,8 @@ pub struct SoftShadowMaps {
     occluder_map_size: u32,
     project: ScreenPass,
     project_group: wgpu::BindGroup,
+    /// What the shaders count for `--count-work` ([`CounterPlan`]); enabled only then.
+    read_counts: ReadCounts,
 }
 
 /// A linear depth map of the occluders or receivers, without bias: micro-patches and receivers sit at their true depths.
@@ -445,18 +577,28 @@ impl SoftShadowMaps {
         let settings_buffer = uniform_buffer(&setup.gpu.device, "atty_settings_uniform", &AttySettingsUniform::from(&settings));
         let receiver_map = ReceiverMap::new(setup, &settings, &settings_buffer)?;
         let bounded = settings.penumbra_bound == PenumbraBound::Receivers;
-        // Unbounded, the accumulation still binds a pyramid, of one texel, that it never reads.
+        let sides = if settings.two_sided { TWO_SIDED } else { ONE_SIDED };
+        let plan = CounterPlan::new(&settings, sides);
+        let read_counts = ReadCounts::with_units(&setup.gpu.device, "atty_read_counts", &plan.counters, setup.count_work);
+        // Unbounded, the accumulation still binds a pyramid, of one texel, that it never reads (nor
+        // builds: its counter slice is the first two counters, never written by it).
         let receiver_bounds = DepthPyramid::new(
             setup,
-            &RECEIVER_BOUNDS,
-            "atty_receiver_bounds",
+            (&RECEIVER_BOUNDS, RECEIVER_BOUNDS.label),
             receiver_map.view(),
             if bounded { settings.ssm_size } else { 1 },
+            (&read_counts, counter_slice(&read_counts, plan.receiver_bounds.unwrap_or(0), PYRAMID_UNITS.len())),
         )?;
-        let accumulations = Self::accumulations(setup, &settings, (receiver_map.view(), &receiver_bounds.view), &settings_buffer)?;
-        let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation)?;
-        let patches_pipeline = Self::patches_pipeline(setup)?;
-        let (project, project_group) = Self::projection(setup, &accumulations, &receiver_map, &settings_buffer)?;
+        let accumulations = Self::accumulations(
+            setup,
+            (&settings, sides, &plan),
+            (receiver_map.view(), &receiver_bounds.view),
+            (&settings_buffer, &read_counts),
+        )?;
+        let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation, &read_counts)?;
+        let patches_pipeline = Self::patches_pipeline(setup, &read_counts)?;
+        let (project, project_group) =
+            Self::projection(setup, &accumulations, &receiver_map, &settings_buffer, (&read_counts, plan.project))?;
         Ok(Self {
             receiver_map,
             receiver_bounds: bounded.then_some(receiver_bounds),
@@ -466,6 +608,7 @@ impl SoftShadowMaps {
             occluder_map_size: settings.occluder_map_size,
             project,
             project_group,
+            read_counts,
         })
     }
 
@@ -473,32 +616,29 @@ impl SoftShadowMaps {
     /// two-sided (Sec. 3.5), the nearest front faces and the farthest back faces.
     fn accumulations(
         setup: &TechniqueSetup<'_>,
-        settings: &AttySettings,
+        (settings, sides, plan): (&AttySettings, &[Side], &CounterPlan),
         (receivers, receiver_bounds): (&wgpu::TextureView, &wgpu::TextureView),
-        settings_buffer: &wgpu::Buffer,
+        (settings_buffer, read_counts): (&wgpu::Buffer, &ReadCounts),
     ) -> Result<Vec<SideAccumulation>> {
         let device = &setup.gpu.device;
         let layout = Self::accumulate_layout(device);
-        let sides: &[(&'static str, &'static str, Option<wgpu::Face>, bool)] = if settings.two_sided {
-            &[
-                ("atty_occluder_map_front", "atty_accumulate_front", Some(wgpu::Face::Back), false),
-                ("atty_occluder_map_back", "atty_accumulate_back", Some(wgpu::Face::Front), true),
-            ]
-        } else {
-            &[("atty_occluder_map", "atty_accumulate", None, false)]
-        };
         sides
             .iter()
-            .map(|&(map_label, pass_label, cull, farthest)| {
-                let occluder_map = unbiased_depth_map(setup, map_label, settings.occluder_map_size, Geometry::Occluders, (cull, farthest))?;
+            .zip(&plan.sides)
+            .map(|(side, counters)| {
+                let (pass_label, farthest) = (side.accumulate, side.farthest);
+                let occluder_map =
+                    unbiased_depth_map(setup, side.occluder_map, settings.occluder_map_size, Geometry::Occluders, (side.cull, farthest))?;
                 let merging = settings.merge_tolerance > 0.0;
-                // Without merging, the accumulation still binds a pyramid, of one texel, that it never reads.
+                // Without merging, the accumulation still binds a pyramid, of one texel, that it
+                // never reads (nor builds: its counter slice is the first two counters, never
+                // written by it).
                 let patch_merge = DepthPyramid::new(
                     setup,
-                    &PATCH_MERGE,
-                    if farthest { "atty_patch_merge_back" } else { "atty_patch_merge" },
+                    (&PATCH_MERGE, side.patch_merge),
                     &occluder_map.linear_depth_view,
                     if merging { settings.occluder_map_size } else { 1 },
+                    (read_counts, counter_slice(read_counts, counters.patch_merge.unwrap_or(0), PYRAMID_UNITS.len())),
                 )?;
                 let texture_label = format!("{pass_label}_soft_shadow_map");
                 let texture = render_texture(
@@ -534,19 +674,25 @@ impl SoftShadowMaps {
                         wgpu::BindingResource::TextureView(&patch_merge.view),
                         patches.as_entire_binding(),
                         draw_arguments.as_entire_binding(),
+                        counter_slice(read_counts, counters.patches, PATCHES_UNITS.len()),
                     ],
                 );
                 let bind_group = bind_group(
                     device,
                     &format!("{pass_label}_bind_group"),
                     &layout,
-                    &[patches.as_entire_binding(), wgpu::BindingResource::TextureView(receivers), settings_buffer.as_entire_binding()],
+                    &[
+                        patches.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(receivers),
+                        settings_buffer.as_entire_binding(),
+                        counter_slice(read_counts, counters.accumulate, READS_ONLY.len()),
+                    ],
                 );
                 Ok(SideAccumulation {
                     occluder_map,
                     draw_arguments,
                     patches_group,
-                    patches_label: format!("{pass_label}_patches"),
+                    patches_label: side.patches,
                     patch_merge: merging.then_some(patch_merge),
                     soft_shadow_map: labelled_view(&texture, &texture_label),
                     bind_group,
@@ -557,19 +703,31 @@ impl SoftShadowMaps {
     }
 
     fn accumulate_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        bind_group_layout(device, "atty_accumulate_layout", &[storage_entry(0, true), texture_entry(1), uniform_entry(2)])
+        bind_group_layout(
+            device,
+            "atty_accumulate_layout",
+            &[storage_entry(0, true), texture_entry(1), uniform_entry(2), ReadCounts::layout_entry(3)],
+        )
     }
 
     fn patches_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         bind_group_layout(
             device,
             "atty_patches_layout",
-            &[texture_entry(0), uniform_entry(1), texture_entry(2), texture_entry(3), storage_entry(4, false), storage_entry(5, false)],
+            &[
+                texture_entry(0),
+                uniform_entry(1),
+                texture_entry(2),
+                texture_entry(3),
+                storage_entry(4, false),
+                storage_entry(5, false),
+                ReadCounts::layout_entry(6),
+            ],
         )
     }
 
     /// The pass that lists the micro-patches (`atty_patches.wgsl`).
-    fn patches_pipeline(setup: &TechniqueSetup<'_>) -> Result<wgpu::ComputePipeline> {
+    fn patches_pipeline(setup: &TechniqueSetup<'_>, read_counts: &ReadCounts) -> Result<wgpu::ComputePipeline> {
         let device = &setup.gpu.device;
         let module = create_shader_with_imports(setup.gpu, "atty_patches_shader", PATCHES_SHADER, LOCAL_SHADERS)?;
         let pipeline = compute_pipeline(
@@ -578,7 +736,7 @@ impl SoftShadowMaps {
             &module,
             "atty_patches",
             &[setup.gpu.uniform_layout(), &Self::patches_layout(device)],
-            &[],
+            &read_counts.pipeline_constants(),
         );
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
@@ -589,7 +747,11 @@ impl SoftShadowMaps {
 
     /// The instanced micro-patch pipeline: one quad per occluder texel, summed by additive
     /// blending into the float SSM (Sec. 4.1).
-    fn accumulate_pipeline(setup: &TechniqueSetup<'_>, accumulation: Accumulation) -> Result<wgpu::RenderPipeline> {
+    fn accumulate_pipeline(
+        setup: &TechniqueSetup<'_>,
+        accumulation: Accumulation,
+        read_counts: &ReadCounts,
+    ) -> Result<wgpu::RenderPipeline> {
         let device = &setup.gpu.device;
         let module = create_shader_with_imports(setup.gpu, "atty_accumulate_shader", ACCUMULATE_SHADER, LOCAL_SHADERS)?;
         let layout = Self::accumulate_layout(device);
@@ -618,7 +780,10 @@ impl SoftShadowMaps {
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("atty_patch_fragment"),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &read_counts.pipeline_constants(),
+                    ..Default::default()
+                },
                 targets: &[Some(wgpu::ColorTargetState {
                     format: accumulation.format(),
                     blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
@@ -636,10 +801,14 @@ impl SoftShadowMaps {
         accumulations: &[SideAccumulation],
         receiver_map: &ReceiverMap,
         settings_buffer: &wgpu::Buffer,
+        (read_counts, first_counter): (&ReadCounts, u32),
     ) -> Result<(ScreenPass, wgpu::BindGroup)> {
         let device = &setup.gpu.device;
-        let layout =
-            bind_group_layout(device, "atty_project_layout", &[texture_entry(0), texture_entry(1), texture_entry(2), uniform_entry(3)]);
+        let layout = bind_group_layout(
+            device,
+            "atty_project_layout",
+            &[texture_entry(0), texture_entry(1), texture_entry(2), uniform_entry(3), ReadCounts::layout_entry(4)],
+        );
         let Some(front) = accumulations.first().map(|a| &a.soft_shadow_map) else {
             return Err(Error::Technique { technique: NAME.into(), message: "no occluder side to project".into() });
         };
@@ -654,11 +823,19 @@ impl SoftShadowMaps {
                 wgpu::BindingResource::TextureView(back),
                 wgpu::BindingResource::TextureView(receiver_map.view()),
                 settings_buffer.as_entire_binding(),
+                counter_slice(read_counts, first_counter, READS_ONLY.len()),
             ],
         );
         let module = create_shader_with_imports(setup.gpu, "atty_project_shader", PROJECT_SHADER, LOCAL_SHADERS)?;
-        let project =
-            ScreenPass::new(setup, NAME, "atty_project", (&module, "atty_project"), Some(&layout), VISIBILITY_FORMAT.into(), &[])?;
+        let project = ScreenPass::new(
+            setup,
+            NAME,
+            PROJECT_LABEL,
+            (&module, "atty_project"),
+            Some(&layout),
+            VISIBILITY_FORMAT.into(),
+            &read_counts.pipeline_constants(),
+        )?;
         Ok((project, group))
     }
 }
@@ -694,6 +871,7 @@ impl ShadowTechnique for SoftShadowMaps {
             .light_bind_groups
             .get(light)
             .ok_or_else(|| Error::Technique { technique: NAME.into(), message: format!("no light {light}") })?;
+        self.read_counts.clear(frame, light);
         self.receiver_map.encode(frame, light_frame);
         if let Some(bounds) = &self.receiver_bounds {
             bounds.encode(frame);
@@ -706,7 +884,7 @@ impl ShadowTechnique for SoftShadowMaps {
             // The patch count back to 0 (bytes 4 to 8; the 4 vertices stay).
             frame.clear_buffer("atty_patch_count_reset", &accumulation.draw_arguments, 4, Some(4));
             {
-                let mut pass = frame.compute_pass(&accumulation.patches_label);
+                let mut pass = frame.compute_pass(accumulation.patches_label);
                 pass.set_pipeline(&self.patches_pipeline);
                 pass.set_bind_group(0, light_frame, &[]);
                 pass.set_bind_group(1, &accumulation.patches_group, &[]);
@@ -725,6 +903,12 @@ impl ShadowTechnique for SoftShadowMaps {
         }
         self.project.encode(frame, light, output, Some(&self.project_group), None);
         Ok(())
+    }
+
+    /// Per counting pass ([`CounterPlan`]): texel reads, atomics and bytes written to storage, as
+    /// its shader counted them (`atty_counts.wgsl`), when built for `--count-work`.
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 }
 
@@ -770,7 +954,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "atty-map-size",
-        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided",
+        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided; in counted work (--count-work; README, Counted work) the accumulation's fragments grow with the micro-patches, n², while each patch covers fewer",
         scenes: &["floating-sphere"],
         varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
         x_axis: "atty.occluder_map_size",

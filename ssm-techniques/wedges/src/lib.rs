@@ -42,7 +42,9 @@ use ssm_core::passes::{
     bind_group, bind_group_layout, color_attachment, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer,
     uniform_entry,
 };
+use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
+use ssm_core::work::ShaderWork;
 use ssm_core::{
     Choice, Error, Frame, GpuContext, ParamValues, Preset, Requirements, Result, ScreenPass, Settings, ShadowTechnique, TechniqueInfo,
     TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT, register_technique,
@@ -56,7 +58,11 @@ pub use plan::{AllocationPlan, FINAL_BINDING_BYTES_PER_PIXEL, PlannedBuffer, STO
 pub const NAME: &str = "wedges";
 
 /// WGSL files the wedges shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("wedges/wedges_common.wgsl", ssm_shaders::wedges::WEDGES_COMMON)];
+const LOCAL_SHADERS: &[(&str, &str)] = &[
+    ("wedges/wedges_common.wgsl", ssm_shaders::wedges::WEDGES_COMMON),
+    ("wedges/wedges_counts.wgsl", ssm_shaders::wedges::WEDGES_COUNTS),
+    ("wedges/wedges_wedges.wgsl", WEDGES_SHADER),
+];
 /// Silhouettes, regions, groups, wedge construction (compute).
 const SILHOUETTES_SHADER: &str = ssm_shaders::wedges::WEDGES_SILHOUETTES;
 /// The G-buffer's depth into the stencil target.
@@ -67,6 +73,24 @@ const VOLUMES_SHADER: &str = ssm_shaders::wedges::WEDGES_VOLUMES;
 const WEDGES_SHADER: &str = ssm_shaders::wedges::WEDGES_WEDGES;
 /// Blending and resolve.
 const BLEND_SHADER: &str = ssm_shaders::wedges::WEDGES_BLEND;
+/// Penumbra wedges with the depth test forced before the fragment, for counting.
+const WEDGES_COUNTED_SHADER: &str = ssm_shaders::wedges::WEDGES_WEDGES_COUNTED;
+
+/// The counters of `--count-work` (issue #40; [`TechniqueSetup::count_work`]), in the order of
+/// `wedges_counts.wgsl`'s `COUNTER_*` indices: (pass, unit). The passes that run without a
+/// casting mesh come first, so that without one the rest are left out (a counter of a pass that
+/// did not run would be work that was not done).
+const COUNTERS: &[(&str, &str)] = &[
+    ("wedges_depth_copy", "reads"),
+    ("wedges_resolve", "reads"),
+    ("wedges_wedges", "reads"),
+    ("wedges_blend", "reads"),
+    ("wedges_blend", "storage_bytes"),
+    ("wedges_silhouettes", "atomics"),
+    ("wedges_silhouettes", "storage_bytes"),
+];
+/// The counters of the passes that run without a casting mesh.
+const COUNTERS_WITHOUT_MESH: usize = 2;
 
 /// Most silhouette buffers (`MAX_SILHOUETTE_BUFFERS` in the WGSL).
 pub const MAX_SILHOUETTE_BUFFERS: u32 = 64;
@@ -301,6 +325,8 @@ pub struct PenumbraWedges {
     fragment_counts: wgpu::Buffer,
     passes_issued: u32,
     pixels: u64,
+    /// What the shaders count for `--count-work` ([`COUNTERS`]); enabled only then.
+    read_counts: ReadCounts,
 }
 
 impl PenumbraWedges {
@@ -321,6 +347,8 @@ impl PenumbraWedges {
         let casting = (!casting.faces.is_empty()).then_some(casting);
         AllocationPlan::new(width, height, casting.as_ref()).check(&device.limits())?;
         let settings_buffer = uniform_buffer(device, "wedges_settings_uniform", &WedgesSettingsUniform::from(&settings));
+        let counters = if casting.is_some() { COUNTERS } else { &COUNTERS[..COUNTERS_WITHOUT_MESH] };
+        let read_counts = ReadCounts::with_units(device, "wedges_read_counts", counters, setup.count_work);
 
         let indirect = storage(device, "wedges_indirect_arguments", INDIRECT_WORDS * 4, wgpu::BufferUsages::INDIRECT);
         let final_size = pixels * FINAL_BINDING_BYTES_PER_PIXEL;
@@ -340,7 +368,8 @@ impl PenumbraWedges {
             })
             .collect();
 
-        let (depth_copy_pipeline, depth_copy_group) = depth_copy(gpu, gbuffer, (&settings_buffer, &setup.scene.camera_buffer))?;
+        let (depth_copy_pipeline, depth_copy_group) =
+            depth_copy(gpu, gbuffer, (&settings_buffer, &setup.scene.camera_buffer), &read_counts)?;
         let umbra_mask = render_texture(device, "wedges_umbra_mask", width, height, UMBRA_MASK_FORMAT, wgpu::TextureUsages::empty());
         let umbra_mask_view = labelled_view(&umbra_mask, "wedges_umbra_mask");
         let blend_layout = blend_layout(device);
@@ -350,6 +379,7 @@ impl PenumbraWedges {
         blend_resources.push(wgpu::BindingResource::TextureView(&umbra_mask_view));
         blend_resources.push(fragment_counts.as_entire_binding());
         blend_resources.extend(final_rectangles.iter().map(wgpu::Buffer::as_entire_binding));
+        blend_resources.push(read_counts.buffer().as_entire_binding());
         let blend_group = bind_group(device, "wedges_blend_bind_group", &blend_layout, &blend_resources);
         let blend_module = create_shader_with_imports(gpu, "wedges_blend_shader", BLEND_SHADER, LOCAL_SHADERS)?;
         let blend_pipeline = compute_pipeline(
@@ -358,7 +388,7 @@ impl PenumbraWedges {
             &blend_module,
             "wedges_blend",
             &[gpu.uniform_layout(), gpu.gbuffer_layout(), &blend_layout],
-            &[],
+            &read_counts.pipeline_constants(),
         );
         let umbra_mask_pipeline = umbra_mask_pipeline(gpu, &blend_module);
         let resolve = ScreenPass::new(
@@ -368,13 +398,13 @@ impl PenumbraWedges {
             (&blend_module, "wedges_resolve"),
             Some(&blend_layout),
             VISIBILITY_FORMAT.into(),
-            &[],
+            &read_counts.pipeline_constants(),
         )?;
 
         let mesh = match &casting {
             Some(casting) => {
                 let uniform = WedgesMeshUniform::new(casting, (width, height), &setup.scene.bounds);
-                Some(MeshPasses::new(setup, casting, uniform, (&settings_buffer, &indirect))?)
+                Some(MeshPasses::new(setup, casting, uniform, (&settings_buffer, &indirect, &read_counts))?)
             }
             None => None,
         };
@@ -397,6 +427,7 @@ impl PenumbraWedges {
             fragment_counts,
             passes_issued: 0,
             pixels,
+            read_counts,
         })
     }
 
@@ -411,6 +442,7 @@ fn depth_copy(
     gpu: &GpuContext,
     gbuffer: &ssm_core::GBuffer,
     (settings, camera): (&wgpu::Buffer, &wgpu::Buffer),
+    read_counts: &ReadCounts,
 ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
     let device = &gpu.device;
     let layout = bind_group_layout(
@@ -431,6 +463,7 @@ fn depth_copy(
             texture_entry(2),
             texture_entry(3),
             uniform_entry(4),
+            ReadCounts::layout_entry(5),
         ],
     );
     let group = bind_group(
@@ -443,6 +476,7 @@ fn depth_copy(
             wgpu::BindingResource::TextureView(&gbuffer.position_view),
             wgpu::BindingResource::TextureView(&gbuffer.normal_view),
             camera.as_entire_binding(),
+            read_counts.buffer().as_entire_binding(),
         ],
     );
     let module = create_shader_with_imports(gpu, "wedges_depth_copy_shader", DEPTH_COPY_SHADER, LOCAL_SHADERS)?;
@@ -472,7 +506,7 @@ fn depth_copy(
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("wedges_depth_copy"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &read_counts.pipeline_constants(), ..Default::default() },
             targets: &[],
         }),
         multiview_mask: None,
@@ -489,6 +523,7 @@ fn blend_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     entries.push(texture_entry(areas + 2));
     entries.push(storage_entry(areas + 3, false, wgpu::ShaderStages::COMPUTE));
     entries.extend((0..RADIAL_PARTS as u32).map(|part| storage_entry(areas + 4 + part, false, wgpu::ShaderStages::COMPUTE)));
+    entries.push(ReadCounts::layout_entry(areas + 4 + RADIAL_PARTS as u32));
     bind_group_layout(device, "wedges_blend_layout", &entries)
 }
 
@@ -536,7 +571,7 @@ impl MeshPasses {
         setup: &TechniqueSetup<'_>,
         casting: &CastingMesh,
         uniform: WedgesMeshUniform,
-        (settings_buffer, indirect): (&wgpu::Buffer, &wgpu::Buffer),
+        (settings_buffer, indirect, read_counts): (&wgpu::Buffer, &wgpu::Buffer, &ReadCounts),
     ) -> Result<Self> {
         let gpu = setup.gpu;
         let device = &gpu.device;
@@ -562,6 +597,7 @@ impl MeshPasses {
         entries.extend((2..5).map(|b| storage_entry(b, true, compute)));
         entries.extend((5..13).map(|b| storage_entry(b, false, compute)));
         entries.push(storage_entry(13, true, compute));
+        entries.push(ReadCounts::layout_entry(14));
         let mesh_layout = bind_group_layout(device, "wedges_silhouettes_layout", &entries);
         let mesh_group = bind_group(
             device,
@@ -582,6 +618,7 @@ impl MeshPasses {
                 caps.as_entire_binding(),
                 winding.as_entire_binding(),
                 component_convex.as_entire_binding(),
+                read_counts.buffer().as_entire_binding(),
             ],
         );
         let indirect_layout = bind_group_layout(device, "wedges_indirect_layout", &[storage_entry(0, false, compute)]);
@@ -590,8 +627,9 @@ impl MeshPasses {
         let light = gpu.uniform_layout();
         let plain = [light, &mesh_layout];
         let writes_arguments = [light, &mesh_layout, &indirect_layout];
+        let constants = read_counts.pipeline_constants();
         let pipeline = |entry: &str, layouts: &[&wgpu::BindGroupLayout]| {
-            compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts, &[])
+            compute_pipeline(device, &format!("{entry}_pipeline"), &module, entry, layouts, &constants)
         };
         let silhouettes = SilhouettePasses {
             reset: pipeline("wedges_reset", &writes_arguments),
@@ -634,15 +672,15 @@ impl MeshPasses {
         let wedge_layout = bind_group_layout(
             device,
             "wedges_wedge_layout",
-            &[storage_entry(0, true, wgpu::ShaderStages::VERTEX_FRAGMENT), uniform_entry(1)],
+            &[storage_entry(0, true, wgpu::ShaderStages::VERTEX_FRAGMENT), uniform_entry(1), ReadCounts::layout_entry(2)],
         );
         let wedge_group = bind_group(
             device,
             "wedges_wedge_bind_group",
             &wedge_layout,
-            &[half_edges.as_entire_binding(), settings_buffer.as_entire_binding()],
+            &[half_edges.as_entire_binding(), settings_buffer.as_entire_binding(), read_counts.buffer().as_entire_binding()],
         );
-        let wedge_pipeline = wedge_pipeline(gpu, &wedge_layout)?;
+        let wedge_pipeline = wedge_pipeline(gpu, &wedge_layout, (read_counts, setup.count_work))?;
         Ok(Self {
             silhouettes,
             face_workgroups: uniform.rank_blocks,
@@ -702,9 +740,32 @@ fn volume_pipeline(gpu: &GpuContext, module: &wgpu::ShaderModule, layout: &wgpu:
 
 /// The wedge pipeline: back faces of the half-wedges (culling front faces, depth unclipped, tested
 /// against the scene's), eight float targets, areas and counts added, rectangles and maxima kept by maximum.
-fn wedge_pipeline(gpu: &GpuContext, layout: &wgpu::BindGroupLayout) -> Result<wgpu::RenderPipeline> {
+///
+/// Built for counting (`counting`, with `read_counts` enabled), the fragment counts its reads and has its depth
+/// test forced before it (`wedges_wedges_counted.wgsl`: a fragment with a side effect is otherwise
+/// tested after it runs, and every wedge fragment behind the scene would run and be counted),
+/// which needs [`wgpu::Features::SHADER_EARLY_DEPTH_TEST`].
+///
+/// # Errors
+/// [`Error::MissingFeatures`] when counting on a device without that feature; a shader error.
+fn wedge_pipeline(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    (read_counts, counting): (&ReadCounts, bool),
+) -> Result<wgpu::RenderPipeline> {
     let device = &gpu.device;
-    let module = create_shader_with_imports(gpu, "wedges_wedges_shader", WEDGES_SHADER, LOCAL_SHADERS)?;
+    let early_depth = wgpu::Features::SHADER_EARLY_DEPTH_TEST;
+    if counting && !gpu.features().contains(early_depth) {
+        return Err(Error::MissingFeatures { technique: NAME.into(), features: early_depth, adapter: gpu.describe() });
+    }
+    let (module, fragment_entry) = if counting {
+        (
+            create_shader_with_imports(gpu, "wedges_wedges_counted_shader", WEDGES_COUNTED_SHADER, LOCAL_SHADERS)?,
+            "wedges_wedge_fragment_counted",
+        )
+    } else {
+        (create_shader_with_imports(gpu, "wedges_wedges_shader", WEDGES_SHADER, LOCAL_SHADERS)?, "wedges_wedge_fragment")
+    };
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("wedges_wedge_pipeline_layout"),
         bind_group_layouts: &[Some(gpu.uniform_layout()), Some(gpu.uniform_layout()), Some(layout), Some(gpu.gbuffer_layout())],
@@ -745,8 +806,8 @@ fn wedge_pipeline(gpu: &GpuContext, layout: &wgpu::BindGroupLayout) -> Result<wg
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some("wedges_wedge_fragment"),
-            compilation_options: Default::default(),
+            entry_point: Some(fragment_entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &read_counts.pipeline_constants(), ..Default::default() },
             targets: &targets,
         }),
         multiview_mask: None,
@@ -810,6 +871,7 @@ impl ShadowTechnique for PenumbraWedges {
         if light == 0 {
             self.passes_issued = 0;
         }
+        self.read_counts.clear(frame, light);
         if let Some(mesh) = &self.mesh {
             mesh.encode_silhouettes(frame, light_frame, &self.indirect);
             self.passes_issued += 1;
@@ -844,6 +906,12 @@ impl ShadowTechnique for PenumbraWedges {
         self.resolve.encode(frame, light, output, Some(&self.blend_group), None);
         self.passes_issued += 1;
         Ok(())
+    }
+
+    /// Per counting pass ([`COUNTERS`]): texel reads, atomics and bytes written to storage, as its
+    /// shader counted them (`wedges_counts.wgsl`), when built for `--count-work`.
+    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
+        self.read_counts.work(gpu)
     }
 
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
@@ -1041,7 +1109,7 @@ const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "wedges-fig12",
-        summary: "Forest et al., Fig. 12: frame time of the plain penumbra wedges (blending=none, one silhouette buffer) and of the blending (forest, 16 buffers); one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles)",
+        summary: "Forest et al., Fig. 12: frame time of the plain penumbra wedges (blending=none, one silhouette buffer) and of the blending (forest, 16 buffers); one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles). In counted work (--count-work; README, Counted work): the same wedge fragments, and per buffer a blend thread per pixel, a full-screen umbra mask and the silhouette targets written back",
         scenes: FIG12_SCENES,
         varies: &["wedges.blending:silhouette_buffers=none:1,forest:16"],
         y_axis: "time",

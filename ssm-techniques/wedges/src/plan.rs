@@ -16,8 +16,8 @@ use crate::{CastingMesh, NAME, SILHOUETTE_BYTES, SILHOUETTE_TARGETS, WEDGE_RECOR
 /// Bytes per pixel of each final-buffer binding (one `vec4<f32>`).
 pub const FINAL_BINDING_BYTES_PER_PIXEL: u64 = 16;
 /// Storage buffers bound in one shader stage at most: the silhouette step's compute passes
-/// (twelve in the mesh's group, the indirect arguments in another).
-pub const STORAGE_BUFFERS_PER_STAGE: u32 = 13;
+/// (twelve in the mesh's group and the counters of `--count-work`, the indirect arguments in another).
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 14;
 
 /// What one storage buffer holds: `units` of `bytes_per_unit` each, and what a unit is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
