@@ -11,12 +11,12 @@ fn tap_depth(uv: vec2<f32>) -> f32 {
 @fragment
 fn pcss_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
-    let trivial = trivial_visibility(point);
-    if (trivial >= 0.0) {
-        return trivial;
-    }
+    // The G-buffer's two texels, read at every pixel, trivial ones included.
     reads = 2u;
-    let visibility = soft_visibility(pcss_pixel(point));
+    var visibility = trivial_visibility(point);
+    if (visibility < 0.0) {
+        visibility = soft_visibility(pcss_pixel(point));
+    }
     record_pcss_reads(point.texel);
     return visibility;
 }

@@ -39,10 +39,13 @@ struct PcssSettings {
 // Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Texel reads of this invocation: the G-buffer's two and every shadow-map tap (counted in each
-// entry file's tap_depth), or in the tiled pass the texels it loaded into the tile instead of the
-// taps that read the tile.
-var<private> reads: u32;
+// Texel reads of this invocation, each a textureLoad of one texel (nearest, no sampler): the
+// G-buffer's two (position and normal) at every pixel, trivial ones (background, trivially lit or
+// dark) included, and every shadow-map tap of a computed pixel (counted in each entry file's
+// tap_depth; a tap past the map's border counts as one, as hard's lookup does, though
+// shadow_map_depth fetches nothing there), or in the tiled pass the texels an invocation loaded
+// into the tile instead of the taps that read the tile.
+var<private> reads: u32 = 0u;
 
 // A pixel's lookup, prepared before its taps.
 struct PcssPixel {
@@ -99,14 +102,15 @@ fn soft_visibility(pixel: PcssPixel) -> f32 {
     return lit / f32(m * m);
 }
 
-// Records this invocation's reads (with COUNT_READS: the settings' count_reads, or a counting
-// frame) for a computed pixel.
+// Records this invocation's pixel and its reads (with COUNT_READS: the settings' count_reads, or a
+// counting frame), at every pixel of the screen.
 fn record_pcss_reads(texel: vec2<i32>) {
     record_pcss_reads_of(texel, 1u);
 }
 
-// Records `pixels` (0 or 1) and this invocation's reads: 0 for an invocation of the tiled pass
-// that only loaded its share of the tile.
+// Records `pixels` (0 or 1) and this invocation's reads: 0 for an invocation of the tiled pass past
+// the screen's edge, which only loaded its share of the tile, so that the invocations counted are
+// the screen's pixels in both passes.
 fn record_pcss_reads_of(texel: vec2<i32>, pixels: u32) {
     if (COUNT_READS && (pixels != 0u || reads != 0u)) {
         let word = read_count_word(0u, texel);

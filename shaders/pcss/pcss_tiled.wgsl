@@ -83,12 +83,12 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         record_pcss_reads_of(vec2<i32>(id.xy), 0u);
         return;
     }
+    // The G-buffer's two texels, read at every pixel of the screen, trivial ones included.
+    reads += 2u;
     var visibility = trivial;
     if (trivial < 0.0) {
-        // The G-buffer's two texels.
-        reads += 2u;
         visibility = soft_visibility(pixel);
     }
-    record_pcss_reads_of(point.texel, u32(trivial < 0.0));
+    record_pcss_reads(point.texel);
     textureStore(visibility_target, vec2<i32>(id.xy), vec4<f32>(visibility));
 }

@@ -38,11 +38,12 @@ fn sssm_blocker_blur_rows(
     if (inside) {
         point = screen_point_at(texel);
         own = textureLoad(horizontal_blocker, texel, 0);
+        // The G-buffer's two texels and step 1's, read at every pixel of the screen.
+        reads = 3u;
         if (own.x < 0.0) {
             result = vec4<f32>(own.w, 0.0, 0.0, -1.0);
         } else {
             computed = true;
-            reads = 3u;
             let searched = blocker_search(point, own);
             result = searched.result;
             blur = searched.blur;
@@ -70,5 +71,8 @@ fn sssm_blocker_blur_rows(
         textureStore(horizontal_blur_target, texel, result);
         textureStore(vertical_tap_source, texel, packed_vertical_tap_source(result.x, point));
     }
-    record_reads_of(1u, texel, u32(computed));
+    record_reads_of(1u, texel, u32(inside));
+    if (computed) {
+        record_failed_rows(1u, texel);
+    }
 }

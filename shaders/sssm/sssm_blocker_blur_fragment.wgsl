@@ -20,11 +20,13 @@ struct BlockerBlurOutput {
 fn sssm_blocker_blur(in: FullscreenVertex) -> BlockerBlurOutput {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
+    // The G-buffer's two texels and step 1's, read at every pixel.
+    reads = 3u;
     if (own.x < 0.0) {
         store_penumbra_error(point.texel);
+        record_reads(1u, point.texel);
         return BlockerBlurOutput(vec4<f32>(own.w, 0.0, 0.0, -1.0), packed_vertical_tap_source(own.w, point));
     }
-    reads = 3u;
     let searched = blocker_search(point, own);
     store_penumbra_error(point.texel);
     var result = searched.result;
@@ -32,5 +34,6 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> BlockerBlurOutput {
         result = horizontal_blur(in.clip.xy, point, own, result);
     }
     record_reads(1u, point.texel);
+    record_failed_rows(1u, point.texel);
     return BlockerBlurOutput(result, packed_vertical_tap_source(result.x, point));
 }

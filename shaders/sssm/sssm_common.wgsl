@@ -31,8 +31,14 @@ struct SssmSettings {
 // reads) per bucket (common/read_counts.wgsl).
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Texture reads of this invocation so far (G-buffer, shadow map, the passes' own targets).
-var<private> reads: u32;
+// Texel reads of this invocation so far, each a textureLoad of one texel (nearest, no sampler):
+// the G-buffer's two at every pixel of the screen, trivial ones (background, trivially lit or
+// dark) included, and in steps 2 and 3 the pixel's own texel of the previous step's target, also
+// at every pixel; then a computed pixel's shadow-map taps (one each; a tap past the map's border
+// counts as one, though shadow_map_depth fetches nothing there), the previous steps' texels its
+// rows and blur taps read, and in the compute passes the texels of the shared segment this
+// invocation loaded (a tap that reads workgroup memory is not a texel read).
+var<private> reads: u32 = 0u;
 
 // Rows of this invocation's kernel that failed their reuse test (α in step 2, β in step 3), by
 // cause, when counting: the row's pixel lies off the screen (with CLAMP_EDGE_ROWS, only a
@@ -58,26 +64,33 @@ fn count_failed_row(off_screen: bool, no_data: bool) {
     }
 }
 
-// Adds this pixel and its reads to pass `pass_index`'s counts, when counting (COUNT_READS).
+// Adds this invocation's pixel and its reads to pass `pass_index`'s counts, when counting
+// (COUNT_READS): at every pixel of the screen, computed or not.
 fn record_reads(pass_index: u32, texel: vec2<i32>) {
     record_reads_of(pass_index, texel, 1u);
 }
 
 // Adds `pixels` (0 or 1) and this invocation's reads to pass `pass_index`'s counts, when counting:
-// 0 for an invocation that only loaded its share of a workgroup's shared row.
+// 0 for a compute invocation past the screen's edge, which only loaded its share of a workgroup's
+// shared segment, so that the invocations counted are the screen's pixels in every variant.
 fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
     if (COUNT_READS && (pixels != 0u || reads != 0u)) {
         let word = read_count_word(pass_index, texel);
         atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
     }
-    // Steps 2 and 3 also count their failed rows by cause, per computed pixel.
-    if (COUNT_READS && pixels != 0u && (pass_index == 1u || pass_index == 2u)) {
+}
+
+// Adds a computed pixel's failed rows of step 2 (`pass_index` 1) or step 3 (2), by cause, to
+// their counters (diagnostics per computed pixel, not work: ReadCounts::work leaves their unit,
+// rows, out), when counting.
+fn record_failed_rows(pass_index: u32, texel: vec2<i32>) {
+    if (COUNT_READS) {
         let first = 3u + (pass_index - 1u) * FAILED_ROW_COUNTERS;
         let causes = array<u32, 3>(failed_rows_off_screen, failed_rows_no_data, failed_rows_depth);
         for (var cause = 0u; cause < FAILED_ROW_COUNTERS; cause++) {
             let word = read_count_word(first + cause, texel);
-            atomicAdd(&read_counts[word], pixels);
+            atomicAdd(&read_counts[word], 1u);
             atomicAdd(&read_counts[word + 1u], causes[cause]);
         }
     }

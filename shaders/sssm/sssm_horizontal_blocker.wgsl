@@ -17,11 +17,13 @@ struct HorizontalBlockerOutput {
 @fragment
 fn sssm_horizontal_blocker(in: FullscreenVertex) -> HorizontalBlockerOutput {
     let point = screen_point(in);
+    // The G-buffer's two texels, read at every pixel.
+    reads = 2u;
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
+        record_reads(0u, point.texel);
         return HorizontalBlockerOutput(vec4<f32>(-1.0, 0.0, 0.0, trivial), packed_blur_source(trivial, point));
     }
-    reads = 2u;
     let result = partial_blocker(point);
     record_reads(0u, point.texel);
     return HorizontalBlockerOutput(result, packed_blur_source(result.w, point));

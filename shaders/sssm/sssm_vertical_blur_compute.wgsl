@@ -36,9 +36,10 @@ fn sssm_vertical_blur_columns(@builtin(workgroup_id) group: vec3<u32>, @builtin(
         point = screen_point_at(texel);
         // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
         own = textureLoad(horizontal_blur, texel, 0);
+        // The G-buffer's two texels and step 2's, read at every pixel of the screen.
+        reads = 3u;
         if (own.w >= 0.0) {
             computed = true;
-            reads = 3u;
             let radius = vertical_radius(own);
             if (radius > 0.0) {
                 reach_for(radius);
@@ -57,17 +58,20 @@ fn sssm_vertical_blur_columns(@builtin(workgroup_id) group: vec3<u32>, @builtin(
     }
     workgroupBarrier();
     if (!inside) {
+        // Past the screen's bottom edge: no pixel, but its share of the segment's loads.
+        record_reads_of(2u, texel, 0u);
         return;
     }
     if (!computed) {
         // Nothing computed here (background, behind the light): -1 keeps it out of the average.
         textureStore(reuse_share, texel, vec4<f32>(-1.0));
         textureStore(visibility_target, texel, vec4<f32>(own.x));
-        record_reads_of(2u, texel, 0u);
+        record_reads(2u, texel);
         return;
     }
     let result = vertical(vec2<f32>(texel) + 0.5, point, own);
     textureStore(reuse_share, texel, vec4<f32>(result.y));
     textureStore(visibility_target, texel, vec4<f32>(result.x));
     record_reads(2u, texel);
+    record_failed_rows(2u, texel);
 }

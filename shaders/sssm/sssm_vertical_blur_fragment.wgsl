@@ -19,11 +19,14 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> VerticalBlurOutput {
     let point = screen_point(in);
     // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
     let own = textureLoad(horizontal_blur, point.texel, 0);
+    // The G-buffer's two texels and step 2's, read at every pixel.
+    reads = 3u;
     if (own.w < 0.0) {
+        record_reads(2u, point.texel);
         return VerticalBlurOutput(own.x, -1.0);
     }
-    reads = 3u;
     let result = vertical(in.clip.xy, point, own);
     record_reads(2u, point.texel);
+    record_failed_rows(2u, point.texel);
     return VerticalBlurOutput(result.x, result.y);
 }

@@ -61,7 +61,7 @@ pub struct PcssSettings {
     /// Samples per axis of the PCF filter (m; m² taps per pixel).
     #[param(default = 15, min = 1, max = 128)]
     pub pcf_kernel: u32,
-    /// Count each pass's texture reads per pixel (diagnostics `pcss_blocker_search_and_filter_reads_per_pixel`); the atomics cost time, so off when timing.
+    /// Count each pass's texel reads per pixel of the screen, the G-buffer's included (diagnostics `pcss_blocker_search_and_filter_reads_per_pixel`); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
     /// Where taps read their depth: texture (a fragment pass reading the shadow map) or workgroup_tile (a compute pass whose workgroups share the texels their pixels read, when they fit; the same pixels).
@@ -217,14 +217,15 @@ impl ShadowTechnique for Pcss {
         Ok(())
     }
 
-    /// The pass's texel reads (the G-buffer's two texels and every shadow-map tap, one each; in the
-    /// tiled pass a tap read from workgroup memory is not a texel read, the tile's loads are not
-    /// counted either) and the pixels it computed, when built for counting.
+    /// The pass's texel reads and invocations, when built for counting: one invocation per pixel
+    /// of the screen, each reading the G-buffer's two texels (trivial pixels included), and a
+    /// computed pixel one texel per shadow-map tap; in the tiled pass a tap read from workgroup
+    /// memory is not a texel read, and the tile's loads are (one per texel of the union).
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
         self.read_counts.work(gpu)
     }
 
-    /// With `count_reads`: texture reads per computed pixel, and the pixels; with `tap_source =
+    /// With `count_reads`: texel reads per pixel of the screen, and the pixels; with `tap_source =
     /// workgroup_tile`, `pcss_tiled_share`: the share of the last light's workgroups (with a pixel
     /// to compute) whose union of windows fitted their tile.
     fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {

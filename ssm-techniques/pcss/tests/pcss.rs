@@ -155,3 +155,46 @@ fn workgroup_tiles_give_the_fragment_passes_pixels() {
         assert_eq!(largest, 0.0, "{name}: the tiled pass differs from the fragment pass by up to {largest}");
     }
 }
+
+/// PCSS's texel reads in a counting frame (`--count-work`) against the count by hand, under a
+/// point light on `parallel-square` (shaders/pcss/pcss_common.wgsl's convention: a textureLoad is
+/// one texel). Every pixel, the background included, is one invocation and reads its two G-buffer
+/// texels; every covered pixel computes (no surface is closed and all lie in front of the light,
+/// so the shared rules leave none trivial) and reads the n² taps of its blocker search. With the
+/// light a point, both extents are zero: every tap reads the pixel's own texel, so a blocker is
+/// found exactly where the filter then reads 0 (tap depth below the receiver's, against at or
+/// above it), and only those pixels read the m² filter taps. So, with P pixels, C covered and Z
+/// covered at visibility 0: 2P + n²C + m²Z reads, P invocations, exactly. The tiled pass counts
+/// the same invocations (its tile's loads, not its taps, are its reads).
+#[test]
+fn reads_are_two_gbuffer_texels_per_pixel_and_n2_plus_m2_per_shadowed_pixel_under_a_point_light() {
+    let (width, height, n, m) = (96u32, 72u32, 3u64, 5u64);
+    let gpu = gpu();
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.lights[0].half_size = glam::Vec2::ZERO;
+    let work_of = |tap_source: &'static str| {
+        let settings = [("shadow_map_size", "256"), ("blocker_kernel", "3"), ("pcf_kernel", "5"), ("tap_source", tap_source)];
+        let mut rendered = render(&gpu, &scene, &ssm_pcss::INFO, &settings, width, height).unwrap();
+        let params = ssm_pcss::INFO.params_from(settings).unwrap();
+        let work = rendered.renderer.count_work(&ssm_pcss::INFO, &params).unwrap();
+        println!("{tap_source}: {}", work.passes_column());
+        assert!(work.shader_counts, "pcss counts its reads");
+        let pass = work.passes.iter().find(|p| p.name == "pcss_blocker_search_and_filter").unwrap().clone();
+        (rendered, pass)
+    };
+    let (rendered, texture) = work_of("texture");
+    let pixels = u64::from(width * height);
+    let coverage = rendered.coverage();
+    let covered = coverage.iter().filter(|c| **c).count() as u64;
+    let shadowed = rendered.visibility.iter().zip(&coverage).filter(|(v, c)| **c && **v == 0.0).count() as u64;
+    println!("{pixels} pixels, {covered} covered, {shadowed} of them in shadow");
+    assert!(covered < pixels && shadowed > 0 && shadowed < covered, "the case must have background, lit and shadowed pixels");
+    assert_eq!(
+        (texture.counted_invocations, texture.texel_reads),
+        (pixels, 2 * pixels + n * n * covered + m * m * shadowed),
+        "(invocations, texel reads)"
+    );
+    let (_, tiled) = work_of("workgroup_tile");
+    assert_eq!(tiled.counted_invocations, pixels, "the tiled pass counts the screen's pixels, not its workgroups' threads");
+    assert!(tiled.texel_reads > 2 * pixels, "the G-buffer's texels and the tiles' loads: {}", tiled.texel_reads);
+}

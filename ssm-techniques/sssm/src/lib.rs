@@ -78,7 +78,8 @@ pub enum EdgeRows {
     /// From the depth map, as a row that fails its reuse test (a blocker row's n taps compared
     /// with the receiver, a blur row's m taps shadow-tested on the pixel's tangent plane): the
     /// same result at the borders as inside the screen, at n or m reads a row (at 29/41 on
-    /// `leaves`, 106 more reads per pixel than `Clamp`: the sssm README's "Texel reads").
+    /// `leaves`, 78 more reads per pixel of the screen than `Clamp`: the sssm README's "Texel
+    /// reads").
     Recompute,
     /// From the nearest pixel on the screen, reused when it passes the reuse test (α, β), as a
     /// screen-space pass reading through a clamp-to-edge sampler would; a reused one counts as
@@ -124,7 +125,7 @@ pub struct SssmSettings {
     /// Where blocker rows and blur rows past the screen's edges come from: clamp (the nearest pixel on the screen when it passes the reuse test, as a clamp-to-edge read would: the paper's screen-space passes, wrong where the shadow changes past the edge) or recompute (the depth map, as a failed reuse test's: exact borders, at n or m reads a row).
     #[param(choice, default = "clamp")]
     pub edge_rows: EdgeRows,
-    /// Count each pass's texture reads per pixel (diagnostics `sssm_<pass>_reads_per_pixel`) and the kernel rows that failed their reuse test per pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`; with `edge_rows = clamp`, `off_screen` counts only blocker rows behind the eye, the others being read from the edge); the atomics cost time, so off when timing.
+    /// Count each pass's texel reads per pixel of the screen, the G-buffer's and the previous step's own texel included at every pixel (diagnostics `sssm_<pass>_reads_per_pixel`), and the kernel rows that failed their reuse test per computed pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`; with `edge_rows = clamp`, `off_screen` counts only blocker rows behind the eye, the others being read from the edge); the atomics cost time, so off when timing.
     #[param(default = false)]
     pub count_reads: bool,
     /// Also search every blocker row of each pixel (no reuse, PCSS's search) and measure the squared difference of the two penumbra widths in shadow-map texels (diagnostics `sssm_penumbra_mse_texels2` over the pixels either search finds a blocker for and `sssm_penumbra_mse_all_texels2` over every pixel computed, debug output `penumbra_error`: the paper's Table 5); a full search per pixel, so off when timing.
@@ -210,10 +211,11 @@ enum BlurSteps {
     },
 }
 
-/// What `count_reads` counts per computed pixel, in the shaders' order (`record_reads_of` and
-/// `count_failed_row` in sssm_common.wgsl): each pass's texture reads, then the rows of step 2's
-/// blocker search and of step 3's blur that failed their reuse test, by cause (off the screen, no
-/// data in the pixel there, a depth difference of α or β or more).
+/// What `count_reads` counts, in the shaders' order (`record_reads_of`, `record_failed_rows` and
+/// `count_failed_row` in sssm_common.wgsl): each pass's texel reads per pixel of the screen, then,
+/// per computed pixel, the rows of step 2's blocker search and of step 3's blur that failed their
+/// reuse test, by cause (off the screen, no data in the pixel there, a depth difference of α or β
+/// or more).
 const COUNTED: &[(&str, &str)] = &[
     ("sssm_horizontal_blocker", "reads"),
     ("sssm_blocker_and_horizontal_blur", "reads"),
@@ -603,10 +605,12 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
         Ok(())
     }
 
-    /// Each pass's texel reads and the pixels it computed (their invocations), from the counters
-    /// the shaders keep when built for counting. Reads follow `ReadCounts`' convention: every
-    /// `textureLoad` (G-buffer, shadow map, the passes' own targets) is one texel. The failed-row
-    /// counters (`rows`) are diagnostics, not work of a pass of their own, and are left out.
+    /// Each pass's texel reads and invocations (one per pixel of the screen, trivial ones
+    /// included), from the counters the shaders keep when built for counting. Reads follow
+    /// `ReadCounts`' convention: every `textureLoad` (G-buffer, shadow map, the passes' own
+    /// targets) is one texel, at every pixel; a blur tap that reads a shared segment's workgroup
+    /// memory is none, the segment's loads are. The failed-row counters (`rows`) are diagnostics,
+    /// not work of a pass of their own, and are left out.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
         let passes = &COUNTED[..3];
         Ok(self
@@ -675,7 +679,7 @@ const TABLE4_VIEWPORT: (u32, u32) = (1280, 960);
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "sssm-table4",
-        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel. In texel reads (count_reads on both), SSSM at 29/41 and 0.1 reads 8.4x fewer than PCSS (283 against 2,394 a pixel; 4.3x at 11/21)",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel. In texel reads per pixel (count_reads on both, every pixel's G-buffer reads counted), SSSM at 29/41 and 0.1 reads 8.4x fewer than PCSS at 1280x960 (213 against 1,783 a pixel; 5.1x at 11/21)",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
@@ -700,7 +704,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-edges",
-        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (the default, as a clamp-to-edge read would) or recomputed from the depth map, at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with count_reads, 106 more texel reads a pixel at 29/41, 390 against 284)",
+        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (the default, as a clamp-to-edge read would) or recomputed from the depth map, at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with count_reads, 78 more texel reads a pixel at 29/41, 291 against 213)",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
@@ -713,7 +717,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-steps",
-        summary: "Buades et al., Tables 2 and 3: milliseconds per step (depth map, horizontal blocker, blocker + horizontal blur, vertical blur) at 29/41 as alpha = beta grow, with a 1024² and a 4096² depth map (on leaves; the per-pass times are in sweep.csv's passes_ms; with count_reads, the texel reads per step fall from 283 a pixel at 0.1 to 162 at 0.5, the same with either map)",
+        summary: "Buades et al., Tables 2 and 3: milliseconds per step (depth map, horizontal blocker, blocker + horizontal blur, vertical blur) at 29/41 as alpha = beta grow, with a 1024² and a 4096² depth map (on leaves; the per-pass times are in sweep.csv's passes_ms; with count_reads at 640x480, the texel reads per pixel fall from 213 at 0.1 to 123 at 0.5, the same with either map)",
         scenes: &["leaves"],
         varies: &[
             "sssm.alpha:beta=0:0,0.01:0.01,0.02:0.02,0.05:0.05,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",

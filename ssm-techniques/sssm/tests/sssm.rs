@@ -248,22 +248,24 @@ fn value(diagnostics: &[(String, f64)], key: &str) -> f64 {
     diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v).unwrap_or_else(|| panic!("no {key} in {diagnostics:?}"))
 }
 
-/// The read counters count what the shaders read: SSSM's first pass reads the G-buffer's two
-/// textures, the hard shadow's texel and the n texels of its row at every computed pixel; PCSS
-/// reads the G-buffer, n² blocker taps, and m² filter taps where it found a blocker; with
-/// α = β = 0 SSSM recomputes every row, n² + m² taps and more, as PCSS does. Off by default.
+/// The read counters count what the shaders read, per pixel of the screen (exactly, by hand:
+/// `reads_under_a_point_light_are_counted_exactly` below): PCSS reads the G-buffer at every pixel,
+/// n² blocker taps at a computed one, and m² filter taps where it found a blocker; with α = β = 0
+/// SSSM recomputes every row, n² + m² taps and more, as PCSS does. Both count one invocation per
+/// pixel. Off by default.
 #[test]
 fn read_counters_count_the_taps() {
     let scene = builtin("parallel-square").unwrap().build();
+    let pixels = f64::from(SIZE.0 * SIZE.1);
     let sssm = diagnostics_of(&ssm_sssm::INFO, &scene, &[("blocker_kernel", "7"), ("blur_kernel", "15"), ("count_reads", "true")]);
-    assert_eq!(value(&sssm, "sssm_horizontal_blocker_reads_per_pixel"), 2.0 + 1.0 + 7.0);
-    let pixels = value(&sssm, "sssm_horizontal_blocker_pixels");
-    assert!(pixels > 0.0);
+    let step_1 = value(&sssm, "sssm_horizontal_blocker_reads_per_pixel");
+    assert!(step_1 > 2.0 && step_1 < 2.0 + 1.0 + 7.0, "2 at every pixel, 2 + 1 + n at a computed one: {step_1}");
+    assert_eq!(value(&sssm, "sssm_horizontal_blocker_pixels"), pixels, "every pixel counted");
     let pcss = diagnostics_of(&ssm_pcss::INFO, &scene, &[("blocker_kernel", "7"), ("pcf_kernel", "15"), ("count_reads", "true")]);
     let pcss_reads = value(&pcss, "pcss_blocker_search_and_filter_reads_per_pixel");
     println!("PCSS 7/15: {pcss_reads:.1} reads per pixel over {pixels} pixels");
-    assert!(pcss_reads > 2.0 + 49.0 && pcss_reads < 2.0 + 49.0 + 225.0, "{pcss_reads}");
-    assert_eq!(value(&pcss, "pcss_blocker_search_and_filter_pixels"), pixels, "both compute the same pixels");
+    assert!(pcss_reads > 2.0 && pcss_reads < 2.0 + 49.0 + 225.0, "{pcss_reads}");
+    assert_eq!(value(&pcss, "pcss_blocker_search_and_filter_pixels"), pixels, "every pixel counted");
     let exhaustive = diagnostics_of(
         &ssm_sssm::INFO,
         &scene,
@@ -276,6 +278,45 @@ fn read_counters_count_the_taps() {
     println!("SSSM 7/15 with alpha = beta = 0: {total:.1} reads per pixel");
     assert!(total > pcss_reads * 0.5, "{total} against PCSS's {pcss_reads}");
     assert!(diagnostics_of(&ssm_sssm::INFO, &scene, &[]).iter().all(|(k, _)| !k.contains("reads")), "counted only on request");
+}
+
+/// Each pass's texel reads in a counting frame (`--count-work`) against the count by hand, under a
+/// point light on `parallel-square` with α = 0, in both `blur_passes` (sssm_common.wgsl's
+/// convention: a textureLoad is one texel). Every pixel, the background included, is one
+/// invocation of each pass and reads the G-buffer's two texels, and in steps 2 and 3 its own texel
+/// of the previous step's target. Every covered pixel computes (no surface is closed and all lie
+/// in front of the light, so the shared rules leave none trivial): step 1 reads its hard test's
+/// texel and its row's n taps; step 2 reads, for each of its n rows, the step-1 texel of the pixel
+/// that sees the row (on the screen: rows past the edges are clamped to it) and, as α = 0 reuses
+/// none, the row's n taps. The light a point, every row and tap lands on the pixel's own texel and
+/// the penumbra is 0 wide: no blur in either step, so step 3 reads nothing more, and the shared
+/// rows' segments are empty. With P pixels and C covered: step 1 2P + (1 + n)C, step 2
+/// 3P + (n + n²)C, step 3 3P, exactly; and P invocations each.
+#[test]
+fn reads_under_a_point_light_are_counted_exactly() {
+    let (width, height, n) = (96u32, 72u32, 3u64);
+    let gpu = gpu();
+    let mut scene = builtin("parallel-square").unwrap().build();
+    scene.lights[0].half_size = glam::Vec2::ZERO;
+    for blur_passes in ["fragment", "shared_rows"] {
+        let settings =
+            [("shadow_map_size", "256"), ("blocker_kernel", "3"), ("blur_kernel", "5"), ("alpha", "0"), ("blur_passes", blur_passes)];
+        let mut rendered = render(&gpu, &scene, &ssm_sssm::INFO, &settings, width, height).unwrap();
+        let params = ssm_sssm::INFO.params_from(settings).unwrap();
+        let work = rendered.renderer.count_work(&ssm_sssm::INFO, &params).unwrap();
+        println!("{blur_passes}: {}", work.passes_column());
+        assert!(work.shader_counts, "sssm counts its reads");
+        let pixels = u64::from(width * height);
+        let covered = rendered.coverage().iter().filter(|c| **c).count() as u64;
+        assert!(covered > 0 && covered < pixels, "{covered} of {pixels} pixels covered: the case must have both");
+        let counted = |name: &str| {
+            let pass = work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
+            (pass.counted_invocations, pass.texel_reads)
+        };
+        assert_eq!(counted("sssm_horizontal_blocker"), (pixels, 2 * pixels + (1 + n) * covered), "{blur_passes}: step 1");
+        assert_eq!(counted("sssm_blocker_and_horizontal_blur"), (pixels, 3 * pixels + (n + n * n) * covered), "{blur_passes}: step 2");
+        assert_eq!(counted("sssm_vertical_blur"), (pixels, 3 * pixels), "{blur_passes}: step 3");
+    }
 }
 
 /// The failed-row counters split each row that fails its reuse test by cause, per computed pixel:
@@ -626,17 +667,18 @@ fn check_against_blessed(cases: &[(&str, Scene)], settings: &[(&str, &str)], pre
 /// otherwise, SSSM reads at least 8 times fewer texels per pixel than PCSS (issue 40's goal; a
 /// perfectly separable pair would read 2·(29 + 41) = 140 against 29² + 41² = 2,522, 18 times
 /// fewer), and it saves more at 29/41 than at 11/21 (Table 4: "SSSM achieves higher performance
-/// when high-quality filters are used"). Both techniques compute the same pixels. Seen to fail with
-/// `edge_rows = recompute` as the default (6.3 times fewer at 29/41, the rows past the screen's
-/// edges read from the depth map), and with SSSM's failed-row counters (diagnostics, not passes)
-/// left in its counted work.
+/// when high-quality filters are used"). Reads are per pixel of the screen: both count every pixel
+/// and its G-buffer texels, trivial ones included (8.61 and 5.15 times fewer at 160×120). Seen to
+/// fail with `edge_rows = recompute` as the default (6.26 times fewer at 29/41, the rows past the
+/// screen's edges read from the depth map), and with SSSM's failed-row counters (diagnostics, not
+/// passes) left in its counted work.
 #[test]
 fn sssm_reads_eight_times_fewer_texels_than_pcss_at_table_4s_largest_kernels() {
     let scene = builtin("leaves").unwrap().build();
     let gpu = gpu();
-    // Texel reads per computed pixel from the framework's counting frame (--count-work), which
-    // builds each technique for counting and adds what its shaders counted to the passes the
-    // frame ran; and those pixels.
+    // Texel reads per pixel from the framework's counting frame (--count-work), which builds each
+    // technique for counting and adds what its shaders counted to the passes the frame ran; and
+    // the pixels (every one, an invocation of each pass).
     let reads = |info: &'static ssm_core::TechniqueInfo, first_pass: &str, settings: &[(&str, &str)]| {
         let params = info.params_from(settings.iter().copied()).unwrap();
         let needs = (info.requirements)(&params).unwrap();
@@ -655,7 +697,7 @@ fn sssm_reads_eight_times_fewer_texels_than_pcss_at_table_4s_largest_kernels() {
         let sssm_settings = [("blocker_kernel", blocker), ("blur_kernel", blur), ("alpha", "0.1"), ("beta", "0.1")];
         let (sssm, sssm_pixels) = reads(&ssm_sssm::INFO, "sssm_horizontal_blocker", &sssm_settings);
         println!("{blocker}/{blur}: PCSS {pcss:.1} texel reads per pixel, SSSM {sssm:.1}: {:.2} times fewer", pcss / sssm);
-        assert_eq!(pcss_pixels, sssm_pixels, "the same pixels computed");
+        assert_eq!(pcss_pixels, sssm_pixels, "the same pixels counted");
         savings.push(pcss / sssm);
     }
     assert!(savings[1] >= 8.0, "29/41: SSSM reads {:.2} times fewer than PCSS, issue 40 asks at least 8", savings[1]);
