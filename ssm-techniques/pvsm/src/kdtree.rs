@@ -92,6 +92,21 @@ impl Pyramid {
         out
     }
 
+    /// The texels the cells `[min, max)` of level 0 need, each at its own resolution (its two axes'
+    /// product over its area): what no tiling of them can go below.
+    #[must_use]
+    pub fn cells_texels(&self, min: UVec2, max: UVec2) -> f32 {
+        let cell_area = 1.0 / (self.size as f32 * self.size as f32);
+        let mut sum = 0.0;
+        for y in min.y..max.y.min(self.size) {
+            for x in min.x..max.x.min(self.size) {
+                let resolution = self.levels[0][(y * self.size + x) as usize];
+                sum += resolution.x * resolution.y * cell_area;
+            }
+        }
+        sum
+    }
+
     /// The smallest rectangle of level-0 cells inside `[min, max)` that holds every cell needing something, if any.
     #[must_use]
     pub fn fitted(&self, min: UVec2, max: UVec2) -> Option<(UVec2, UVec2)> {
@@ -157,43 +172,87 @@ pub struct Tiling {
 /// Smallest side a tile's map is given, texels.
 pub const MIN_TILE_SIZE: u32 = 8;
 
+/// Nodes needing fewer texels than this are not split for savings: a tile costs passes of its own
+/// (culling, its pyramid, a filter dispatch over the screen) whatever its size.
+pub const MIN_SPLIT_TEXELS: f32 = 65_536.0;
+
+/// The texels a node's map needs: its finest cell's resolution over its extent, per axis, rounded up
+/// and clamped as tiles are.
+fn needed_size(pyramid: &Pyramid, (min, max): (UVec2, UVec2), max_tile: u32) -> (Vec2, UVec2) {
+    let extent = (max - min).as_vec2() / pyramid.size as f32;
+    let needed = pyramid.range_max(min, max) * extent;
+    let size = needed.ceil().as_uvec2().clamp(UVec2::splat(MIN_TILE_SIZE), UVec2::splat(max_tile.max(MIN_TILE_SIZE)));
+    (needed, size)
+}
+
+/// The two halves of `(min, max)` split at its middle across x (or y), each fitted to the cells that
+/// need a map (none, one or two nodes).
+fn halves(pyramid: &Pyramid, (min, max): (UVec2, UVec2), along_x: bool) -> Vec<(UVec2, UVec2)> {
+    let (first, second) = if along_x {
+        let middle = (min.x + max.x) / 2;
+        ((min, UVec2::new(middle, max.y)), (UVec2::new(middle, min.y), max))
+    } else {
+        let middle = (min.y + max.y) / 2;
+        ((min, UVec2::new(max.x, middle)), (UVec2::new(min.x, middle), max))
+    };
+    [first, second].into_iter().filter_map(|(low, high)| pyramid.fitted(low, high)).collect()
+}
+
 /// Builds the kd-tree top-down and returns its leaves: every node is first
-/// fitted to the cells that need a map; it is a leaf when one map of at most
-/// `max_tile` texels a side meets its finest requirement; otherwise it is
-/// split at the middle of its longest side in demanded texels. At most
-/// `max_tiles` leaves: past the cap, nodes become leaves at `max_tile`, with
-/// less resolution than predicted (reported), so that the cost stays bounded
-/// whatever the prediction asks.
+/// fitted to the cells that need a map; it is split at the middle of its
+/// longest side in demanded texels while one map of at most `max_tile` texels
+/// a side cannot meet its finest requirement (the paper, after Giegl and
+/// Wimmer). A node that fits is also split, across the axis that saves more,
+/// while its map has more than `split_excess` times the texels its cells
+/// need each at its own resolution, if `split_excess` > 0 (not the paper's, whose tile takes its finest cell's resolution everywhere): a few
+/// cells asking for fine texels (contact shadows, surfaces the light sees
+/// edge-on) then refine only their own part of the map, and the filters of
+/// the pixels around them, which ask for less, read coarser texels. At most
+/// `max_tiles` leaves: past the cap, nodes become leaves, those that do not
+/// fit at `max_tile` with less resolution than predicted (reported), so that
+/// the cost stays bounded whatever the prediction asks.
 #[must_use]
-pub fn tile(pyramid: &Pyramid, max_tile: u32, max_tiles: usize) -> Tiling {
-    let cell = 1.0 / pyramid.size as f32;
+pub fn tile(pyramid: &Pyramid, max_tile: u32, max_tiles: usize, split_excess: f32) -> Tiling {
     let mut tiling = Tiling::default();
     let mut queue: VecDeque<(UVec2, UVec2)> = VecDeque::new();
     queue.extend(pyramid.fitted(UVec2::ZERO, UVec2::splat(pyramid.size)));
+    let texels = |size: UVec2| size.x as f32 * size.y as f32;
     while let Some((min, max)) = queue.pop_front() {
-        let extent = (max - min).as_vec2() * cell;
-        let needed = pyramid.range_max(min, max) * extent;
+        let (needed, size) = needed_size(pyramid, (min, max), max_tile);
         let fits = needed.x <= max_tile as f32 && needed.y <= max_tile as f32;
         let splittable = (max - min).cmpgt(UVec2::ONE).any();
         let full = tiling.tiles.len() + queue.len() + 2 > max_tiles.max(1);
-        if fits || !splittable || full {
-            let size = needed.ceil().as_uvec2().clamp(UVec2::splat(MIN_TILE_SIZE), UVec2::splat(max_tile.max(MIN_TILE_SIZE)));
-            tiling.cap_reached |= !fits && splittable;
-            tiling.tiles.push(Tile { uv_min: min.as_vec2() * cell, uv_max: max.as_vec2() * cell, size, clamped: !fits });
-            continue;
-        }
-        // Split across the axis that most exceeds the limit (one that can still be split).
-        let ratio = needed / max_tile as f32;
-        let along_x = (max.x - min.x > 1) && (ratio.x >= ratio.y || max.y - min.y <= 1);
-        let (first, second) = if along_x {
-            let middle = (min.x + max.x) / 2;
-            ((min, UVec2::new(middle, max.y)), (UVec2::new(middle, min.y), max))
+        let children = if !splittable || full {
+            None
+        } else if !fits {
+            // Split across the axis that most exceeds the limit (one that can still be split).
+            let ratio = needed / max_tile as f32;
+            let along_x = (max.x - min.x > 1) && (ratio.x >= ratio.y || max.y - min.y <= 1);
+            Some(halves(pyramid, (min, max), along_x))
+        } else if split_excess > 0.0 && texels(size) >= MIN_SPLIT_TEXELS && texels(size) > split_excess * pyramid.cells_texels(min, max) {
+            // Split for savings, across whichever axis leaves fewer texels.
+            let cost = |nodes: &Vec<(UVec2, UVec2)>| nodes.iter().map(|&node| texels(needed_size(pyramid, node, max_tile).1)).sum::<f32>();
+            [true, false]
+                .into_iter()
+                .filter(|&along_x| if along_x { max.x - min.x > 1 } else { max.y - min.y > 1 })
+                .map(|along_x| halves(pyramid, (min, max), along_x))
+                .map(|nodes| (cost(&nodes), nodes))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, nodes)| nodes)
         } else {
-            let middle = (min.y + max.y) / 2;
-            ((min, UVec2::new(max.x, middle)), (UVec2::new(min.x, middle), max))
+            None
         };
-        for (low, high) in [first, second] {
-            queue.extend(pyramid.fitted(low, high));
+        match children {
+            Some(nodes) => queue.extend(nodes),
+            None => {
+                tiling.cap_reached |= !fits && splittable;
+                tiling.tiles.push(Tile {
+                    uv_min: min.as_vec2() / pyramid.size as f32,
+                    uv_max: max.as_vec2() / pyramid.size as f32,
+                    size,
+                    clamped: !fits,
+                });
+            }
         }
     }
     tiling
@@ -234,14 +293,14 @@ mod tests {
 
     #[test]
     fn nothing_needed_gives_no_tile() {
-        let tiling = tile(&grid(16, &[]), 4096, 64);
+        let tiling = tile(&grid(16, &[]), 4096, 64, 0.0);
         assert!(tiling.tiles.is_empty() && !tiling.cap_reached);
     }
 
     #[test]
     fn a_modest_requirement_is_one_fitted_tile() {
         // Cells (2..4, 3..5) of a 16-grid need 1,000 texels per unit: 2/16 of the map → 125 texels.
-        let tiling = tile(&grid(16, &[(2, 3, 1000.0), (3, 4, 1000.0)]), 4096, 64);
+        let tiling = tile(&grid(16, &[(2, 3, 1000.0), (3, 4, 1000.0)]), 4096, 64, 0.0);
         assert_eq!(tiling.tiles.len(), 1);
         let tile = tiling.tiles[0];
         assert_eq!((tile.uv_min, tile.uv_max), (Vec2::new(2.0, 3.0) / 16.0, Vec2::new(4.0, 5.0) / 16.0));
@@ -253,20 +312,50 @@ mod tests {
     fn a_demanding_grid_splits_until_every_tile_fits() {
         // Everything needs 16,384 texels per unit: four times the largest map, so 4 × 4 tiles.
         let everything: Vec<(u32, u32, f32)> = (0..16).flat_map(|y| (0..16).map(move |x| (x, y, 16384.0))).collect();
-        let tiling = tile(&grid(16, &everything), 4096, 64);
+        let tiling = tile(&grid(16, &everything), 4096, 64, 0.0);
         assert_eq!(tiling.tiles.len(), 16);
         assert!(tiling.tiles.iter().all(|t| t.size == UVec2::splat(4096) && !t.clamped));
         let area: f32 = tiling.tiles.iter().map(|t| (t.uv_max - t.uv_min).x * (t.uv_max - t.uv_min).y).sum();
         assert!((area - 1.0).abs() < 1e-6, "the tiles cover the map once: {area}");
         // A cap of 4 stops the splitting: four tiles of the largest size, flagged.
-        let capped = tile(&grid(16, &everything), 4096, 4);
+        let capped = tile(&grid(16, &everything), 4096, 4, 0.0);
         assert!(capped.cap_reached && capped.tiles.len() <= 4);
         assert!(capped.tiles.iter().all(|t| t.size.max_element() <= 4096));
     }
 
     #[test]
+    fn a_few_fine_cells_refine_only_their_part_of_the_map_when_splitting_for_savings() {
+        // A 64-grid whose every cell needs 512 texels per unit, but for one cell (the contact shadow)
+        // needing 4,096. The paper's tree: one tile over the frame at 4,096 a side (it fits), 16.8 M
+        // texels, where the cells need 512² + (4,096² - 512²)/64² = 266,176 (integers, exact in f32).
+        let mut cells: Vec<(u32, u32, f32)> = (0..64).flat_map(|y| (0..64).map(move |x| (x, y, 512.0))).collect();
+        cells[(20 * 64 + 37) as usize].2 = 4096.0;
+        let pyramid = grid(64, &cells);
+        assert_eq!(pyramid.cells_texels(UVec2::ZERO, UVec2::splat(64)), 266_176.0);
+        let paper = tile(&pyramid, 4096, 64, 0.0);
+        assert_eq!(paper.tiles.len(), 1);
+        assert_eq!(paper.tiles[0].size, UVec2::splat(4096));
+        // Splitting while a node has more than twice its cells' texels (and at least MIN_SPLIT_TEXELS):
+        // the fine cell ends in a node whose map is within twice its cells' need or under
+        // MIN_SPLIT_TEXELS, the rest at 512 per unit: each split halves the node holding the fine cell,
+        // so the total is far under the paper's, and the tiles still cover every cell once at no
+        // less than its resolution.
+        let split = tile(&pyramid, 4096, 64, 2.0);
+        let texels: f32 = split.tiles.iter().map(|t| t.size.x as f32 * t.size.y as f32).sum();
+        assert!(split.tiles.len() > 1 && !split.cap_reached);
+        assert!(texels < 0.1 * 4096.0 * 4096.0, "{texels} texels in {} tiles", split.tiles.len());
+        let area: f32 = split.tiles.iter().map(|t| (t.uv_max - t.uv_min).x * (t.uv_max - t.uv_min).y).sum();
+        assert!((area - 1.0).abs() < 1e-6, "the tiles cover the map once: {area}");
+        for t in &split.tiles {
+            let (low, high) = ((t.uv_min * 64.0).round().as_uvec2(), (t.uv_max * 64.0).round().as_uvec2());
+            let needed = pyramid.range_max(low, high) * (t.uv_max - t.uv_min);
+            assert!(t.size.as_vec2().cmpge(needed.floor()).all(), "{t:?} needs {needed}");
+        }
+    }
+
+    #[test]
     fn a_cell_needing_more_than_the_largest_map_is_clamped() {
-        let tiling = tile(&grid(4, &[(0, 0, 1e9)]), 2048, 64);
+        let tiling = tile(&grid(4, &[(0, 0, 1e9)]), 2048, 64, 0.0);
         assert_eq!(tiling.tiles.len(), 1);
         assert!(tiling.tiles[0].clamped && tiling.tiles[0].size == UVec2::splat(2048));
         assert!(!tiling.cap_reached, "a single cell cannot be split: not the cap");

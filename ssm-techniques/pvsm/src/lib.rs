@@ -142,6 +142,9 @@ pub struct PvsmSettings {
     /// Most tiles per light and frame: past it, tiles get less resolution than predicted (reported in the diagnostics).
     #[param(default = 64, min = 1, max = 256)]
     pub max_tiles: u32,
+    /// A tile that fits one map is also split (kd-tree, step 6) while its map has more than this many times the texels its grid cells need, each at its own resolution: a few cells asking for fine texels (contact shadows, surfaces the light sees edge-on) then refine only their part of the map (not the paper's, whose tile takes its finest cell's resolution everywhere); 0: never (the paper). Fewer texels rendered and filtered, but thin occluders under large filters lose the resolution those cells gave them (README, "What differs").
+    #[param(default = 0, min = 0, max = 64)]
+    pub split_excess: u32,
     /// ρ, the perceptual model (Sec. 5.1): dynamic, static, linear (Fig. 8(b)), or fixed (no prediction: one map of fixed_size², Fig. 8(c)).
     #[param(choice, default = "dynamic")]
     pub prediction: Prediction,
@@ -874,7 +877,8 @@ impl PredictedVirtualShadowMaps {
         let pyramid = Pyramid::from_levels(self.settings.grid_size, &values)
             .map_err(|message| Error::Technique { technique: NAME.into(), message })?;
         let (max_tile, max_tiles) = (self.atlas_side, self.settings.max_tiles as usize);
-        Ok(frame.cpu_scope("pvsm_kdtree", || kdtree::tile(&pyramid, max_tile, max_tiles)))
+        let split_excess = self.settings.split_excess as f32;
+        Ok(frame.cpu_scope("pvsm_kdtree", || kdtree::tile(&pyramid, max_tile, max_tiles, split_excess)))
     }
 }
 
