@@ -5,12 +5,15 @@
 // axis-aligned box, as Sec. 4.2 does). The pixel's accumulator gets the visible covered area Σ c·o
 // and the covered area Σ c, so that tiles sharing a filter merge exactly (Sec. 5.2's V·A and A).
 //
-// Eq. 2's sum is walked top-down over the tile's min/max depth pyramid (pvsm_tile_pyramid.wgsl):
-// a block whose depths are all at or behind the receiver's (every texel lit) or all in front of it
-// (every texel occluding) adds its exact covered area in one step, and only mixed blocks descend to
-// their four children; texels are the leaves. The sum is the per-texel one (filter_walk = texels),
-// within f32 summation order, and its cost follows the penumbra's boundary texels, not the
-// filter's area.
+// Eq. 2's sum is walked top-down over the tile's two-layer min/max depth pyramid
+// (pvsm_tile_pyramid.wgsl): a block whose depths are all at or behind the receiver's (every texel
+// lit) or all in front of it (every texel occluding) adds its exact covered area in one step; a
+// block of two layers (a bar over a floor) lying entirely inside the filter, with the receiver
+// between its layers, adds its far layer's texel count as its lit area (inside the filter every
+// texel weighs its whole area); only the other blocks descend to their four children; texels are
+// the leaves. The sum is the per-texel one (filter_walk = texels), within f32 summation order, and
+// its cost follows where occluders' edges cross the filter's boundary or the receiver's depth, not
+// the filter's area.
 
 // #import pvsm/pvsm_common.wgsl
 // #import common/read_counts.wgsl
@@ -36,12 +39,18 @@ struct TileSettings {
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
-// The tile map's min/max depth pyramid: mip m holds level m + 1 (blocks of 2^(m+1) texels a side),
-// (nearest, farthest) depth; only the tile's region, from the top-left corner, is written.
+// The tile map's two-layer min/max depth pyramid (pvsm_tile_pyramid.wgsl): mip m holds level m + 1
+// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), and its near_count in
+// tile_near_counts; only the tile's region, from the top-left corner, is written.
 @group(3) @binding(3) var tile_pyramid: texture_2d<f32>;
+@group(3) @binding(4) var tile_near_counts: texture_2d<u32>;
 
-// The ReadCounts counter of this pass (PvsmReadCounter::TileFilter in src/lib.rs).
+// The ReadCounts counters of this pass and the resolve (READ_COUNTERS in src/lib.rs): every read of
+// every invocation of pvsm_tile_filter; the walk's reads per filter evaluation (the texels filtered,
+// a diagnostic, not a pass); every read of pvsm_resolve.
 const READ_COUNTER_TILE_FILTER: u32 = 6u;
+const READ_COUNTER_TILE_FILTER_WALK: u32 = 7u;
+const READ_COUNTER_RESOLVE: u32 = 8u;
 
 // Smallest half-axis of a filter, in texels of the tile (see texel_filter).
 const MIN_HALF_TEXELS: f32 = 1e-3;
@@ -195,6 +204,30 @@ fn block_area(shape: TexelFilter, lo: vec2<f32>, hi: vec2<f32>) -> f32 {
     return area;
 }
 
+// The height of the middle of whole column `column`'s box, as the per-texel walk computes it (its
+// column's left and right ends are column and column + 1 there).
+fn column_centre(shape: TexelFilter, column: f32) -> f32 {
+    return shape.centre.y + (0.5 * (column + (column + 1.0)) - shape.centre.x) * shape.slope;
+}
+
+// Whether the block of texels [lo, hi) lies entirely inside the filter, so that each of its texels
+// weighs its whole area (1 texel) in the per-texel walk: whole columns inside [x_low, x_high) (the
+// walk's width min(c + 1, x_high) - max(c, x_low) is then exactly 1), each column's box reaching
+// past the block's rows (the walk's height exactly 1). The boxes' centres move monotonically with
+// the column (each f32 operation of column_centre is monotone), so the first and last columns'
+// bound the rest; the slack, 8 roundoffs of the terms' magnitudes, covers a compiler fusing the
+// per-texel walk's evaluation differently. A block this test refuses descends (exact either way).
+fn inside_filter(shape: TexelFilter, lo: vec2<f32>, hi: vec2<f32>) -> bool {
+    if (lo.x < shape.x_low || hi.x > shape.x_high) {
+        return false;
+    }
+    let first = column_centre(shape, lo.x);
+    let last = column_centre(shape, hi.x - 1.0);
+    let magnitude = abs(shape.centre.y) + abs(shape.slope) * (hi.x + abs(shape.centre.x) + 1.0) + shape.half_height + hi.y;
+    let slack = 8.0 * F32_ROUNDOFF * magnitude;
+    return max(first, last) - shape.half_height <= lo.y - slack && min(first, last) + shape.half_height >= hi.y + slack;
+}
+
 // Bounds (lowest, highest) of what tap_plane_depth(receiver, uv) returns at the texel centres of the
 // rectangle [uv_low, uv_high] (shadow-map coordinates of its first and last centres), as f32
 // evaluates it, so that a block classified from them is classified as each of its texels would be.
@@ -294,13 +327,16 @@ fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride:
     return sums;
 }
 
-// Eq. 2 over the tile's min/max pyramid, top-down (filter_walk = hierarchy): from the (at most 2×2)
-// blocks of the coarsest level that hold the filter's rows and columns, a block the filter does not
-// cover is skipped unread; one whose nearest depth is no nearer than the receiver's farthest
-// compared depth over it (every texel lit, o = 1) or whose farthest depth is nearer than the
-// receiver's nearest (every texel occluding, o = 0) adds its covered area (block_area) at once; a
-// mixed one descends to its four children; a texel is tested as the per-texel walk tests it. The
-// same weights and the same tests: the per-texel sum, in another order. The walk is depth-first and
+// Eq. 2 over the tile's two-layer min/max pyramid, top-down (filter_walk = hierarchy): from the (at
+// most 2×2) blocks of the coarsest level that hold the filter's rows and columns, a block the
+// filter does not cover is skipped unread; one whose nearest depth is no nearer than the receiver's
+// farthest compared depth over it (every texel lit, o = 1) or whose farthest depth is nearer than
+// the receiver's nearest (every texel occluding, o = 0) adds its covered area (block_area) at once;
+// one of two layers whose near layer is in front of every compared depth and whose far layer is
+// behind them, lying inside the filter (inside_filter: every texel weighs 1), adds its covered
+// area and, as lit area, its far layer's texels (its near count, one more read); another descends
+// to its four children; a texel is tested as the per-texel walk tests it. The same weights and the
+// same tests: the per-texel sum, in another order. The walk is depth-first and
 // needs no stack: after a block, the next is its next sibling, or its parent's (climbing while it
 // is the fourth child), so that the state is one block and its level.
 fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> FilterSums {
@@ -365,16 +401,20 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
         // with; a texel is a block whose bounds are its own test's values, never mixed. Loads are
         // clamped to the texture: a real walk never leaves it. (A mip's size from the base's:
         // textureDimensions with a level returns the base level's size on llvmpipe.)
-        var depths: vec2<f32>;
+        var depths: vec4<f32>;
         var compared: vec2<f32>;
+        var pyramid_texel = vec2<i32>(0);
+        var mip = 0u;
         if (level == 0u) {
             let z = textureLoad(tile_map, min(vec2<i32>(block), vec2<i32>(tile.size) - 1), 0).x;
-            depths = vec2<f32>(z);
+            // A texel is one layer (near_max = far_min).
+            depths = vec4<f32>(z);
             compared = vec2<f32>(tap_plane_depth(receiver, tile_uv(lo + 0.5, scale)));
         } else {
-            let mip = min(level - 1u, pyramid_levels - 1u);
+            mip = min(level - 1u, pyramid_levels - 1u);
             let mip_size = max(pyramid_base >> vec2<u32>(mip), vec2<u32>(1u));
-            depths = textureLoad(tile_pyramid, vec2<i32>(min(block, mip_size - 1u)), i32(mip)).xy;
+            pyramid_texel = vec2<i32>(min(block, mip_size - 1u));
+            depths = textureLoad(tile_pyramid, pyramid_texel, i32(mip));
             compared = compared_bounds(receiver, tile_uv(lo + 0.5, scale), tile_uv(hi - 0.5, scale));
         }
         if (compared.y <= depths.x) {
@@ -383,6 +423,15 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
             sums.covered += area;
         } else if (compared.x > depths.y) {
             // Every texel in front of the receiver: occluding.
+            sums.covered += area;
+        } else if (depths.z < depths.w && compared.x > depths.z && compared.y <= depths.w && inside_filter(shape, lo, hi)) {
+            // Two layers, the receiver between them: the near cluster's texels occlude, the far
+            // cluster's are lit, and inside the filter each weighs one texel, so the lit area is
+            // the far cluster's texel count (its near_count, one more read).
+            let near_count = textureLoad(tile_near_counts, pyramid_texel, i32(mip)).x;
+            sums.reads += 1u;
+            let texels = u32(hi.x - lo.x) * u32(hi.y - lo.y);
+            sums.visible += f32(texels - near_count);
             sums.covered += area;
         } else if (steps >= MAX_WALK_STEPS) {
             // The cap (reported): the block counted half lit rather than walked further.
@@ -427,12 +476,21 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
     return sums;
 }
 
-// Records one filter evaluation's texel reads (with COUNT_READS, the settings' count_reads).
-fn record_filter_reads(pixel: vec2<u32>, reads: u32) {
+// Records one invocation's texel reads (with COUNT_READS, the settings' count_reads), one per
+// textureLoad or per element of a per-pixel storage array (ReadCounts' convention): every
+// invocation reads its pixel's kernel record (step 3's output); one that filters (`filtered`) also
+// the G-buffer's two texels, its accumulated sums (the tiles' before it) and the walk's
+// `walk_reads`, which the walk counter keeps apart (pvsm_texels_filtered).
+fn record_filter_reads(pixel: vec2<u32>, walk_reads: u32, filtered: bool) {
     if (COUNT_READS) {
         let word = read_count_word(READ_COUNTER_TILE_FILTER, vec2<i32>(pixel));
         atomicAdd(&read_counts[word], 1u);
-        atomicAdd(&read_counts[word + 1u], reads);
+        atomicAdd(&read_counts[word + 1u], select(1u, 4u + walk_reads, filtered));
+        if (filtered) {
+            let walk_word = read_count_word(READ_COUNTER_TILE_FILTER_WALK, vec2<i32>(pixel));
+            atomicAdd(&read_counts[walk_word], 1u);
+            atomicAdd(&read_counts[walk_word + 1u], walk_reads);
+        }
     }
 }
 
@@ -445,6 +503,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.y * size.x + id.x;
     let kernel = kernels[index];
     if (kernel.flags != KERNEL_ACTIVE) {
+        record_filter_reads(id.xy, 0u, false);
         return;
     }
     let point = screen_point_at(vec2<i32>(id.xy));
@@ -467,7 +526,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
         if (sums.capped) {
             capped[index] = 1u;
         }
-        record_filter_reads(id.xy, sums.reads);
+        record_filter_reads(id.xy, sums.reads, true);
         return;
     }
     // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
@@ -494,7 +553,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any_capped) {
         capped[index] = 1u;
     }
-    record_filter_reads(id.xy, reads);
+    record_filter_reads(id.xy, reads, true);
 }
 
 // The final visibility (Sec. 5.2's merge: V = Σ V·A / Σ A) into the framework's target.
@@ -509,6 +568,12 @@ fn pvsm_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.y * size.x + id.x;
     let kernel = kernels[index];
     var value = 1.0;
+    if (COUNT_READS) {
+        // The pixel's kernel record, and a filtered pixel's sums and capped flag.
+        let word = read_count_word(READ_COUNTER_RESOLVE, vec2<i32>(id.xy));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], select(1u, 3u, kernel.flags == KERNEL_ACTIVE));
+    }
     if (kernel.flags == KERNEL_DARK) {
         value = 0.0;
     } else if (kernel.flags == KERNEL_ACTIVE) {

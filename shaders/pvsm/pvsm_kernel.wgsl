@@ -28,8 +28,9 @@
 const READ_COUNTER_KERNEL_SHAPE: u32 = 1u;
 const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 2u;
 
-// Records one pixel's texel reads (one per textureLoad of the low-resolution map, ReadCounts'
-// convention) and atomics, with COUNT_READS (the settings' count_reads).
+// Records one pixel's texel reads (one per textureLoad, ReadCounts' convention: the G-buffer's two
+// at every pixel, trivial ones included, and the low-resolution map's) and atomics, with
+// COUNT_READS (the settings' count_reads).
 fn record_kernel_work(pixel: vec2<u32>, reads: u32, atomics: u32) {
     if (COUNT_READS) {
         let word = read_count_word(READ_COUNTER_KERNEL_SHAPE, vec2<i32>(pixel));
@@ -89,6 +90,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     if (trivial >= 0.0) {
         kernel.flags = select(0u, KERNEL_DARK, trivial == 0.0);
         kernels[index] = kernel;
+        // The G-buffer's two texels.
+        record_kernel_work(id.xy, 2u, 0u);
         return;
     }
     let uvd = light_uv_depth(frame, point.position);
@@ -115,7 +118,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     // edge still finds it (the parallel-square test's penumbra error rises from 0.0175 to 0.0197
     // without it).
     let nearest = textureLoad(low_res_map, vec2<i32>(0), i32(levels - 1u)).x;
-    var reads = 1u;
+    // The G-buffer's two texels and this one.
+    var reads = 3u;
     let search = light_half_extent_uv(frame, clamp(0.98 * nearest, frame.projection.z, d), d);
     let n = max(settings.blocker_kernel, 1u);
     let span = max(2.0 * search * base_size, vec2<f32>(1.0));

@@ -1,9 +1,19 @@
-// PVSM step 8's hierarchy: one level of the min/max depth pyramid of a tile's map, which the filter
-// walks top-down (pvsm_filter.wgsl's walk_hierarchy). Level l's texel (i, j) holds the nearest and
-// farthest depth of the tile map's texels [2^l i, 2^l (i + 1)) × [2^l j, 2^l (j + 1)) inside the tile's
-// region (the top-left tile.size texels of the map), from the four texels of level l - 1 below it:
-// a block whose depths all lie on one side of the receiver adds its covered area at once (Eq. 2).
-// One compute pass per level, level 1 from the map itself.
+// PVSM step 8's hierarchy: one level of the two-layer min/max depth pyramid of a tile's map, which
+// the filter walks top-down (pvsm_filter.wgsl's walk_hierarchy). Level l's texel (i, j) describes
+// the tile map's texels [2^l i, 2^l (i + 1)) × [2^l j, 2^l (j + 1)) inside the tile's region (the
+// top-left tile.size texels of the map), from the four texels of level l - 1 below it:
+// - (nearest, farthest): their depths' range. A block whose depths all lie on one side of the
+//   receiver adds its covered area at once (Eq. 2).
+// - (near_max, far_min) and near_count: where near_max < far_min, the block is two layers: every
+//   one of its texels is at or nearer than near_max (near_count of them: the near cluster) or at
+//   or farther than far_min (the far cluster), split at the widest gap between its depths that
+//   the children's own clusters show; a bar over a floor is two layers. A block lying entirely
+//   inside a filter (every texel weighing its whole area) whose receiver is behind the near
+//   cluster and in front of the far one adds its lit area, its far texels, at once. Otherwise
+//   (no gap: one layer) near_max = far_min = farthest and near_count is every texel.
+// Exact, not estimated: each child's clusters are intervals holding a known number of texels, and
+// the parent's gap is a depth interval that no child's interval enters, so the texels below it are
+// counted exactly. One compute pass per level, level 1 from the map itself.
 
 // #import common/read_counts.wgsl
 
@@ -21,7 +31,7 @@ struct TileSettings {
 struct PyramidLevel {
     // The level written (1 or more); its texels are in mip level - 1 of the pyramid.
     level: u32,
-    // 1: the level below is the tile map (one depth per texel); 0: a pyramid level (nearest, farthest).
+    // 1: the level below is the tile map (one depth per texel); 0: a pyramid level.
     from_map: u32,
     _pad0: u32,
     _pad1: u32,
@@ -29,11 +39,15 @@ struct PyramidLevel {
 
 @group(0) @binding(0) var<uniform> tile: TileSettings;
 @group(1) @binding(0) var<uniform> pyramid_level: PyramidLevel;
+// The level below: the tile map (depth in x), or (nearest, farthest, near_max, far_min).
 @group(1) @binding(1) var finer: texture_2d<f32>;
-@group(1) @binding(2) var coarser: texture_storage_2d<rg32float, write>;
+@group(1) @binding(2) var coarser: texture_storage_2d<rgba32float, write>;
 // ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_PYRAMID (reads) and
 // READ_COUNTER_TILE_PYRAMID_BYTES (bytes written).
 @group(1) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+// The level below's near_count (unread when it is the map).
+@group(1) @binding(4) var finer_counts: texture_2d<u32>;
+@group(1) @binding(5) var coarser_counts: texture_storage_2d<r32uint, write>;
 
 // The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
 const READ_COUNTER_TILE_PYRAMID: u32 = 4u;
@@ -46,6 +60,15 @@ fn level_size(level: u32) -> vec2<u32> {
     return (size + block - 1u) / block;
 }
 
+// The region's texels in block `block` of `level` (fewer on the region's right and bottom edges).
+fn block_texels(level: u32, block: vec2<u32>) -> u32 {
+    let size = vec2<u32>(tile.size);
+    let side = 1u << level;
+    let start = min(block * side, size);
+    let span = min(size - start, vec2<u32>(side));
+    return span.x * span.y;
+}
+
 @compute @workgroup_size(8, 8)
 fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
     let level = pyramid_level.level;
@@ -53,29 +76,96 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let below = level_size(level - 1u);
+    // The children's depth intervals, [low, high] holding `texels` texels each: one per child, or two
+    // for a two-layer child (its near and far clusters).
+    var lows: array<f32, 8>;
+    var highs: array<f32, 8>;
+    var texels: array<u32, 8>;
+    var intervals = 0u;
     var nearest = NO_SURFACE;
     var farthest = -NO_SURFACE;
+    var total = 0u;
     var reads = 0u;
     for (var dy = 0u; dy < 2u; dy++) {
         for (var dx = 0u; dx < 2u; dx++) {
             let texel = 2u * id.xy + vec2<u32>(dx, dy);
             // A block on the region's right or bottom edge has fewer texels below it.
-            if (all(texel < below)) {
-                let depths = textureLoad(finer, vec2<i32>(texel), 0);
-                nearest = min(nearest, depths.x);
-                farthest = max(farthest, select(depths.y, depths.x, pyramid_level.from_map != 0u));
+            if (!all(texel < below)) {
+                continue;
+            }
+            let child = textureLoad(finer, vec2<i32>(texel), 0);
+            reads += 1u;
+            if (pyramid_level.from_map != 0u) {
+                lows[intervals] = child.x;
+                highs[intervals] = child.x;
+                texels[intervals] = 1u;
+                intervals += 1u;
+                nearest = min(nearest, child.x);
+                farthest = max(farthest, child.x);
+                total += 1u;
+                continue;
+            }
+            let child_texels = block_texels(level - 1u, texel);
+            nearest = min(nearest, child.x);
+            farthest = max(farthest, child.y);
+            total += child_texels;
+            if (child.z < child.w) {
+                let near_count = textureLoad(finer_counts, vec2<i32>(texel), 0).x;
                 reads += 1u;
+                lows[intervals] = child.x;
+                highs[intervals] = child.z;
+                texels[intervals] = near_count;
+                lows[intervals + 1u] = child.w;
+                highs[intervals + 1u] = child.y;
+                texels[intervals + 1u] = child_texels - near_count;
+                intervals += 2u;
+            } else {
+                lows[intervals] = child.x;
+                highs[intervals] = child.y;
+                texels[intervals] = child_texels;
+                intervals += 1u;
             }
         }
     }
-    textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest, farthest, 0.0, 0.0));
+    // The widest gap: an interval's top `cut` such that every interval lies at or below it or
+    // starts past it, to the lowest start past it. The texels at or below it are the near cluster.
+    var near_max = farthest;
+    var far_min = farthest;
+    var near_count = total;
+    var widest = 0.0;
+    for (var k = 0u; k < intervals; k++) {
+        let cut = highs[k];
+        var next = NO_SURFACE;
+        var above = false;
+        var splits = true;
+        var under = 0u;
+        for (var j = 0u; j < intervals; j++) {
+            if (lows[j] > cut) {
+                next = select(lows[j], min(next, lows[j]), above);
+                above = true;
+            } else if (highs[j] > cut) {
+                splits = false;
+            } else {
+                under += texels[j];
+            }
+        }
+        if (splits && above && next - cut > widest) {
+            widest = next - cut;
+            near_max = cut;
+            far_min = next;
+            near_count = under;
+        }
+    }
+    textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest, farthest, near_max, far_min));
+    textureStore(coarser_counts, vec2<i32>(id.xy), vec4<u32>(near_count, 0u, 0u, 0u));
     if (COUNT_READS) {
-        // Texel reads as ReadCounts counts them (one per textureLoad); 8 bytes written per texel.
+        // Texel reads as ReadCounts counts them (one per textureLoad: a child's depths, and its
+        // near_count where it is two layers); 20 bytes written per texel (16 + 4).
         let word = read_count_word(READ_COUNTER_TILE_PYRAMID, vec2<i32>(id.xy));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
         let bytes_word = read_count_word(READ_COUNTER_TILE_PYRAMID_BYTES, vec2<i32>(id.xy));
         atomicAdd(&read_counts[bytes_word], 1u);
-        atomicAdd(&read_counts[bytes_word + 1u], 8u);
+        atomicAdd(&read_counts[bytes_word + 1u], 20u);
     }
 }

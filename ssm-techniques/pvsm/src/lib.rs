@@ -65,9 +65,13 @@ const TILE_PYRAMID_SHADER: &str = ssm_shaders::pvsm::PVSM_TILE_PYRAMID;
 
 /// The work the passes count with `count_reads` ([`ReadCounts`]), in the order the shaders index
 /// them: `(WGSL constant, shader, pass, unit)`. A texel read is one texel fetched (a `textureLoad`,
-/// or one element of a storage array read as a map's texel); the tile maps' texels written are
-/// the `pvsm_texels_rendered` diagnostic, counted on the CPU from the tiles' sizes.
-const READ_COUNTERS: [(&str, &str, &str, &str); 7] = [
+/// or one element of a storage array read as a map's texel or a pixel's record), every read of
+/// every invocation, the G-buffer's two texels included. `pvsm_tile_filter_walk` is no pass: the
+/// filter's walk's reads alone per filter evaluation (unit `texels`, a diagnostic only), whose total
+/// is `pvsm_texels_filtered`. The tile maps' texels rendered are the `pvsm_texels_rendered`
+/// diagnostic, counted on the CPU from the tiles' sizes; the bytes the render passes store to
+/// them the framework counts as target bytes.
+const READ_COUNTERS: [(&str, &str, &str, &str); 9] = [
     ("READ_COUNTER_LOW_RES_MIPS", MIPS_SHADER, "pvsm_low_res_mips", "reads"),
     ("READ_COUNTER_KERNEL_SHAPE", KERNEL_SHADER, "pvsm_kernel_shape", "reads"),
     ("READ_COUNTER_KERNEL_SHAPE_ATOMICS", KERNEL_SHADER, "pvsm_kernel_shape", "atomics"),
@@ -75,6 +79,8 @@ const READ_COUNTERS: [(&str, &str, &str, &str); 7] = [
     ("READ_COUNTER_TILE_PYRAMID", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "reads"),
     ("READ_COUNTER_TILE_PYRAMID_BYTES", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "storage_bytes"),
     ("READ_COUNTER_TILE_FILTER", FILTER_SHADER, "pvsm_tile_filter", "reads"),
+    ("READ_COUNTER_TILE_FILTER_WALK", FILTER_SHADER, "pvsm_tile_filter_walk", "texels"),
+    ("READ_COUNTER_RESOLVE", FILTER_SHADER, "pvsm_resolve", "reads"),
 ];
 
 /// How the low-resolution map is rasterised conservatively (step 2).
@@ -417,21 +423,44 @@ struct TileSlot {
     filter_groups: Vec<wgpu::BindGroup>,
 }
 
-/// Step 8's min/max depth pyramid of the current tile's map: mip m holds level m + 1 (blocks of
-/// 2^(m+1) texels a side) as (nearest, farthest), for the tile's region only. One texture serves
-/// every tile, rebuilt before each tile's filter; its side is half the largest tile map's side
-/// rounded up to a power of two, so that level l holds ceil(size / 2^l) texels of any region.
+/// Step 8's two-layer min/max depth pyramid of the current tile's map: mip m holds level m + 1
+/// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), its near_count in
+/// a second texture of the same mips, for the tile's region only (`pvsm_tile_pyramid.wgsl`). One
+/// pair serves every tile, rebuilt before each tile's filter; its side is half the largest tile
+/// map's side rounded up to a power of two, so that level l holds ceil(size / 2^l) texels of any
+/// region.
 struct TilePyramid {
     /// Every mip, for the filter.
     view: wgpu::TextureView,
+    /// Every mip of the near counts, for the filter.
+    counts_view: wgpu::TextureView,
     /// Per tile map size: level 1's group, reading that map.
     first_level: Vec<wgpu::BindGroup>,
     /// Levels 2, 3...: each reading the mip below.
     upper_levels: Vec<wgpu::BindGroup>,
 }
 
+/// The format of the tile pyramid's depths: (nearest, farthest, near_max, far_min).
+const TILE_PYRAMID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The format of its near counts.
+const TILE_PYRAMID_COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// A bind-group-layout entry for a `texture_2d<u32>` read with `textureLoad`.
+const fn uint_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 impl TilePyramid {
-    /// The pyramid for maps up to `largest` texels a side, and its level groups; a 1×1 texture that
+    /// The pyramid for maps up to `largest` texels a side, and its level groups; 1×1 textures that
     /// no pass reads when the filter does not walk it (`built` false).
     fn new(
         device: &wgpu::Device,
@@ -443,19 +472,24 @@ impl TilePyramid {
     ) -> Self {
         let side = if built { (largest.next_power_of_two() / 2).max(1) } else { 1 };
         let mips = side.ilog2() + 1;
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("pvsm_tile_pyramid"),
-            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
-            mip_level_count: mips,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rg32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
-            view_formats: &[],
-        });
-        let mip_view = |mip: u32| {
+        let texture = |label: &str, format: wgpu::TextureFormat, side: u32, mips: u32| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+                mip_level_count: mips,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let depths = texture("pvsm_tile_pyramid", TILE_PYRAMID_FORMAT, side, mips);
+        let counts = texture("pvsm_tile_pyramid_near_counts", TILE_PYRAMID_COUNTS_FORMAT, side, mips);
+        let mip_view = |texture: &wgpu::Texture, mip: u32| {
+            let name = if texture.format() == TILE_PYRAMID_FORMAT { "pvsm_tile_pyramid" } else { "pvsm_tile_pyramid_near_counts" };
             texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some(&format!("pvsm_tile_pyramid_mip{mip}_view")),
+                label: Some(&format!("{name}_mip{mip}_view")),
                 base_mip_level: mip,
                 mip_level_count: Some(1),
                 ..Default::default()
@@ -466,6 +500,9 @@ impl TilePyramid {
             uniform_buffer(device, &format!("pvsm_tile_pyramid_level{level}_uniform"), &value)
         };
         let (first_level, upper_levels) = if built {
+            // Level 1 reads the map, not counts: a 1×1 texture stands in for them.
+            let no_counts = texture("pvsm_tile_pyramid_no_counts", TILE_PYRAMID_COUNTS_FORMAT, 1, 1);
+            let no_counts_view = ssm_core::passes::labelled_view(&no_counts, "pvsm_tile_pyramid_no_counts_view");
             let first_uniform = level_uniform(1, true);
             let first = maps
                 .iter()
@@ -477,8 +514,10 @@ impl TilePyramid {
                         &[
                             first_uniform.as_entire_binding(),
                             wgpu::BindingResource::TextureView(&map.linear_depth_view),
-                            wgpu::BindingResource::TextureView(&mip_view(0)),
+                            wgpu::BindingResource::TextureView(&mip_view(&depths, 0)),
                             read_counts.buffer().as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&no_counts_view),
+                            wgpu::BindingResource::TextureView(&mip_view(&counts, 0)),
                         ],
                     )
                 })
@@ -491,9 +530,11 @@ impl TilePyramid {
                         layout,
                         &[
                             level_uniform(level, false).as_entire_binding(),
-                            wgpu::BindingResource::TextureView(&mip_view(level - 2)),
-                            wgpu::BindingResource::TextureView(&mip_view(level - 1)),
+                            wgpu::BindingResource::TextureView(&mip_view(&depths, level - 2)),
+                            wgpu::BindingResource::TextureView(&mip_view(&depths, level - 1)),
                             read_counts.buffer().as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&mip_view(&counts, level - 2)),
+                            wgpu::BindingResource::TextureView(&mip_view(&counts, level - 1)),
                         ],
                     )
                 })
@@ -502,7 +543,12 @@ impl TilePyramid {
         } else {
             (Vec::new(), Vec::new())
         };
-        Self { view: ssm_core::passes::labelled_view(&texture, "pvsm_tile_pyramid_all_levels"), first_level, upper_levels }
+        Self {
+            view: ssm_core::passes::labelled_view(&depths, "pvsm_tile_pyramid_all_levels"),
+            counts_view: ssm_core::passes::labelled_view(&counts, "pvsm_tile_pyramid_near_counts_all_levels"),
+            first_level,
+            upper_levels,
+        }
     }
 }
 
@@ -785,6 +831,7 @@ impl PredictedVirtualShadowMaps {
                                         resource: wgpu::BindingResource::TextureView(&map.linear_depth_view),
                                     },
                                     wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&pyramid.view) },
+                                    wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&pyramid.counts_view) },
                                 ],
                             })
                         })
@@ -1036,7 +1083,11 @@ impl Layouts {
                     ReadCounts::layout_entry(6),
                 ],
             ),
-            tile: bind_group_layout(device, "pvsm_tile_layout", &[uniform_entry(0), texture_entry(1), texture_entry(3)]),
+            tile: bind_group_layout(
+                device,
+                "pvsm_tile_layout",
+                &[uniform_entry(0), texture_entry(1), texture_entry(3), uint_texture_entry(4)],
+            ),
             tile_pyramid_tile: bind_group_layout(device, "pvsm_tile_pyramid_tile_layout", &[uniform_entry(0)]),
             tile_pyramid_level: bind_group_layout(
                 device,
@@ -1044,8 +1095,10 @@ impl Layouts {
                 &[
                     uniform_entry(0),
                     texture_entry(1),
-                    write_storage_texture_entry(2, wgpu::TextureFormat::Rg32Float),
+                    write_storage_texture_entry(2, TILE_PYRAMID_FORMAT),
                     ReadCounts::layout_entry(3),
+                    uint_texture_entry(4),
+                    write_storage_texture_entry(5, TILE_PYRAMID_COUNTS_FORMAT),
                 ],
             ),
             cull: bind_group_layout(
@@ -1135,7 +1188,7 @@ impl Pipelines {
                 &filter_module,
                 "pvsm_resolve",
                 &[screen[0], screen[1], &layouts.common, &layouts.resolve],
-                &[],
+                &counting,
             ),
             cull: compute_pipeline(
                 device,
@@ -1288,10 +1341,10 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
             }
         }
         let counted = self.read_counts.diagnostics(gpu);
-        // The filter's reads over the frame: its reads per evaluation times its evaluations (a
-        // pixel's filter is evaluated once per tile it reaches); 0 when no pixel was filtered.
-        let per_evaluation = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_reads_per_pixel").map(|(_, v)| *v);
-        let evaluations = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_pixels").map(|(_, v)| *v);
+        // The texels the filter's walks read over the frame: per evaluation times the evaluations
+        // (a pixel's filter is evaluated once per tile it reaches); 0 when no pixel was filtered.
+        let per_evaluation = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_walk_texels_per_pixel").map(|(_, v)| *v);
+        let evaluations = counted.iter().find(|(key, _)| key == "pvsm_tile_filter_walk_pixels").map(|(_, v)| *v);
         if self.counting {
             out.push(("pvsm_texels_filtered".to_owned(), (per_evaluation.unwrap_or(0.0) * evaluations.unwrap_or(0.0)).round()));
         }
@@ -1299,21 +1352,12 @@ impl ShadowTechnique for PredictedVirtualShadowMaps {
         out
     }
 
-    /// The shaders' counts (`READ_COUNTERS`), and the tile maps' texels: step 7 renders
-    /// `pvsm_texels_rendered` texels, each one 4-byte linear depth written (the paper's measure of
-    /// the tiles' cost, Fig. 10), counted from the tiles' sizes as `pvsm_tile_map`'s storage bytes.
+    /// The shaders' counts (`READ_COUNTERS`). The tile maps' texels rendered (the paper's measure
+    /// of the tiles' cost, Fig. 10) are the `pvsm_texels_rendered` diagnostic only: `pvsm_tile_map`
+    /// is a render pass, whose fragments the pipeline statistics count and whose stores to its
+    /// attachments the framework counts as target bytes.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
-        let Some(mut work) = self.read_counts.work(gpu)? else {
-            return Ok(None);
-        };
-        let texels: u64 = self.last.tilings.iter().flat_map(|t| &t.tiles).map(|t| u64::from(t.size.x) * u64::from(t.size.y)).sum();
-        work.push(ssm_core::ShaderWork {
-            pass: "pvsm_tile_map".to_owned(),
-            invocations: texels,
-            storage_bytes: 4 * texels,
-            ..ssm_core::ShaderWork::default()
-        });
-        Ok(Some(work))
+        self.read_counts.work(gpu)
     }
 
     /// `tiles`: each pixel shaded by the tile its filter's centre falls in (Fig. 10's inset), of the

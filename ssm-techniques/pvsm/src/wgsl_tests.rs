@@ -13,11 +13,12 @@ use ssm_core::{GpuContext, LightFrameUniform, Settings};
 
 use crate::prediction::{self, DYNAMIC_PEAK, Prediction};
 use crate::{
-    FILTER_SHADER, LOCAL_SHADERS, PvsmSettings, PvsmSettingsUniform, TILE_PYRAMID_SHADER, TilePyramidLevelUniform, TileSettingsUniform,
+    FILTER_SHADER, LOCAL_SHADERS, PvsmSettings, PvsmSettingsUniform, TILE_PYRAMID_COUNTS_FORMAT, TILE_PYRAMID_FORMAT, TILE_PYRAMID_SHADER,
+    TilePyramidLevelUniform, TileSettingsUniform, uint_texture_entry,
 };
 
 /// The test entry points. Inputs and outputs are `vec4<f32>`s; group 3's bindings 5 and 6 are free in
-/// the filter module (0, 1 and 3 hold the tile, its map and its pyramid, 2 the resolve pass's target).
+/// the filter module (0, 1, 3 and 4 hold the tile, its map and its pyramid, 2 the resolve pass's target).
 const TEST_ENTRY_POINTS: &str = r"
 @group(3) @binding(5) var<storage, read> test_in: array<vec4<f32>>;
 @group(3) @binding(6) var<storage, read_write> test_out: array<vec4<f32>>;
@@ -104,9 +105,9 @@ impl Tile {
     }
 }
 
-/// Builds `tile`'s min/max pyramid with `pvsm_tile_pyramid.wgsl`, as the technique does before each
-/// tile's filter: levels 1 to ceil(log2 of the region's longer side).
-fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid: &wgpu::Texture) {
+/// Builds `tile`'s two-layer min/max pyramid (depths and near counts) with `pvsm_tile_pyramid.wgsl`,
+/// as the technique does before each tile's filter: levels 1 to ceil(log2 of the region's longer side).
+fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid: &wgpu::Texture, counts: &wgpu::Texture) {
     let device = &gpu.device;
     let module = ssm_core::shader::create_shader_with_imports(gpu, "pvsm_test_pyramid_module", TILE_PYRAMID_SHADER, LOCAL_SHADERS).unwrap();
     let tile_layout = bind_group_layout(device, "pvsm_test_pyramid_tile_layout", &[uniform_entry(0)]);
@@ -116,31 +117,46 @@ fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid
         &[
             uniform_entry(0),
             texture_entry(1),
-            write_storage_texture_entry(2, wgpu::TextureFormat::Rg32Float),
+            write_storage_texture_entry(2, TILE_PYRAMID_FORMAT),
             ssm_core::read_counts::ReadCounts::layout_entry(3),
+            uint_texture_entry(4),
+            write_storage_texture_entry(5, TILE_PYRAMID_COUNTS_FORMAT),
         ],
     );
     let pipeline =
         ssm_core::passes::compute_pipeline(device, "pvsm_test_pyramid", &module, "pvsm_tile_pyramid", &[&tile_layout, &level_layout], &[]);
-    let counts = ssm_core::read_counts::ReadCounts::new(device, "pvsm_test_pyramid_counts", &["pyramid"], false);
+    let read_counts = ssm_core::read_counts::ReadCounts::new(device, "pvsm_test_pyramid_counts", &["pyramid"], false);
     let tile_uniform = ssm_core::passes::uniform_buffer(device, "pvsm_test_pyramid_tile", &tile.uniform);
     let tile_group =
         ssm_core::passes::bind_group(device, "pvsm_test_pyramid_tile_group", &tile_layout, &[tile_uniform.as_entire_binding()]);
-    let mip = |level: u32| {
-        pyramid.create_view(&wgpu::TextureViewDescriptor {
+    let mip = |texture: &wgpu::Texture, level: u32| {
+        texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("pvsm_test_pyramid_mip"),
             base_mip_level: level,
             mip_level_count: Some(1),
             ..Default::default()
         })
     };
+    // Level 1 reads the map, not counts.
+    let no_counts = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("pvsm_test_pyramid_no_counts"),
+        size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: TILE_PYRAMID_COUNTS_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
     let longer = tile.uniform.size[0].max(tile.uniform.size[1]) as u32;
     let levels = longer.max(2).next_power_of_two().ilog2();
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pvsm_test_pyramid_encoder") });
     for level in 1..=levels {
         let value = TilePyramidLevelUniform { level, from_map: u32::from(level == 1), _pad0: 0, _pad1: 0 };
         let uniform = ssm_core::passes::uniform_buffer(device, "pvsm_test_pyramid_level", &value);
-        let finer = if level == 1 { map.clone() } else { mip(level - 2) };
+        let finer = if level == 1 { map.clone() } else { mip(pyramid, level - 2) };
+        let finer_counts =
+            if level == 1 { ssm_core::passes::labelled_view(&no_counts, "pvsm_test_no_counts") } else { mip(counts, level - 2) };
         let group = ssm_core::passes::bind_group(
             device,
             "pvsm_test_pyramid_level_group",
@@ -148,8 +164,10 @@ fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid
             &[
                 uniform.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&finer),
-                wgpu::BindingResource::TextureView(&mip(level - 1)),
-                counts.buffer().as_entire_binding(),
+                wgpu::BindingResource::TextureView(&mip(pyramid, level - 1)),
+                read_counts.buffer().as_entire_binding(),
+                wgpu::BindingResource::TextureView(&finer_counts),
+                wgpu::BindingResource::TextureView(&mip(counts, level - 1)),
             ],
         );
         let texels = (longer + (1 << level) - 1) >> level;
@@ -174,7 +192,7 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
     let tile_layout = bind_group_layout(
         device,
         "pvsm_test_tile_layout",
-        &[uniform_entry(0), texture_entry(1), texture_entry(3), storage_entry(5, true), storage_entry(6, false)],
+        &[uniform_entry(0), texture_entry(1), texture_entry(3), uint_texture_entry(4), storage_entry(5, true), storage_entry(6, false)],
     );
     let pipeline = ssm_core::passes::compute_pipeline(
         device,
@@ -211,20 +229,25 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
     let view = ssm_core::passes::labelled_view(&texture, "pvsm_test_tile_map_view");
     // The pyramid as the technique sizes it: half the map's side, one mip per level.
     let pyramid_side = (tile.side / 2).max(1);
-    let pyramid = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("pvsm_test_tile_pyramid"),
-        size: wgpu::Extent3d { width: pyramid_side, height: pyramid_side, depth_or_array_layers: 1 },
-        mip_level_count: pyramid_side.ilog2() + 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rg32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
-        view_formats: &[],
-    });
+    let pyramid_texture = |label: &str, format: wgpu::TextureFormat| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: pyramid_side, height: pyramid_side, depth_or_array_layers: 1 },
+            mip_level_count: pyramid_side.ilog2() + 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+            view_formats: &[],
+        })
+    };
+    let pyramid = pyramid_texture("pvsm_test_tile_pyramid", TILE_PYRAMID_FORMAT);
+    let counts = pyramid_texture("pvsm_test_tile_pyramid_near_counts", TILE_PYRAMID_COUNTS_FORMAT);
     if tile.side > 1 {
-        build_pyramid(gpu, tile, &view, &pyramid);
+        build_pyramid(gpu, tile, &view, &pyramid, &counts);
     }
     let pyramid_view = ssm_core::passes::labelled_view(&pyramid, "pvsm_test_tile_pyramid");
+    let counts_view = ssm_core::passes::labelled_view(&counts, "pvsm_test_tile_pyramid_near_counts");
     let group = |label: &str, layout: &wgpu::BindGroupLayout, entries: &[(u32, wgpu::BindingResource<'_>)]| {
         let entries: Vec<wgpu::BindGroupEntry<'_>> =
             entries.iter().map(|(binding, resource)| wgpu::BindGroupEntry { binding: *binding, resource: resource.clone() }).collect();
@@ -241,6 +264,7 @@ fn evaluate(gpu: &GpuContext, entry: &str, inputs: &[[f32; 4]], outputs: usize, 
                 (0, tile_uniform.as_entire_binding()),
                 (1, wgpu::BindingResource::TextureView(&view)),
                 (3, wgpu::BindingResource::TextureView(&pyramid_view)),
+                (4, wgpu::BindingResource::TextureView(&counts_view)),
                 (5, input.as_entire_binding()),
                 (6, output.as_entire_binding()),
             ],
@@ -506,17 +530,17 @@ fn test_frame() -> LightFrameUniform {
 
 /// Random filters over [`mixed_depths`], for receivers compared with their tangent planes: centres
 /// from a tenth of the region outside it to a tenth past it (filters straddling the tile's edges),
-/// half-widths from nothing (the texel under the point) to 40 texels, sheared as antialiasing makes
+/// half-widths from nothing (the texel under the point) to `largest` texels, sheared as antialiasing makes
 /// them, receivers at depths 1 to 2 tilted up to about 60° from the light (some nearly edge-on, where
 /// the plane's depth is unbounded over a block).
-fn random_filters(random: &mut Random, count: usize, texel: [f32; 2]) -> Vec<[f32; 4]> {
+fn random_filters(random: &mut Random, count: usize, texel: [f32; 2], largest: f32) -> Vec<[f32; 4]> {
     let mut inputs = Vec::new();
     for index in 0..count {
         let (u, v) = (random.range(-0.1, 1.1), random.range(-0.1, 1.1));
         let depth = random.range(1.0, 2.0);
-        let half = if index % 7 == 0 { 0.0 } else { random.range(0.0, 40.0) };
+        let half = if index % 7 == 0 { 0.0 } else { random.range(0.0, largest) };
         let shear = if index % 2 == 0 { 0.0 } else { random.range(-0.5, 0.5) * half };
-        let height = if index % 7 == 0 { 0.0 } else { random.range(0.0, 40.0) };
+        let height = if index % 7 == 0 { 0.0 } else { random.range(0.0, largest) };
         let tilt = if index % 11 == 0 { 1.55 } else { random.range(0.0, 1.0) };
         let turn = random.range(0.0, std::f32::consts::TAU);
         let normal = [tilt.sin() * turn.cos(), tilt.cos(), tilt.sin() * turn.sin()];
@@ -554,53 +578,154 @@ fn the_hierarchy_sums_what_every_texel_sums() {
     let (mut hierarchy_reads, mut texel_reads) = (0.0, 0.0);
     for (size, uv) in regions {
         let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
-        let mut inputs = random_filters(&mut random, 300, texel);
-        // The random centres spread over the region's rectangle of the frame.
-        for case in inputs.chunks_mut(4) {
-            case[0][0] = uv[0][0] + case[0][0] * (uv[1][0] - uv[0][0]);
-            case[0][1] = uv[0][1] + case[0][1] * (uv[1][1] - uv[0][1]);
-            let depth = case[1][1];
-            case[2] = [depth * (2.0 * case[0][0] - 1.0), -depth, depth * (2.0 * case[0][1] - 1.0), 0.0];
-        }
+        let inputs = spread_over(random_filters(&mut random, 300, texel, 40.0), uv);
         let tile = |walk: &str| Tile::new(64, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
         let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
         let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
-        let mut decided = [0usize; 3];
-        for (index, (h, t)) in walked.iter().zip(&every).enumerate() {
-            let texels = t[3];
-            let u = f32::EPSILON / 2.0;
-            let (half, shear) = (inputs[4 * index][2] / texel[0], inputs[4 * index][3] / texel[1]);
-            let slope = shear.abs() / half.abs().max(1e-3);
-            let texel_area = texel[0] * texel[1];
-            let sheared = if shear == 0.0 { 0.0 } else { 12.0 * u * 128.0 * (1.0 + slope) * texels * texel_area };
-            let tolerance = 2.0 * (texels + 10.0) * u * t[1].max(h[1]) + sheared;
-            assert!(
-                (h[0] - t[0]).abs() <= tolerance && (h[1] - t[1]).abs() <= tolerance,
-                "region {size:?}, filter {index} ({:?}): hierarchy (Σ c·o, Σ c) = ({}, {}), every texel ({}, {}); {texels} texels, tolerance {tolerance}",
-                &inputs[4 * index..4 * index + 4],
-                h[0],
-                h[1],
-                t[0],
-                t[1],
-            );
-            assert_eq!((h[2], t[2]), (0.0, 0.0), "no walk this small reaches the cap");
-            hierarchy_reads += h[3];
-            texel_reads += texels;
-            if t[1] > 0.0 {
-                decided[usize::from(t[0] > 0.0) + usize::from(t[0] >= t[1])] += 1;
-            }
-        }
-        println!("region {size:?}: {} filters in umbra, {} in penumbra, {} lit", decided[0], decided[1], decided[2]);
-        assert!(decided.iter().all(|count| *count >= 3), "every kind of filter is exercised: {decided:?}");
+        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("region {size:?}"));
+        hierarchy_reads += h;
+        texel_reads += t;
     }
     println!("texels read: hierarchy {hierarchy_reads}, every texel {texel_reads}");
     assert!(hierarchy_reads < texel_reads, "{hierarchy_reads} against {texel_reads}");
 }
 
+/// [`random_filters`]' centres, drawn over [0, 1]², moved into the region's rectangle `uv` of the
+/// frame, and their receivers' positions with them.
+fn spread_over(mut inputs: Vec<[f32; 4]>, uv: [[f32; 2]; 2]) -> Vec<[f32; 4]> {
+    for case in inputs.chunks_mut(4) {
+        case[0][0] = uv[0][0] + case[0][0] * (uv[1][0] - uv[0][0]);
+        case[0][1] = uv[0][1] + case[0][1] * (uv[1][1] - uv[0][1]);
+        let depth = case[1][1];
+        case[2] = [depth * (2.0 * case[0][0] - 1.0), -depth, depth * (2.0 * case[0][1] - 1.0), 0.0];
+    }
+    inputs
+}
+
+/// Asserts that the hierarchy's sums (`walked`) are the per-texel walk's (`every`) for each filter
+/// of `inputs` within the f32 bound of [`the_hierarchy_sums_what_every_texel_sums`], that no walk was
+/// capped, and that umbra, penumbra and lit filters are all among them; returns the texels each
+/// walk read.
+fn assert_walks_agree(inputs: &[[f32; 4]], walked: &[[f32; 4]], every: &[[f32; 4]], texel: [f32; 2], label: &str) -> (f32, f32) {
+    let (mut hierarchy_reads, mut texel_reads) = (0.0, 0.0);
+    let mut decided = [0usize; 3];
+    for (index, (h, t)) in walked.iter().zip(every).enumerate() {
+        let texels = t[3];
+        let u = f32::EPSILON / 2.0;
+        let (half, shear) = (inputs[4 * index][2] / texel[0], inputs[4 * index][3] / texel[1]);
+        let slope = shear.abs() / half.abs().max(1e-3);
+        let texel_area = texel[0] * texel[1];
+        let sheared = if shear == 0.0 { 0.0 } else { 12.0 * u * 128.0 * (1.0 + slope) * texels * texel_area };
+        let tolerance = 2.0 * (texels + 10.0) * u * t[1].max(h[1]) + sheared;
+        assert!(
+            (h[0] - t[0]).abs() <= tolerance && (h[1] - t[1]).abs() <= tolerance,
+            "{label}, filter {index} ({:?}): hierarchy (Σ c·o, Σ c) = ({}, {}), every texel ({}, {}); {texels} texels, tolerance {tolerance}",
+            &inputs[4 * index..4 * index + 4],
+            h[0],
+            h[1],
+            t[0],
+            t[1],
+        );
+        assert_eq!((h[2], t[2]), (0.0, 0.0), "{label}: no walk this small reaches the cap");
+        hierarchy_reads += h[3];
+        texel_reads += texels;
+        if t[1] > 0.0 {
+            decided[usize::from(t[0] > 0.0) + usize::from(t[0] >= t[1])] += 1;
+        }
+    }
+    println!(
+        "{label}: {} filters in umbra, {} in penumbra, {} lit; texels read: hierarchy {hierarchy_reads}, every texel {texel_reads}",
+        decided[0], decided[1], decided[2]
+    );
+    assert!(decided.iter().all(|count| *count >= 3), "{label}: every kind of filter is exercised: {decided:?}");
+    (hierarchy_reads, texel_reads)
+}
+
+/// A 128² map of bars over a floor, as thin geometry under a large light gives the filter: a floor
+/// whose depth ramps from 2.5 to 3 across the map (behind every receiver, not parallel to the
+/// light's plane), 24 bars 1 to 6 texels wide and 10 to 100 long, across or along the map, most at
+/// depths 0.3 to 0.9 (in front of every receiver) and a third at 1.2 to 1.8 (between the
+/// receivers' depths: three layers, where the widest gap need not hold the receiver), crossing
+/// each other.
+fn bars_over_a_floor(random: &mut Random) -> Vec<f32> {
+    let side = 128usize;
+    let mut depths: Vec<f32> = (0..side * side).map(|i| 2.5 + 0.5 * (i % side) as f32 / side as f32).collect();
+    for index in 0..24 {
+        let depth = if index % 3 == 2 { random.range(1.2, 1.8) } else { random.range(0.3, 0.9) };
+        let (width, length) = (1 + (random.next() * 6.0) as usize, 10 + (random.next() * 90.0) as usize);
+        let (w, h) = if index % 2 == 0 { (length, width) } else { (width, length) };
+        let (x, y) = ((random.next() * side as f32) as usize, (random.next() * side as f32) as usize);
+        for row in y..(y + h).min(side) {
+            for column in x..(x + w).min(side) {
+                depths[row * side + column] = depth;
+            }
+        }
+    }
+    depths
+}
+
+/// The two-layer blocks are exact: over [`bars_over_a_floor`], 300 random filters (half-axes up to 60
+/// texels, so that blocks of up to 32² lie inside them; sheared; receivers' tangent planes at
+/// depths 1 to 2, tilted up to nearly edge-on) on the whole 128² map and on a 100 × 77 region of a
+/// smaller rectangle of the frame (blocks past the region's edges, whose near counts hold the
+/// region's texels only) give the per-texel sums within the bound of
+/// [`the_hierarchy_sums_what_every_texel_sums`], for fewer reads.
+#[test]
+fn the_two_layer_hierarchy_sums_what_every_texel_sums_over_bars() {
+    let gpu = ssm_testing::gpu();
+    let mut random = Random(0x2545_f491);
+    let depths = bars_over_a_floor(&mut random);
+    let regions = [([128.0f32, 128.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([100.0, 77.0], [[0.15, 0.1], [0.8, 0.9]])];
+    for (size, uv) in regions {
+        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
+        let inputs = spread_over(random_filters(&mut random, 300, texel, 60.0), uv);
+        let tile = |walk: &str| Tile::new(128, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
+        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
+        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
+        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("bars, region {size:?}"));
+        assert!(h < t, "{h} against {t}");
+    }
+}
+
+/// A bar over a floor under a filter covering the whole 64² tile (centre 32, half-axes 33 texels:
+/// every texel weighs its whole area), a receiver at depth 1 compared with its own depth. The walk
+/// starts at the four 32² blocks (level 5). One bar at 0.5 over columns 8 to 11, the floor at 3: the
+/// two left blocks are two layers with the receiver between (one read each, and one for its near
+/// count), the right ones all lit (one read): 6 reads, V = 60 / 64. Bars at 0.5 (columns 8 to 11)
+/// and 2 (columns 20 to 23) over the floor: the left blocks' widest gap is 0.5 to 2 (1.5 against 1),
+/// the receiver in it: 6 reads, V = 60 / 64 again; a receiver at 2.5 is in the far cluster's span
+/// (2 to 3), so the left blocks descend: their 16² children hold one bar each over the floor,
+/// two layers around 2.5 (2 reads each), and the right blocks are lit: 4 + 2 × 4 × 2 = 20 reads,
+/// V = 56 / 64 (both bars occlude).
+#[test]
+fn a_bar_over_a_floor_inside_the_filter_costs_one_block_and_its_count() {
+    let gpu = ssm_testing::gpu();
+    let texel = 1.0 / 64.0;
+    let floor_with = |bars: &[(usize, f32)]| {
+        let depths = (0..64 * 64)
+            .map(|i| bars.iter().find(|(first, _)| (*first..first + 4).contains(&(i % 64))).map_or(3.0, |(_, depth)| *depth))
+            .collect();
+        Tile::new(64, depths, &[])
+    };
+    let input = |depth: f32| filter_input(32.0 * texel, 32.0 * texel, [33.0 * texel, 0.0], 33.0 * texel, depth);
+    let one_bar = evaluate(&gpu, "test_integrate", &input(1.0), 1, &floor_with(&[(8, 0.5)]))[0];
+    let two_bars = floor_with(&[(8, 0.5), (20, 2.0)]);
+    let between = evaluate(&gpu, "test_integrate", &input(1.0), 1, &two_bars)[0];
+    let behind_both = evaluate(&gpu, "test_integrate", &input(2.5), 1, &two_bars)[0];
+    println!("one bar: {one_bar:?}; two bars, receiver at 1: {between:?}, at 2.5: {behind_both:?}");
+    for (got, visibility, reads) in [(one_bar, 60.0 / 64.0, 6.0), (between, 60.0 / 64.0, 6.0), (behind_both, 56.0 / 64.0, 20.0)] {
+        assert!(close(got[0] / got[1], visibility, F32_TOLERANCE), "{got:?}: V against {visibility}");
+        assert!(close(got[1], 1.0, F32_TOLERANCE), "{got:?}: the whole tile is covered");
+        assert_eq!((got[2], got[3]), (0.0, reads), "{got:?}");
+    }
+}
+
 /// The hierarchy's cost follows the penumbra's boundary, by hand. A 64² tile, a filter covering
 /// texels [2, 62)² (start level 5: the four 32² blocks): with every texel occluding, each of the four
 /// blocks is decided at once (4 reads, V = 0). With an edge between columns 32 and 33 (texels x ≤ 32
-/// occluding), the blocks holding both columns are mixed at every level l (one column of blocks, at
+/// occluding at 0.5; those past it lit, at 1.1 on even rows and 5 on odd ones, so that a block
+/// across the edge is not two layers around the receiver at 1: its widest gap, 1.1 to 5, is
+/// behind it), the blocks holding both columns are mixed at every level l (one column of blocks, at
 /// most ceil(62 / 2^l) + 1 of them), and each mixed block reads its four children: at most
 /// 4 + 4 Σ_{l=1..5} (ceil(62 / 2^l) + 1) = 4 + 4 (32 + 17 + 9 + 5 + 3) = 268 reads against the 3,600
 /// texels under the filter; V = 29 / 60 exactly (columns 33 to 61 lit).
@@ -610,7 +735,7 @@ fn a_decided_block_costs_one_read_and_an_edge_its_boundary() {
     let texel = 1.0 / 64.0;
     let input = filter_input(32.0 * texel, 32.0 * texel, [30.0 * texel, 0.0], 30.0 * texel, 1.0);
     let occluding = Tile::new(64, vec![0.5; 64 * 64], &[]);
-    let edge = Tile::new(64, (0..64 * 64).map(|i| if i % 64 <= 32 { 0.5 } else { ssm_core::NO_SURFACE }).collect(), &[]);
+    let edge = Tile::new(64, (0..64 * 64).map(|i| if i % 64 <= 32 { 0.5 } else { [1.1, 5.0][(i / 64) % 2] }).collect(), &[]);
     let uniform = evaluate(&gpu, "test_integrate", &input, 1, &occluding)[0];
     let stepped = evaluate(&gpu, "test_integrate", &input, 1, &edge)[0];
     println!("uniform: {} reads; edge: {} reads, V = {}", uniform[3], stepped[3], stepped[0] / stepped[1]);
@@ -620,8 +745,10 @@ fn a_decided_block_costs_one_read_and_an_edge_its_boundary() {
 }
 
 /// The walks are bounded whatever the map: past MAX_WALK_STEPS = 32,768 loop iterations a walk stops
-/// and says so (pvsm_capped_pixels). On a 512² checkerboard of occluding and empty texels (every
-/// block mixed down to the texels), a filter 400 texels square (160,000 texels): the per-texel walk
+/// and says so (pvsm_capped_pixels). On a 512² map of three layers in every 2×2 block, an occluder
+/// at depth 0.5 and lit texels at 1.1 and 5 for a receiver at 1 (every block mixed down to the
+/// texels, and no block two layers around the receiver: the widest gap, 1.1 to 5, is behind it),
+/// a filter 400 texels square (160,000 texels): the per-texel walk
 /// reads 400 of every 401 steps (one per column), so 32,768 × 400 / 401 − 400 to 32,768 texels; the
 /// hierarchy stops descending after 32,768 steps (blocks and climbs to a parent) and counts the
 /// blocks left, at most three siblings per level (under 256 more steps). The same filter over a
@@ -631,17 +758,16 @@ fn a_decided_block_costs_one_read_and_an_edge_its_boundary() {
 fn a_walk_past_its_cap_stops_and_says_so() {
     let gpu = ssm_testing::gpu();
     let side = 512usize;
-    let checkerboard: Vec<f32> =
-        (0..side * side).map(|i| if (i % side + i / side).is_multiple_of(2) { 0.5 } else { ssm_core::NO_SURFACE }).collect();
+    let layered: Vec<f32> = (0..side * side).map(|i| [0.5, 1.1, 5.0, 0.5][i % 2 + 2 * ((i / side) % 2)]).collect();
     let texel = 1.0 / side as f32;
     let input = filter_input(256.0 * texel, 256.0 * texel, [200.0 * texel, 0.0], 200.0 * texel, 1.0);
     let run = |depths: &[f32], walk: &str| {
         evaluate(&gpu, "test_integrate", &input, 1, &Tile::new(512, depths.to_vec(), &[("filter_walk", walk)]))[0]
     };
-    let texels = run(&checkerboard, "texels");
-    let hierarchy = run(&checkerboard, "hierarchy");
+    let texels = run(&layered, "texels");
+    let hierarchy = run(&layered, "hierarchy");
     let uniform = run(&vec![0.5; side * side], "hierarchy");
-    println!("checkerboard: texels {texels:?}, hierarchy {hierarchy:?}; uniform {uniform:?}");
+    println!("layered: texels {texels:?}, hierarchy {hierarchy:?}; uniform {uniform:?}");
     assert!(texels[2] == 1.0 && texels[3] >= 32_768.0 * 400.0 / 401.0 - 400.0 && texels[3] <= 32_768.0, "{texels:?}");
     assert!(hierarchy[2] == 1.0 && hierarchy[3] <= 32_768.0 + 256.0, "{hierarchy:?}");
     assert!(close(hierarchy[1], uniform[1], F32_TOLERANCE), "a capped walk still covers the whole filter: {hierarchy:?}");
