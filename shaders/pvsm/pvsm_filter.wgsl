@@ -10,8 +10,10 @@
 // lit) or all in front of it (every texel occluding) adds its exact covered area in one step; a
 // block of two layers (a bar over a floor) lying entirely inside the filter, with the receiver
 // between its layers, adds its far layer's texel count as its lit area (inside the filter every
-// texel weighs its whole area); only the other blocks descend to their four children; texels are
-// the leaves. The sum is the per-texel one (filter_walk = texels), within f32 summation order, and
+// texel weighs its whole area), and one straddling the filter's edge settles so its children that
+// lie inside the filter or hold one cluster, or at level 1 its texels, from its per-child near
+// counts; only the other blocks (and such a block's children on the edge holding both clusters,
+// at the cost of their counts alone) descend to their four children; texels are the leaves. The sum is the per-texel one (filter_walk = texels), within f32 summation order, and
 // its cost follows where occluders' edges cross the filter's boundary or the receiver's depth, not
 // the filter's area.
 
@@ -40,8 +42,9 @@ struct TileSettings {
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
 // The tile map's two-layer min/max depth pyramid (pvsm_tile_pyramid.wgsl): mip m holds level m + 1
-// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), and its near_count in
-// tile_near_counts; only the tile's region, from the top-left corner, is written.
+// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), and in
+// tile_near_counts its near cluster's texels in each child (x, y, z, w: children (0, 0), (1, 0),
+// (0, 1), (1, 1)); only the tile's region, from the top-left corner, is written.
 @group(3) @binding(3) var tile_pyramid: texture_2d<f32>;
 @group(3) @binding(4) var tile_near_counts: texture_2d<u32>;
 
@@ -327,6 +330,39 @@ fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride:
     return sums;
 }
 
+// The child `child` at `level` of a two-layer block around the receiver that straddles the
+// filter's edge, `near` of its texels in the near cluster (occluding; the others lit): (lit area,
+// covered area, 0) where it is settled here (inside the filter: its far texels, each weighing one;
+// on the edge, all of one cluster: its covered area lit or not; a texel: its covered area if far),
+// (0, 0, 1) where it must be walked (on the edge, texels of both clusters: two layers around the
+// receiver itself, since its parent's cut lies in its gap), zeros where the filter misses it.
+fn settle_child(shape: TexelFilter, child: vec2<u32>, level: u32, near: u32) -> vec3<f32> {
+    let lo = vec2<f32>(child << vec2<u32>(level));
+    let hi = min(vec2<f32>((child + 1u) << vec2<u32>(level)), tile.size);
+    if (any(lo >= tile.size)) {
+        return vec3<f32>(0.0);
+    }
+    let area = block_area(shape, lo, hi);
+    if (area <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    if (level == 0u) {
+        return vec3<f32>(select(area, 0.0, near != 0u), area, 0.0);
+    }
+    let texels = u32(hi.x - lo.x) * u32(hi.y - lo.y);
+    if (inside_filter(shape, lo, hi)) {
+        return vec3<f32>(f32(texels - near), area, 0.0);
+    }
+    // On the edge: wholly far (lit) or wholly near (occluding), or walked.
+    if (near == 0u) {
+        return vec3<f32>(area, area, 0.0);
+    }
+    if (near == texels) {
+        return vec3<f32>(0.0, area, 0.0);
+    }
+    return vec3<f32>(0.0, 0.0, 1.0);
+}
+
 // Eq. 2 over the tile's two-layer min/max pyramid, top-down (filter_walk = hierarchy): from the (at
 // most 2×2) blocks of the coarsest level that hold the filter's rows and columns, a block the
 // filter does not cover is skipped unread; one whose nearest depth is no nearer than the receiver's
@@ -334,11 +370,17 @@ fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride:
 // the receiver's nearest (every texel occluding, o = 0) adds its covered area (block_area) at once;
 // one of two layers whose near layer is in front of every compared depth and whose far layer is
 // behind them, lying inside the filter (inside_filter: every texel weighs 1), adds its covered
-// area and, as lit area, its far layer's texels (its near count, one more read); another descends
-// to its four children; a texel is tested as the per-texel walk tests it. The same weights and the
-// same tests: the per-texel sum, in another order. The walk is depth-first and
-// needs no stack: after a block, the next is its next sibling, or its parent's (climbing while it
-// is the fourth child), so that the state is one block and its level.
+// area and, as lit area, its far layer's texels (its near counts, one more read); such a block
+// straddling the filter's edge reads its near counts too and settles so (settle_child) each child
+// inside the filter, each on the edge holding one cluster and, at level 1, each texel, descending
+// only to the children on the edge holding both clusters, whose near counts alone are then read
+// (`settled`, `pending`); another block descends to its four children; a texel is tested as the
+// per-texel walk tests it. The same weights and the same tests: the per-texel sum, in another
+// order (every texel of a two-layer block's far cluster is behind every compared depth, so lit,
+// every texel of the near cluster in front, so occluding, whatever the level it is settled at).
+// The walk is depth-first and needs no stack: after a block, the next is its next sibling, or its
+// parent's (climbing while it is the fourth child), so that the state is one block and its level,
+// and per level which children of the block last descended from are walked.
 fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> FilterSums {
     var sums = FilterSums(0.0, 0.0, false, 0u);
     var steps = 0u;
@@ -361,6 +403,11 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
     var block = low;
     var level = top_level;
     var next = false;
+    // Bit l: the blocks at level l now visited are children of a straddling two-layer block, which
+    // settled those inside the filter (set or cleared at each descent to level l; top_level's never).
+    var settled = 0u;
+    // Per level: which of those children (bit dx + 2 dy) are walked.
+    var pending: array<u32, 16>;
     loop {
         if (steps >= MAX_WALK_STEPS + 256u) {
             // Past the cap no block descends, and the siblings left (at most three per level) end the
@@ -396,53 +443,110 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
         if (area <= 0.0) {
             continue;
         }
+        // A child of a two-layer block around the receiver on the filter's edge: that block
+        // settled it unless its bit in `pending` is set (it straddles the edge and holds texels of
+        // both clusters); then it is two layers around the receiver too (the parent's cut lies in
+        // its gap), and only its near counts are read.
+        var settling = false;
+        if ((settled & (1u << level)) != 0u) {
+            let child = (block.x & 1u) + 2u * (block.y & 1u);
+            if ((pending[level] & (1u << child)) == 0u) {
+                continue;
+            }
+            settling = true;
+        }
         sums.reads += 1u;
         // (nearest, farthest) depth of the block's texels, and the bounds of what they are compared
         // with; a texel is a block whose bounds are its own test's values, never mixed. Loads are
         // clamped to the texture: a real walk never leaves it. (A mip's size from the base's:
         // textureDimensions with a level returns the base level's size on llvmpipe.)
-        var depths: vec4<f32>;
-        var compared: vec2<f32>;
         var pyramid_texel = vec2<i32>(0);
         var mip = 0u;
-        if (level == 0u) {
-            let z = textureLoad(tile_map, min(vec2<i32>(block), vec2<i32>(tile.size) - 1), 0).x;
-            // A texel is one layer (near_max = far_min).
-            depths = vec4<f32>(z);
-            compared = vec2<f32>(tap_plane_depth(receiver, tile_uv(lo + 0.5, scale)));
-        } else {
+        if (level > 0u) {
             mip = min(level - 1u, pyramid_levels - 1u);
             let mip_size = max(pyramid_base >> vec2<u32>(mip), vec2<u32>(1u));
             pyramid_texel = vec2<i32>(min(block, mip_size - 1u));
-            depths = textureLoad(tile_pyramid, pyramid_texel, i32(mip));
-            compared = compared_bounds(receiver, tile_uv(lo + 0.5, scale), tile_uv(hi - 0.5, scale));
         }
-        if (compared.y <= depths.x) {
-            // Every texel at or behind the receiver: lit (o = 1, Eq. 2).
-            sums.visible += area;
-            sums.covered += area;
-        } else if (compared.x > depths.y) {
-            // Every texel in front of the receiver: occluding.
-            sums.covered += area;
-        } else if (depths.z < depths.w && compared.x > depths.z && compared.y <= depths.w && inside_filter(shape, lo, hi)) {
-            // Two layers, the receiver between them: the near cluster's texels occlude, the far
-            // cluster's are lit, and inside the filter each weighs one texel, so the lit area is
-            // the far cluster's texel count (its near_count, one more read).
-            let near_count = textureLoad(tile_near_counts, pyramid_texel, i32(mip)).x;
-            sums.reads += 1u;
-            let texels = u32(hi.x - lo.x) * u32(hi.y - lo.y);
-            sums.visible += f32(texels - near_count);
-            sums.covered += area;
-        } else if (steps >= MAX_WALK_STEPS) {
-            // The cap (reported): the block counted half lit rather than walked further.
-            sums.capped = true;
-            sums.visible += 0.5 * area;
-            sums.covered += area;
+        // Its near counts per child, where it is two layers around the receiver and straddles the
+        // filter's edge: its children are settled below.
+        var quadrants = vec4<u32>(0u);
+        var straddling = false;
+        if (settling) {
+            if (steps >= MAX_WALK_STEPS) {
+                // The cap (reported): the block counted half lit rather than walked further.
+                sums.capped = true;
+                sums.visible += 0.5 * area;
+                sums.covered += area;
+                continue;
+            }
+            quadrants = textureLoad(tile_near_counts, pyramid_texel, i32(mip));
+            straddling = true;
         } else {
-            // Mixed: its first child next.
-            level -= 1u;
-            block = 2u * block;
-            next = false;
+            var depths: vec4<f32>;
+            var compared: vec2<f32>;
+            if (level == 0u) {
+                let z = textureLoad(tile_map, min(vec2<i32>(block), vec2<i32>(tile.size) - 1), 0).x;
+                // A texel is one layer (near_max = far_min).
+                depths = vec4<f32>(z);
+                compared = vec2<f32>(tap_plane_depth(receiver, tile_uv(lo + 0.5, scale)));
+            } else {
+                depths = textureLoad(tile_pyramid, pyramid_texel, i32(mip));
+                compared = compared_bounds(receiver, tile_uv(lo + 0.5, scale), tile_uv(hi - 0.5, scale));
+            }
+            if (compared.y <= depths.x) {
+                // Every texel at or behind the receiver: lit (o = 1, Eq. 2).
+                sums.visible += area;
+                sums.covered += area;
+            } else if (compared.x > depths.y) {
+                // Every texel in front of the receiver: occluding.
+                sums.covered += area;
+            } else if (depths.z < depths.w && compared.x > depths.z && compared.y <= depths.w
+                && (inside_filter(shape, lo, hi) || steps < MAX_WALK_STEPS)) {
+                // Two layers, the receiver between them: the near cluster's texels occlude, the far
+                // cluster's are lit. Its near counts per child: one more read.
+                quadrants = textureLoad(tile_near_counts, pyramid_texel, i32(mip));
+                sums.reads += 1u;
+                if (inside_filter(shape, lo, hi)) {
+                    // Inside the filter each texel weighs one, so the lit area is the far cluster's
+                    // texel count.
+                    let texels = u32(hi.x - lo.x) * u32(hi.y - lo.y);
+                    sums.visible += f32(texels - (quadrants.x + quadrants.y + quadrants.z + quadrants.w));
+                    sums.covered += area;
+                } else {
+                    straddling = true;
+                }
+            } else if (steps >= MAX_WALK_STEPS) {
+                // The cap (reported): the block counted half lit rather than walked further.
+                sums.capped = true;
+                sums.visible += 0.5 * area;
+                sums.covered += area;
+            } else {
+                // Mixed: its first child next.
+                level -= 1u;
+                block = 2u * block;
+                next = false;
+                settled &= ~(1u << level);
+            }
+        }
+        if (straddling) {
+            // On the filter's edge: each child inside the filter, or of one cluster, or at level 1
+            // each texel, is settled here from its near count; the others descend. Unrolled, not a
+            // loop: llvmpipe's loop limit (MAX_WALK_STEPS) counts inner loops' iterations with the
+            // walk's (a loop here made the walk end early, unflagged).
+            let first = settle_child(shape, 2u * block, level - 1u, quadrants.x);
+            let second = settle_child(shape, 2u * block + vec2<u32>(1u, 0u), level - 1u, quadrants.y);
+            let third = settle_child(shape, 2u * block + vec2<u32>(0u, 1u), level - 1u, quadrants.z);
+            let fourth = settle_child(shape, 2u * block + vec2<u32>(1u, 1u), level - 1u, quadrants.w);
+            sums.visible += first.x + second.x + third.x + fourth.x;
+            sums.covered += first.y + second.y + third.y + fourth.y;
+            let walked = u32(first.z) | (u32(second.z) << 1u) | (u32(third.z) << 2u) | (u32(fourth.z) << 3u);
+            if (walked != 0u) {
+                level -= 1u;
+                block = 2u * block;
+                next = false;
+                settled |= 1u << level;
+                pending[level] = walked;
+            }
         }
     }
     return sums;

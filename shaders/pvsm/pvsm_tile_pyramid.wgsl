@@ -4,13 +4,16 @@
 // top-left tile.size texels of the map), from the four texels of level l - 1 below it:
 // - (nearest, farthest): their depths' range. A block whose depths all lie on one side of the
 //   receiver adds its covered area at once (Eq. 2).
-// - (near_max, far_min) and near_count: where near_max < far_min, the block is two layers: every
-//   one of its texels is at or nearer than near_max (near_count of them: the near cluster) or at
-//   or farther than far_min (the far cluster), split at the widest gap between its depths that
-//   the children's own clusters show; a bar over a floor is two layers. A block lying entirely
-//   inside a filter (every texel weighing its whole area) whose receiver is behind the near
-//   cluster and in front of the far one adds its lit area, its far texels, at once. Otherwise
-//   (no gap: one layer) near_max = far_min = farthest and near_count is every texel.
+// - (near_max, far_min) and the near counts: where near_max < far_min, the block is two layers:
+//   every one of its texels is at or nearer than near_max (the near cluster) or at or farther than
+//   far_min (the far cluster), split at the widest gap between its depths that the children's own
+//   clusters show; a bar over a floor is two layers. The near cluster's texels are counted per
+//   child (quadrant): (x, y, z, w) for children (0, 0), (1, 0), (0, 1), (1, 1); their sum is the
+//   near count. A block lying entirely inside a filter (every texel weighing its whole area) whose
+//   receiver is behind the near cluster and in front of the far one adds its lit area, its far
+//   texels, at once; one straddling the filter's edge settles so each child inside the filter,
+//   and at level 1 each texel, from its quadrant's count. Otherwise (no gap: one layer) near_max =
+//   far_min = farthest and every texel counts as near.
 // Exact, not estimated: each child's clusters are intervals holding a known number of texels, and
 // the parent's gap is a depth interval that no child's interval enters, so the texels below it are
 // counted exactly. One compute pass per level, level 1 from the map itself.
@@ -45,9 +48,9 @@ struct PyramidLevel {
 // ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_PYRAMID (reads) and
 // READ_COUNTER_TILE_PYRAMID_BYTES (bytes written).
 @group(1) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
-// The level below's near_count (unread when it is the map).
+// The level below's near counts per quadrant (unread when it is the map), and this level's.
 @group(1) @binding(4) var finer_counts: texture_2d<u32>;
-@group(1) @binding(5) var coarser_counts: texture_storage_2d<r32uint, write>;
+@group(1) @binding(5) var coarser_counts: texture_storage_2d<rgba32uint, write>;
 
 // The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
 const READ_COUNTER_TILE_PYRAMID: u32 = 4u;
@@ -76,11 +79,12 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let below = level_size(level - 1u);
-    // The children's depth intervals, [low, high] holding `texels` texels each: one per child, or two
-    // for a two-layer child (its near and far clusters).
+    // The children's depth intervals, [low, high] holding `texels` texels each of child `owners`
+    // (dx + 2 dy): one per child, or two for a two-layer child (its near and far clusters).
     var lows: array<f32, 8>;
     var highs: array<f32, 8>;
     var texels: array<u32, 8>;
+    var owners: array<u32, 8>;
     var intervals = 0u;
     var nearest = NO_SURFACE;
     var farthest = -NO_SURFACE;
@@ -95,6 +99,9 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let child = textureLoad(finer, vec2<i32>(texel), 0);
             reads += 1u;
+            let owner = dx + 2u * dy;
+            owners[intervals] = owner;
+            owners[intervals + 1u] = owner;
             if (pyramid_level.from_map != 0u) {
                 lows[intervals] = child.x;
                 highs[intervals] = child.x;
@@ -110,8 +117,9 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
             farthest = max(farthest, child.y);
             total += child_texels;
             if (child.z < child.w) {
-                let near_count = textureLoad(finer_counts, vec2<i32>(texel), 0).x;
+                let quadrants = textureLoad(finer_counts, vec2<i32>(texel), 0);
                 reads += 1u;
+                let near_count = quadrants.x + quadrants.y + quadrants.z + quadrants.w;
                 lows[intervals] = child.x;
                 highs[intervals] = child.z;
                 texels[intervals] = near_count;
@@ -131,41 +139,44 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
     // starts past it, to the lowest start past it. The texels at or below it are the near cluster.
     var near_max = farthest;
     var far_min = farthest;
-    var near_count = total;
     var widest = 0.0;
     for (var k = 0u; k < intervals; k++) {
         let cut = highs[k];
         var next = NO_SURFACE;
         var above = false;
         var splits = true;
-        var under = 0u;
         for (var j = 0u; j < intervals; j++) {
             if (lows[j] > cut) {
                 next = select(lows[j], min(next, lows[j]), above);
                 above = true;
             } else if (highs[j] > cut) {
                 splits = false;
-            } else {
-                under += texels[j];
             }
         }
         if (splits && above && next - cut > widest) {
             widest = next - cut;
             near_max = cut;
             far_min = next;
-            near_count = under;
+        }
+    }
+    // Each child's texels in the near cluster: its intervals at or below the cut (every interval
+    // lies wholly on one side of it); with no gap, the cut is the farthest depth and all count.
+    var quadrants = vec4<u32>(0u);
+    for (var k = 0u; k < intervals; k++) {
+        if (highs[k] <= near_max) {
+            quadrants[owners[k]] += texels[k];
         }
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest, farthest, near_max, far_min));
-    textureStore(coarser_counts, vec2<i32>(id.xy), vec4<u32>(near_count, 0u, 0u, 0u));
+    textureStore(coarser_counts, vec2<i32>(id.xy), quadrants);
     if (COUNT_READS) {
         // Texel reads as ReadCounts counts them (one per textureLoad: a child's depths, and its
-        // near_count where it is two layers); 20 bytes written per texel (16 + 4).
+        // near counts where it is two layers); 32 bytes written per texel (16 + 16).
         let word = read_count_word(READ_COUNTER_TILE_PYRAMID, vec2<i32>(id.xy));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
         let bytes_word = read_count_word(READ_COUNTER_TILE_PYRAMID_BYTES, vec2<i32>(id.xy));
         atomicAdd(&read_counts[bytes_word], 1u);
-        atomicAdd(&read_counts[bytes_word + 1u], 20u);
+        atomicAdd(&read_counts[bytes_word + 1u], 32u);
     }
 }

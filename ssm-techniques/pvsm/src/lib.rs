@@ -424,8 +424,9 @@ struct TileSlot {
 }
 
 /// Step 8's two-layer min/max depth pyramid of the current tile's map: mip m holds level m + 1
-/// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), its near_count in
-/// a second texture of the same mips, for the tile's region only (`pvsm_tile_pyramid.wgsl`). One
+/// (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), its near
+/// cluster's texels per child in a second texture of the same mips, for the tile's region only
+/// (`pvsm_tile_pyramid.wgsl`). One
 /// pair serves every tile, rebuilt before each tile's filter; its side is half the largest tile
 /// map's side rounded up to a power of two, so that level l holds ceil(size / 2^l) texels of any
 /// region.
@@ -442,8 +443,8 @@ struct TilePyramid {
 
 /// The format of the tile pyramid's depths: (nearest, farthest, near_max, far_min).
 const TILE_PYRAMID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-/// The format of its near counts.
-const TILE_PYRAMID_COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The format of its near counts: the near cluster's texels in each of the four children.
+const TILE_PYRAMID_COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 
 /// A bind-group-layout entry for a `texture_2d<u32>` read with `textureLoad`.
 const fn uint_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {

@@ -687,6 +687,51 @@ fn the_two_layer_hierarchy_sums_what_every_texel_sums_over_bars() {
     }
 }
 
+/// A 128² map of two layers only: a floor ramping from 2.5 to 3 (behind every receiver) under 40
+/// bars at 0.3 to 0.9 (in front of every receiver), 1 to 6 texels wide and 4 to 100 long, across or
+/// along the map, crossing each other: every block holding both is two layers around the receiver,
+/// so that a filter's edge crossing it is settled from the per-child near counts.
+fn two_layers(random: &mut Random) -> Vec<f32> {
+    let side = 128usize;
+    let mut depths: Vec<f32> = (0..side * side).map(|i| 2.5 + 0.5 * (i % side) as f32 / side as f32).collect();
+    for index in 0..40 {
+        let depth = random.range(0.3, 0.9);
+        let (width, length) = (1 + (random.next() * 6.0) as usize, 4 + (random.next() * 96.0) as usize);
+        let (w, h) = if index % 2 == 0 { (length, width) } else { (width, length) };
+        let (x, y) = ((random.next() * side as f32) as usize, (random.next() * side as f32) as usize);
+        for row in y..(y + h).min(side) {
+            for column in x..(x + w).min(side) {
+                depths[row * side + column] = depth;
+            }
+        }
+    }
+    depths
+}
+
+/// Two-layer blocks straddling the filter's edge are exact: their children inside the filter, their
+/// children of one cluster and, at level 1, their texels are settled from the per-child near counts,
+/// only the children holding both clusters on the edge are walked, and the sums are the per-texel
+/// ones within the bound of [`the_hierarchy_sums_what_every_texel_sums`]: over [`two_layers`], 300
+/// random filters (half-axes up to 60 texels, sheared, receivers' tangent planes at depths 1 to 2
+/// tilted up to nearly edge-on) on the whole 128² map and on a 100 × 77 region of a smaller
+/// rectangle of the frame (blocks past the region's edges), for fewer reads.
+#[test]
+fn two_layer_blocks_on_the_filters_edge_sum_what_every_texel_sums() {
+    let gpu = ssm_testing::gpu();
+    let mut random = Random(0x6a09_e667);
+    let depths = two_layers(&mut random);
+    let regions = [([128.0f32, 128.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([100.0, 77.0], [[0.15, 0.1], [0.8, 0.9]])];
+    for (size, uv) in regions {
+        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
+        let inputs = spread_over(random_filters(&mut random, 300, texel, 60.0), uv);
+        let tile = |walk: &str| Tile::new(128, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
+        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
+        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
+        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("two layers, region {size:?}"));
+        assert!(h < t, "{h} against {t}");
+    }
+}
+
 /// A bar over a floor under a filter covering the whole 64² tile (centre 32, half-axes 33 texels:
 /// every texel weighs its whole area), a receiver at depth 1 compared with its own depth. The walk
 /// starts at the four 32² blocks (level 5). One bar at 0.5 over columns 8 to 11, the floor at 3: the
@@ -742,6 +787,29 @@ fn a_decided_block_costs_one_read_and_an_edge_its_boundary() {
     assert_eq!((uniform[0], uniform[3]), (0.0, 4.0), "{uniform:?}");
     assert!(stepped[3] <= 268.0, "{stepped:?}");
     assert!(close(stepped[0] / stepped[1], 29.0 / 60.0, F32_TOLERANCE), "{stepped:?}: V against {}", 29.0 / 60.0);
+}
+
+/// A two-layer block on the filter's edge costs its near counts, by hand. A 64² tile, the filter of
+/// [`a_decided_block_costs_one_read_and_an_edge_its_boundary`] (texels [2, 62)², start level 5:
+/// the four 32² blocks), one bar at 0.5 over columns 8 to 11 on a floor at 3, a receiver at 1. The
+/// right blocks are all floor: lit, one read each. The left ones are two layers around the receiver
+/// and cross the filter's edge: their depths and near counts, two reads each. Of their 16²
+/// children, those holding the bar (columns 0 to 15, four of them) cross the edge at column 2 and
+/// are walked, one read each (their near counts only); the others are floor (lit) or inside the
+/// filter, settled unread. Of those four's 8² children, columns 8 to 15 hold the bar, walked only
+/// where they cross the filter's top or bottom edge (rows 0 to 7 and 56 to 63: two, one read each);
+/// columns 0 to 7 are floor, settled. Their 4² children are all bar, all floor or inside: settled.
+/// 4 + 2 + 4 + 2 = 12 reads against 3,600 texels, V = 56 / 60 exactly (columns 8 to 11 occlude).
+#[test]
+fn a_two_layer_block_on_the_filters_edge_costs_its_near_counts() {
+    let gpu = ssm_testing::gpu();
+    let texel = 1.0 / 64.0;
+    let input = filter_input(32.0 * texel, 32.0 * texel, [30.0 * texel, 0.0], 30.0 * texel, 1.0);
+    let bar = Tile::new(64, (0..64 * 64).map(|i| if (8..12).contains(&(i % 64)) { 0.5 } else { 3.0 }).collect(), &[]);
+    let got = evaluate(&gpu, "test_integrate", &input, 1, &bar)[0];
+    println!("bar over a floor across the filter's edge: {got:?}");
+    assert!(close(got[0] / got[1], 56.0 / 60.0, F32_TOLERANCE), "{got:?}: V against {}", 56.0 / 60.0);
+    assert_eq!((got[2], got[3]), (0.0, 12.0), "{got:?}");
 }
 
 /// The walks are bounded whatever the map: past MAX_WALK_STEPS = 32,768 loop iterations a walk stops
