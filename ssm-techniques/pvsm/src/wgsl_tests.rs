@@ -643,16 +643,16 @@ fn assert_walks_agree(inputs: &[[f32; 4]], walked: &[[f32; 4]], every: &[[f32; 4
 
 /// A 128² map of bars over a floor, as thin geometry under a large light gives the filter: a floor
 /// whose depth ramps from 2.5 to 3 across the map (behind every receiver, not parallel to the
-/// light's plane), 24 bars 1 to 6 texels wide and 10 to 100 long, across or along the map, most at
-/// depths 0.3 to 0.9 (in front of every receiver) and a third at 1.2 to 1.8 (between the
-/// receivers' depths: three layers, where the widest gap need not hold the receiver), crossing
-/// each other.
-fn bars_over_a_floor(random: &mut Random) -> Vec<f32> {
+/// light's plane) under `bars` bars 1 to 6 texels wide and `lengths` (shortest, extra) long, across
+/// or along the map, crossing each other, at depths 0.3 to 0.9 (in front of every receiver); with
+/// `middle_layer`, every third bar at 1.2 to 1.8 instead (between the receivers' depths: three
+/// layers, where the widest gap need not hold the receiver).
+fn bars_over_a_floor(random: &mut Random, bars: usize, lengths: (f32, f32), middle_layer: bool) -> Vec<f32> {
     let side = 128usize;
     let mut depths: Vec<f32> = (0..side * side).map(|i| 2.5 + 0.5 * (i % side) as f32 / side as f32).collect();
-    for index in 0..24 {
-        let depth = if index % 3 == 2 { random.range(1.2, 1.8) } else { random.range(0.3, 0.9) };
-        let (width, length) = (1 + (random.next() * 6.0) as usize, 10 + (random.next() * 90.0) as usize);
+    for index in 0..bars {
+        let depth = if middle_layer && index % 3 == 2 { random.range(1.2, 1.8) } else { random.range(0.3, 0.9) };
+        let (width, length) = (1 + (random.next() * 6.0) as usize, (lengths.0 + random.next() * lengths.1) as usize);
         let (w, h) = if index % 2 == 0 { (length, width) } else { (width, length) };
         let (x, y) = ((random.next() * side as f32) as usize, (random.next() * side as f32) as usize);
         for row in y..(y + h).min(side) {
@@ -664,72 +664,44 @@ fn bars_over_a_floor(random: &mut Random) -> Vec<f32> {
     depths
 }
 
-/// The two-layer blocks are exact: over [`bars_over_a_floor`], 300 random filters (half-axes up to 60
-/// texels, so that blocks of up to 32² lie inside them; sheared; receivers' tangent planes at
-/// depths 1 to 2, tilted up to nearly edge-on) on the whole 128² map and on a 100 × 77 region of a
-/// smaller rectangle of the frame (blocks past the region's edges, whose near counts hold the
-/// region's texels only) give the per-texel sums within the bound of
-/// [`the_hierarchy_sums_what_every_texel_sums`], for fewer reads.
+/// Over the 128² map `depths`, 300 random filters (half-axes up to 60 texels, so that blocks of up
+/// to 32² lie inside them; sheared; receivers' tangent planes at depths 1 to 2, tilted up to nearly
+/// edge-on) on the whole map and on a 100 × 77 region of a smaller rectangle of the frame (blocks
+/// past the region's edges, whose near counts hold the region's texels only) give the per-texel
+/// sums within the bound of [`the_hierarchy_sums_what_every_texel_sums`], for fewer reads.
+fn assert_hierarchy_exact_over(depths: &[f32], random: &mut Random, label: &str) {
+    let gpu = ssm_testing::gpu();
+    let regions = [([128.0f32, 128.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([100.0, 77.0], [[0.15, 0.1], [0.8, 0.9]])];
+    for (size, uv) in regions {
+        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
+        let inputs = spread_over(random_filters(random, 300, texel, 60.0), uv);
+        let tile = |walk: &str| Tile::new(128, depths.to_vec(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
+        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
+        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
+        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("{label}, region {size:?}"));
+        assert!(h < t, "{h} against {t}");
+    }
+}
+
+/// The two-layer blocks are exact over 24 bars over a floor, a third of them between the
+/// receivers' depths ([`assert_hierarchy_exact_over`]).
 #[test]
 fn the_two_layer_hierarchy_sums_what_every_texel_sums_over_bars() {
-    let gpu = ssm_testing::gpu();
     let mut random = Random(0x2545_f491);
-    let depths = bars_over_a_floor(&mut random);
-    let regions = [([128.0f32, 128.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([100.0, 77.0], [[0.15, 0.1], [0.8, 0.9]])];
-    for (size, uv) in regions {
-        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
-        let inputs = spread_over(random_filters(&mut random, 300, texel, 60.0), uv);
-        let tile = |walk: &str| Tile::new(128, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
-        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
-        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
-        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("bars, region {size:?}"));
-        assert!(h < t, "{h} against {t}");
-    }
+    let depths = bars_over_a_floor(&mut random, 24, (10.0, 90.0), true);
+    assert_hierarchy_exact_over(&depths, &mut random, "bars");
 }
 
-/// A 128² map of two layers only: a floor ramping from 2.5 to 3 (behind every receiver) under 40
-/// bars at 0.3 to 0.9 (in front of every receiver), 1 to 6 texels wide and 4 to 100 long, across or
-/// along the map, crossing each other: every block holding both is two layers around the receiver,
-/// so that a filter's edge crossing it is settled from the per-child near counts.
-fn two_layers(random: &mut Random) -> Vec<f32> {
-    let side = 128usize;
-    let mut depths: Vec<f32> = (0..side * side).map(|i| 2.5 + 0.5 * (i % side) as f32 / side as f32).collect();
-    for index in 0..40 {
-        let depth = random.range(0.3, 0.9);
-        let (width, length) = (1 + (random.next() * 6.0) as usize, 4 + (random.next() * 96.0) as usize);
-        let (w, h) = if index % 2 == 0 { (length, width) } else { (width, length) };
-        let (x, y) = ((random.next() * side as f32) as usize, (random.next() * side as f32) as usize);
-        for row in y..(y + h).min(side) {
-            for column in x..(x + w).min(side) {
-                depths[row * side + column] = depth;
-            }
-        }
-    }
-    depths
-}
-
-/// Two-layer blocks straddling the filter's edge are exact: their children inside the filter, their
-/// children of one cluster and, at level 1, their texels are settled from the per-child near counts,
-/// only the children holding both clusters on the edge are walked, and the sums are the per-texel
-/// ones within the bound of [`the_hierarchy_sums_what_every_texel_sums`]: over [`two_layers`], 300
-/// random filters (half-axes up to 60 texels, sheared, receivers' tangent planes at depths 1 to 2
-/// tilted up to nearly edge-on) on the whole 128² map and on a 100 × 77 region of a smaller
-/// rectangle of the frame (blocks past the region's edges), for fewer reads.
+/// Two-layer blocks straddling the filter's edge are exact: over 40 bars in front of a floor (two
+/// layers only, so every block holding both is two layers around the receiver), their children
+/// inside the filter, their children of one cluster and, at level 1, their texels are settled from
+/// the per-child near counts, and only the children holding both clusters on the edge are walked
+/// ([`assert_hierarchy_exact_over`]).
 #[test]
 fn two_layer_blocks_on_the_filters_edge_sum_what_every_texel_sums() {
-    let gpu = ssm_testing::gpu();
     let mut random = Random(0x6a09_e667);
-    let depths = two_layers(&mut random);
-    let regions = [([128.0f32, 128.0], [[0.0f32, 0.0], [1.0, 1.0]]), ([100.0, 77.0], [[0.15, 0.1], [0.8, 0.9]])];
-    for (size, uv) in regions {
-        let texel = [(uv[1][0] - uv[0][0]) / size[0], (uv[1][1] - uv[0][1]) / size[1]];
-        let inputs = spread_over(random_filters(&mut random, 300, texel, 60.0), uv);
-        let tile = |walk: &str| Tile::new(128, depths.clone(), &[]).region(size, uv, test_frame(), &[("filter_walk", walk)]);
-        let walked = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("hierarchy"));
-        let every = evaluate(&gpu, "test_integrate", &inputs, 300, &tile("texels"));
-        let (h, t) = assert_walks_agree(&inputs, &walked, &every, texel, &format!("two layers, region {size:?}"));
-        assert!(h < t, "{h} against {t}");
-    }
+    let depths = bars_over_a_floor(&mut random, 40, (4.0, 96.0), false);
+    assert_hierarchy_exact_over(&depths, &mut random, "two layers");
 }
 
 /// A bar over a floor under a filter covering the whole 64² tile (centre 32, half-axes 33 texels:
