@@ -610,13 +610,9 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
     /// `ReadCounts`' convention: every `textureLoad` (G-buffer, shadow map, the passes' own
     /// targets) is one texel, at every pixel; a blur tap that reads a shared segment's workgroup
     /// memory is none, the segment's loads are. The failed-row counters (`rows`) are diagnostics,
-    /// not work of a pass of their own, and are left out.
+    /// not work of a pass of their own: `ReadCounts::work` leaves them out.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
-        let passes = &COUNTED[..3];
-        Ok(self
-            .read_counts
-            .work(gpu)?
-            .map(|work| work.into_iter().filter(|pass| passes.iter().any(|(name, _)| pass.pass == *name)).collect()))
+        self.read_counts.work(gpu)
     }
 
     /// `sssm_reuse_share`: the mean share of rows reused, over the pixels computed (the paper's Fig. 10).
