@@ -20,6 +20,8 @@
 
 // #import common/read_counts.wgsl
 
+// common/shadow_map.wgsl's NO_SURFACE, written out: importing that file would bring group 0's light
+// frame, where this pass binds its tile.
 const NO_SURFACE: f32 = 3.40282347e38;
 
 struct TileSettings {
