@@ -148,19 +148,24 @@ impl FrameWork {
             .join(";")
     }
 
+    /// The pass called `name`, added (with no work) if the frame has none yet.
+    fn pass_named(&mut self, name: &str) -> &mut PassWork {
+        let index = match self.passes.iter().position(|pass| pass.name == name) {
+            Some(index) => index,
+            None => {
+                self.passes.push(PassWork { name: name.to_owned(), ..PassWork::default() });
+                self.passes.len() - 1
+            }
+        };
+        &mut self.passes[index]
+    }
+
     /// Adds the shaders' counts to the passes of the same name (a pass the pipeline statistics
     /// did not see, such as one past [`MAX_COUNTED_PASSES`], is added).
     pub fn add_shader_work(&mut self, shader_work: &[ShaderWork]) {
         self.shader_counts = true;
         for counted in shader_work {
-            let index = match self.passes.iter().position(|pass| pass.name == counted.pass) {
-                Some(index) => index,
-                None => {
-                    self.passes.push(PassWork { name: counted.pass.clone(), ..PassWork::default() });
-                    self.passes.len() - 1
-                }
-            };
-            let pass = &mut self.passes[index];
+            let pass = self.pass_named(&counted.pass);
             pass.counted_invocations += counted.invocations;
             pass.texel_reads += counted.texel_reads;
             pass.atomics += counted.atomics;
@@ -236,14 +241,7 @@ impl StatisticsQueries {
     pub(crate) fn read(&self, gpu: &GpuContext) -> Result<FrameWork> {
         let mut work = FrameWork { pipeline_statistics: self.query_set.is_some(), ..FrameWork::default() };
         let mut add = |name: &str, target_bytes: u64, statistics: Option<&[u64]>| {
-            let index = match work.passes.iter().position(|pass| pass.name == name) {
-                Some(index) => index,
-                None => {
-                    work.passes.push(PassWork { name: name.to_owned(), ..PassWork::default() });
-                    work.passes.len() - 1
-                }
-            };
-            let pass = &mut work.passes[index];
+            let pass = work.pass_named(name);
             pass.runs += 1;
             pass.target_bytes += target_bytes;
             if let Some(values) = statistics {
