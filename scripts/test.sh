@@ -18,3 +18,6 @@ cargo clippy --workspace --all-targets --locked -- -D warnings
 cargo test --workspace --all-targets --locked
 # The documentation's examples (--all-targets leaves them out): ssm-scene's opening example.
 cargo test --workspace --doc --locked
+# The API documentation builds without a warning (broken links, private items
+# linked from public docs); missing_docs is already a lint of every crate.
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked

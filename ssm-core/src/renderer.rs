@@ -220,7 +220,7 @@ impl Renderer {
     }
 
     /// Shades the current visibility into the composite target and returns
-    /// it ([`Composite::FORMAT`], `COPY_SRC`) without reading it back: what a
+    /// it (the composite format, `COPY_SRC`) without reading it back: what a
     /// live viewer copies to its window.
     ///
     /// # Errors

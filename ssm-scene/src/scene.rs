@@ -107,7 +107,7 @@ impl Aabb {
 
 /// A complete, validated scene.
 ///
-/// Build one with [`Scene::builtin`], [`Scene::load`] or by hand followed by
+/// Build one with [`builtin`](crate::builtin), [`Scene::load`] or by hand followed by
 /// [`Scene::validate`]; the GPU side assumes the invariants `validate` checks.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {

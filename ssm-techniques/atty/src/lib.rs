@@ -905,7 +905,7 @@ impl ShadowTechnique for SoftShadowMaps {
         Ok(())
     }
 
-    /// Per counting pass ([`CounterPlan`]): texel reads, atomics and bytes written to storage, as
+    /// Per counting pass (`CounterPlan`): texel reads, atomics and bytes written to storage, as
     /// its shader counted them (`atty_counts.wgsl`), when built for `--count-work`.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
         self.read_counts.work(gpu)

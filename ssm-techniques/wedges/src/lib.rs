@@ -908,7 +908,7 @@ impl ShadowTechnique for PenumbraWedges {
         Ok(())
     }
 
-    /// Per counting pass ([`COUNTERS`]): texel reads, atomics and bytes written to storage, as its
+    /// Per counting pass (`COUNTERS`): texel reads, atomics and bytes written to storage, as its
     /// shader counted them (`wedges_counts.wgsl`), when built for `--count-work`.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
         self.read_counts.work(gpu)
