@@ -5,6 +5,7 @@
 
 pub mod charts;
 mod commands;
+pub mod docs;
 pub mod report;
 pub mod shard;
 pub mod sweep;

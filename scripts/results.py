@@ -1,0 +1,269 @@
+#!/usr/bin/env python3
+"""Regenerates every results table and figure of the docs and of each technique's README.
+
+Run through scripts/results.sh (see its header for the options). On lavapipe it writes
+docs/results.md, docs/results/*.svg, ssm-techniques/<t>/results.md (+ results/*.svg) and the summary
+table of README.md; on any other adapter one file, docs/results-<adapter>.md (+ docs/results/<adapter>/),
+so that a GPU run lands beside the lavapipe one. Every generated file's first lines name the
+command, the adapter, the date and the commit. Nothing here measures anything itself: each table
+is the output of an `ssm` command (or a crate's example), copied as it printed it.
+"""
+
+import argparse
+import csv
+import datetime
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SSM = ROOT / "target" / "release" / "ssm"
+# The three scenes of the summary table: contact shadows, overlapping penumbrae of many small
+# occluders, and thin occluders at varied heights.
+SUMMARY_SCENES = ["sphere-cube", "contact", "leaves"]
+# The examples whose output a technique README reproduces (crate, example, arguments).
+EXAMPLES = {
+    "atty": [("ssm-atty", "atty_work", [])],
+    "wedges": [("ssm-wedges", "wedges_work", []), ("ssm-wedges", "fig1", []), ("ssm-wedges", "fig12", [])],
+}
+SUMMARY_BEGIN, SUMMARY_END = "<!-- summary -->", "<!-- /summary -->"
+
+
+def run(command, log, **kwargs):
+    """Runs `command` (a list) from the workspace root, echoing it; returns its stdout."""
+    print("+ " + " ".join(map(str, command)), file=sys.stderr, flush=True)
+    started = datetime.datetime.now()
+    result = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, **kwargs)
+    log.write(f"$ {' '.join(map(str, command))}\n{result.stdout}\n{result.stderr}\n")
+    if result.returncode != 0:
+        sys.exit(f"results: `{' '.join(map(str, command))}` failed ({result.returncode}):\n{result.stderr[-4000:]}")
+    print(f"  ({(datetime.datetime.now() - started).total_seconds():.0f} s)", file=sys.stderr, flush=True)
+    return result.stdout
+
+
+def shown(command, scratch=None):
+    """A command as a reader would type it from the workspace root (output folders under `out/`)."""
+    text = " ".join(str(part) for part in command)
+    if scratch is not None:
+        text = text.replace(str(scratch), "out")
+    return text.replace(str(SSM), "ssm").replace(str(ROOT) + "/", "")
+
+
+def presets():
+    """(name, technique or None, description) of every sweep preset, as `ssm sweep --list-presets` prints them."""
+    listing = subprocess.run([str(SSM), "sweep", "--list-presets"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    found = []
+    for line in listing.splitlines():
+        match = re.match(r"^([a-z0-9-]+)(?: \[([a-z0-9-]+)\])?: (.*)$", line)
+        if match:
+            found.append((match.group(1), match.group(2), match.group(3)))
+    return found
+
+
+def sweep_table(out):
+    """sweep.md's table lines (its own first line, the adapter and size, is in our header)."""
+    lines = (out / "sweep.md").read_text().splitlines()
+    return "\n".join(line for line in lines if line.startswith("|"))
+
+
+def main():
+    parser = argparse.ArgumentParser(prog="scripts/results.sh", description=__doc__)
+    parser.add_argument("--width", type=int, default=320, help="image width of every run (default 320)")
+    parser.add_argument("--height", type=int, default=240, help="image height of every run (default 240)")
+    parser.add_argument("--paper-sizes", action="store_true", help="each preset at its paper's viewport instead of --width/--height")
+    parser.add_argument("--frames", type=int, default=3, help="frames timed per point after a warm-up (default 3)")
+    parser.add_argument("--splice-summary", action="store_true", help="only copy docs/results/summary.md (written by the last full run) into README.md")
+    parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, and technique names (default: all)")
+    args = parser.parse_args(sys.argv[1:])
+    only = set(filter(None, args.only.split(",")))
+    if args.splice_summary:
+        splice_summary((ROOT / "docs" / "results" / "summary.md").read_text())
+        return
+    wanted = lambda part: not only or part in only
+
+    command_line = "scripts/results.sh" + "".join(" " + a for a in sys.argv[1:])
+    scratch = Path(tempfile.mkdtemp(prefix="ssm-results-"))
+    # A fresh ground-truth cache, so that the ground truth's own cost is measured, not read back.
+    env = dict(os.environ, SSM_CACHE_DIR=str(scratch / "cache"))
+    log = open(scratch / "commands.log", "w")
+    print(f"results: scratch folder {scratch} (commands.log has every command's output)", file=sys.stderr)
+
+    listing = json.loads(run([str(SSM), "list", "--format", "json"], log, env=env))
+    adapter = listing.get("adapter") or "none"
+    commit = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    if subprocess.run(["git", "diff", "--quiet", "HEAD"], cwd=ROOT).returncode != 0:
+        commit += " (with uncommitted changes)"
+    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    lavapipe = "llvmpipe" in adapter
+    slug = "" if lavapipe else re.sub(r"[^a-z0-9]+", "-", adapter.split("[")[0].lower()).strip("-")
+    size_args = [] if args.paper_sizes else ["--width", str(args.width), "--height", str(args.height)]
+    pixels = "each preset's paper viewport" if args.paper_sizes else f"{args.width}×{args.height} pixels"
+
+    def header(title):
+        return (f"<!-- Generated by `{command_line}`: do not edit; rerun it. -->\n# {title}\n\n"
+                f"- Command: `{command_line}` (from the workspace root)\n- Adapter: {adapter}\n- Date: {date}\n"
+                f"- Commit: {commit}\n- Images: {pixels}; {args.frames} timed frames per point after a warm-up; "
+                "ground truth traced afresh (empty cache).\n\n")
+
+    docs = ROOT / "docs"
+    images = docs / "results" / slug if slug else docs / "results"
+    images.mkdir(parents=True, exist_ok=True)
+    image_link = lambda name: os.path.relpath(images / name, docs)
+    body = []
+    summary_rows = {}
+
+    # 1. Every technique at its defaults on the summary scenes, with counted work.
+    if wanted("summary"):
+        body.append("## Every technique at its defaults\n\n`ssm compare` on three scenes, times and counted work side by side "
+                    "(the error columns are against the ground truth, on the same pixels).\n")
+        for scene in SUMMARY_SCENES:
+            out = scratch / f"compare-{scene}"
+            command = [str(SSM), "compare", "--scene", scene, *(["--width", str(args.width), "--height", str(args.height)] if not args.paper_sizes else []),
+                       "--frames", str(args.frames), "--count-work", "--out", str(out)]
+            run(command, log, env=env)
+            report = (out / "report.md").read_text()
+            # Drop the report's own title and its params column (every technique is at its defaults here).
+            report = re.sub(r"^# .*\n", "", report)
+            report = without_params(report)
+            shutil.copy(out / "passes.svg", images / f"passes-{scene}.svg")
+            body.append(f"### `{scene}`\n\n`{shown(command, scratch)}`\n\n{report.strip()}\n\n"
+                        f"GPU time per pass: ![passes on {scene}]({image_link(f'passes-{scene}.svg')})\n")
+            for row in csv.DictReader(open(out / "results.csv")):
+                summary_rows.setdefault(row["technique"], {})[scene] = row
+
+    # 2. The trade plot: every technique's quality knob, error against time and against counted work.
+    if wanted("trade"):
+        out = scratch / "trade"
+        command = [str(SSM), "sweep", "--preset", "trade", *size_args, "--frames", str(args.frames), "--cost", "work", "--out", str(out)]
+        run(command, log, env=env)
+        shutil.copy(out / "sweep.svg", images / "trade-time.svg")
+        shutil.copy(out / "sweep-work.svg", images / "trade-work.svg")
+        body.append(f"## The trade: error against cost\n\n`{shown(command, scratch)}`\n\n"
+                    f"![error against time]({image_link('trade-time.svg')})\n![error against counted work]({image_link('trade-work.svg')})\n\n"
+                    f"{sweep_table(out)}\n")
+
+    # 3. Several lights: frame time against the light count.
+    if wanted("lights"):
+        out = scratch / "lights"
+        command = [str(SSM), "sweep", "--preset", "lights", *size_args, "--frames", str(args.frames), "--count-work", "--out", str(out)]
+        run(command, log, env=env)
+        shutil.copy(out / "sweep.svg", images / "lights.svg")
+        body.append(f"## Several lights\n\n`{shown(command, scratch)}`\n\n![time against lights]({image_link('lights.svg')})\n\n{sweep_table(out)}\n")
+
+    # 4. Each technique's paper presets (and the examples that reproduce its cost claims).
+    technique_sections = {}
+    for name, technique, description in presets():
+        if technique is None or not wanted(technique):
+            continue
+        out = scratch / f"preset-{name}"
+        command = [str(SSM), "sweep", "--preset", name, *size_args, "--frames", str(args.frames), "--count-work", "--out", str(out)]
+        run(command, log, env=env)
+        technique_sections.setdefault(technique, []).append((name, description, command, out))
+    for technique, examples in EXAMPLES.items():
+        if not wanted(technique):
+            continue
+        for crate, example, extra in examples:
+            command = ["cargo", "run", "--quiet", "--release", "-p", crate, "--example", example, "--", *extra]
+            printed = run(command, log, env=env)
+            technique_sections.setdefault(technique, []).append((example, f"the `{example}` example's output, as printed", command, printed))
+
+    for technique, sections in sorted(technique_sections.items()):
+        folder = ROOT / "ssm-techniques" / technique
+        text = []
+        for name, description, command, out in sections:
+            text.append(f"## {name}\n\n{description}\n\n`{shown(command, scratch)}`\n")
+            if isinstance(out, str):
+                text.append(out.strip() + "\n")
+                continue
+            plots = folder / "results" / slug if slug else folder / "results"
+            plots.mkdir(parents=True, exist_ok=True)
+            shutil.copy(out / "sweep.svg", plots / f"{name}.svg")
+            text.append(f"![{name}]({os.path.relpath(plots / f'{name}.svg', folder)})\n")
+            if (out / "sweep-work.svg").exists():
+                shutil.copy(out / "sweep-work.svg", plots / f"{name}-work.svg")
+                text.append(f"![{name} in counted work]({os.path.relpath(plots / f'{name}-work.svg', folder)})\n")
+            text.append(sweep_table(out) + "\n")
+        if lavapipe:
+            (folder / "results.md").write_text(header(f"{technique}: reproduced figures") + "\n".join(text))
+        else:
+            body.append(f"## {technique}\n\n" + "\n".join(text).replace("\n## ", "\n### "))
+
+    # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
+    if summary_rows:
+        table = summary_table(summary_rows, args)
+        body.insert(0, "## Summary\n\n" + table + "\n")
+        if lavapipe:
+            summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
+                       f"([docs/results.md](docs/results.md)).\n")
+            (docs / "results" / "summary.md").write_text(summary)
+            splice_summary(summary)
+
+    if body:
+        target = docs / ("results.md" if lavapipe else f"results-{slug}.md")
+        target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(body))
+        print(f"results: wrote {target.relative_to(ROOT)}", file=sys.stderr)
+    shutil.rmtree(scratch / "cache", ignore_errors=True)
+
+
+def splice_summary(summary):
+    """Puts `summary` between README.md's summary markers (nothing happens without them)."""
+    readme = ROOT / "README.md"
+    text = readme.read_text()
+    if SUMMARY_BEGIN in text and SUMMARY_END in text:
+        head, rest = text.split(SUMMARY_BEGIN, 1)
+        _, tail = rest.split(SUMMARY_END, 1)
+        readme.write_text(f"{head}{SUMMARY_BEGIN}\n{summary}{SUMMARY_END}{tail}")
+    else:
+        print("results: README.md has no summary markers; the summary table is in docs/results/summary.md", file=sys.stderr)
+
+
+def without_params(report):
+    """`report` with the params column of its tables removed (every technique is at its defaults)."""
+    lines, dropping = [], False
+    for line in report.splitlines():
+        if line.startswith("| technique | params |"):
+            dropping = True
+        elif not line.startswith("|"):
+            dropping = False
+        if dropping:
+            cells = line.split("|")
+            line = "|".join(cells[:2] + cells[3:])
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def summary_table(rows, args):
+    """One row per technique: docs/summary.toml's words, then the penumbra error on each summary scene,
+    the time and the texel reads per frame on the first."""
+    words = {}
+    summary_file = ROOT / "docs" / "summary.toml"
+    if summary_file.exists():
+        for entry in tomllib.loads(summary_file.read_text()).get("technique", []):
+            words[entry["name"]] = entry
+    scenes = SUMMARY_SCENES
+    head = ("| technique | best at | worst at | cost class | " + " | ".join(f"MAE `{s}`" for s in scenes)
+            + f" | ms `{scenes[0]}` | texel reads `{scenes[0]}` |\n|---|---|---|---|" + "---:|" * (len(scenes) + 2) + "\n")
+    order = [entry for entry in words] + sorted(name for name in rows if name not in words)
+    lines = []
+    for name in order:
+        if name not in rows:
+            continue
+        entry = words.get(name, {})
+        first = rows[name].get(scenes[0], {})
+        cells = [f"[`{name}`](ssm-techniques/{name}/README.md)" if (ROOT / "ssm-techniques" / name).is_dir() else f"`{name}`",
+                 entry.get("best", ""), entry.get("worst", ""), entry.get("cost", "")]
+        cells += [rows[name].get(s, {}).get("mae_penumbra", "") and f"{float(rows[name][s]['mae_penumbra']):.4f}" for s in scenes]
+        cells.append(first.get("gpu_ms_median", "") and f"{float(first['gpu_ms_median']):.2f}")
+        cells.append(first.get("texel_reads", "") and f"{int(float(first['texel_reads'])):,}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return head + "\n".join(lines) + f"\n\nMAE: mean absolute error of the visibility over the ground truth's umbra and penumbra; {args.width}×{args.height} pixels.\n"
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Regenerates every results table and figure of the docs and of each technique's README, from
+# scratch, with the `ssm` commands that produce them (issue #42):
+#   docs/results.md and docs/results/*.svg        every technique on three scenes (times and counted
+#                                                 work side by side, per-pass charts, the ground
+#                                                 truth's cost), the trade plot, several lights
+#   ssm-techniques/<t>/results.md (+ results/)    each technique's paper presets and examples
+#   README.md, between <!-- summary --> markers   the summary table (words from docs/summary.toml)
+# On an adapter other than lavapipe (a lent GPU: scripts/gpu-bench-pack.sh) everything goes to one
+# file, docs/results-<adapter>.md, beside the lavapipe one.
+#
+#   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 3] [--only summary,trade,lights,pvsm,...]
+#   scripts/results.sh --splice-summary   (only copies docs/results/summary.md into README.md)
+#
+# Needs python3 (3.11+, for tomllib). Takes hours on lavapipe at the defaults; --only runs a part.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+command -v python3 >/dev/null || { echo "scripts/results.sh: needs python3" >&2; exit 1; }
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+cargo build --release --locked --bin ssm
+cargo build --release --locked -p ssm-atty -p ssm-wedges --examples
+exec python3 scripts/results.py "$@"
