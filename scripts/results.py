@@ -23,7 +23,9 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-SSM = ROOT / "target" / "release" / "ssm"
+# SSM_BIN: a prebuilt `ssm` (the GPU pack's); else the workspace's release build.
+SSM = Path(os.environ.get("SSM_BIN") or ROOT / "target" / "release" / "ssm").resolve()
+EXAMPLES_DIR = ROOT / "target" / "release" / "examples"
 # The three scenes of the summary table: contact shadows, overlapping penumbrae of many small
 # occluders, and thin occluders at varied heights.
 SUMMARY_SCENES = ["sphere-cube", "contact", "leaves"]
@@ -120,7 +122,7 @@ def main():
 
     # 1. Every technique at its defaults on the summary scenes, with counted work.
     if wanted("summary"):
-        body.append("## Every technique at its defaults\n\n`ssm compare` on three scenes, times and counted work side by side "
+        body.append("## defaults\n\nEvery technique at its defaults: `ssm compare` on three scenes, times and counted work side by side "
                     "(the error columns are against the ground truth, on the same pixels).\n")
         for scene in SUMMARY_SCENES:
             out = scratch / f"compare-{scene}"
@@ -144,7 +146,7 @@ def main():
         run(command, log, env=env)
         shutil.copy(out / "sweep.svg", images / "trade-time.svg")
         shutil.copy(out / "sweep-work.svg", images / "trade-work.svg")
-        body.append(f"## The trade: error against cost\n\n`{shown(command, scratch)}`\n\n"
+        body.append(f"## trade\n\nThe trade: every technique's quality knob swept, error against time and against counted work.\n\n`{shown(command, scratch)}`\n\n"
                     f"![error against time]({image_link('trade-time.svg')})\n![error against counted work]({image_link('trade-work.svg')})\n\n"
                     f"{sweep_table(out)}\n")
 
@@ -154,7 +156,7 @@ def main():
         command = [str(SSM), "sweep", "--preset", "lights", *size_args, "--frames", str(args.frames), "--count-work", "--out", str(out)]
         run(command, log, env=env)
         shutil.copy(out / "sweep.svg", images / "lights.svg")
-        body.append(f"## Several lights\n\n`{shown(command, scratch)}`\n\n![time against lights]({image_link('lights.svg')})\n\n{sweep_table(out)}\n")
+        body.append(f"## lights\n\nSeveral lights: every technique at its defaults with 1, 2 and 3 copies of the light.\n\n`{shown(command, scratch)}`\n\n![time against lights]({image_link('lights.svg')})\n\n{sweep_table(out)}\n")
 
     # 4. Each technique's paper presets (and the examples that reproduce its cost claims).
     technique_sections = {}
@@ -169,8 +171,14 @@ def main():
         if not wanted(technique):
             continue
         for crate, example, extra in examples:
-            command = ["cargo", "run", "--quiet", "--release", "-p", crate, "--example", example, "--", *extra]
-            printed = run(command, log, env=env)
+            binary = EXAMPLES_DIR / example
+            command = [str(binary), *extra]
+            if not binary.exists():
+                # A prebuilt pack carries `ssm` alone: say so in the results rather than skip silently.
+                printed = f"Not run: no `{binary.relative_to(ROOT)}` (build it with `cargo build --release -p {crate} --examples`)."
+            else:
+                printed = run(command, log, env=env)
+            command = ["cargo", "run", "--release", "-p", crate, "--example", example, "--", *extra]
             technique_sections.setdefault(technique, []).append((example, f"the `{example}` example's output, as printed", command, printed))
 
     for technique, sections in sorted(technique_sections.items()):
@@ -197,7 +205,7 @@ def main():
     # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
     if summary_rows:
         table = summary_table(summary_rows, args)
-        body.insert(0, "## Summary\n\n" + table + "\n")
+        body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
         if lavapipe:
             summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
                        f"([docs/results.md](docs/results.md)).\n")

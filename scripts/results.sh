@@ -17,6 +17,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v python3 >/dev/null || { echo "scripts/results.sh: needs python3" >&2; exit 1; }
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
-cargo build --release --locked --bin ssm
-cargo build --release --locked -p ssm-atty -p ssm-wedges --examples
+# SSM_BIN (a prebuilt `ssm`, as on a lent GPU machine): no build; the examples run only if built.
+if [ -z "${SSM_BIN:-}" ]; then
+    cargo build --release --locked --bin ssm
+    cargo build --release --locked -p ssm-atty -p ssm-wedges --examples
+fi
 exec python3 scripts/results.py "$@"
