@@ -954,7 +954,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "atty-map-size",
-        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided; in counted work (--count-work; README, Counted work) the accumulation's fragments grow with the micro-patches, n², while each patch covers fewer",
+        summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided; in counted work (--count-work) the accumulation's fragments grow with the micro-patches, n², while each patch covers fewer",
         scenes: &["floating-sphere"],
         varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
         x_axis: "atty.occluder_map_size",

@@ -77,9 +77,8 @@ pub enum BlurPasses {
 pub enum EdgeRows {
     /// From the depth map, as a row that fails its reuse test (a blocker row's n taps compared
     /// with the receiver, a blur row's m taps shadow-tested on the pixel's tangent plane): the
-    /// same result at the borders as inside the screen, at n or m reads a row (at 29/41 on
-    /// `leaves`, 78 more reads per pixel of the screen than `Clamp`: the sssm README's "Texel
-    /// reads").
+    /// same result at the borders as inside the screen, at n or m reads a row (the cost in texel
+    /// reads: `ssm sweep --preset sssm-edges --count-work`; docs/notes/sssm.md).
     Recompute,
     /// From the nearest pixel on the screen, reused when it passes the reuse test (α, β), as a
     /// screen-space pass reading through a clamp-to-edge sampler would; a reused one counts as
@@ -675,7 +674,7 @@ const TABLE4_VIEWPORT: (u32, u32) = (1280, 960);
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "sssm-table4",
-        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel. In texel reads per pixel (count_reads on both, every pixel's G-buffer reads counted), SSSM at 29/41 and 0.1 reads 8.4x fewer than PCSS at 1280x960 (213 against 1,783 a pixel; 5.1x at 11/21)",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel. With --count-work, texel reads per frame beside the times (the test sssm_reads_eight_times_fewer_texels_than_pcss_at_table_4s_largest_kernels asserts at least 8x fewer than PCSS at 29/41)",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
@@ -700,7 +699,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-edges",
-        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (the default, as a clamp-to-edge read would) or recomputed from the depth map, at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with count_reads, 78 more texel reads a pixel at 29/41, 291 against 213)",
+        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (the default, as a clamp-to-edge read would) or recomputed from the depth map, at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with --count-work, in texel reads)",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
@@ -713,7 +712,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-steps",
-        summary: "Buades et al., Tables 2 and 3: milliseconds per step (depth map, horizontal blocker, blocker + horizontal blur, vertical blur) at 29/41 as alpha = beta grow, with a 1024² and a 4096² depth map (on leaves; the per-pass times are in sweep.csv's passes_ms; with count_reads at 640x480, the texel reads per pixel fall from 213 at 0.1 to 123 at 0.5, the same with either map)",
+        summary: "Buades et al., Tables 2 and 3: milliseconds per step (depth map, horizontal blocker, blocker + horizontal blur, vertical blur) at 29/41 as alpha = beta grow, with a 1024² and a 4096² depth map (on leaves; the per-pass times are in sweep.csv's passes_ms; with --count-work, the texel reads fall as alpha = beta grow, the same with either map)",
         scenes: &["leaves"],
         varies: &[
             "sssm.alpha:beta=0:0,0.01:0.01,0.02:0.02,0.05:0.05,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
