@@ -10,7 +10,10 @@
 # Environment: as scripts/gpu-bench.sh (SSM_BENCH_PRESETS, ...), and SSM_BENCH_LIMIT_S (480): the
 # bench is stopped after that many seconds and what it finished is handed back, so that a run
 # ends inside the device tool's 10-minute limit on a command; SSM_BENCH_PACK (.gpu-bench): the
-# packed folder, relative to the repository's root or absolute.
+# packed folder, relative to the repository's root or absolute; SSM_BENCH_RESULTS: instead of the
+# speed presets, run scripts/results.sh (needs python3) with these arguments (e.g. "--only
+# summary,trade --width 1920 --height 1080") and hand back docs/results-<adapter>.md and its plots,
+# the file a GPU run adds beside the lavapipe docs/results.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # ldconfig lives in /sbin, which a user other than root may not have on PATH.
@@ -60,6 +63,14 @@ esac
 
 work=$(mktemp -d)
 status=0
+if [ -n "${SSM_BENCH_RESULTS:-}" ]; then
+    # shellcheck disable=SC2086 # the arguments are meant to split
+    SSM_BIN="$(cd "$pack" && pwd)/ssm" timeout -k 20 "${SSM_BENCH_LIMIT_S:-480}" scripts/results.sh --output-root "$work" $SSM_BENCH_RESULTS || status=$?
+    (cd "$work" && find . -type f | sort | tar -czf "$out/results.tar.gz" -T -)
+    cp "$work"/docs/results*.md "$out"/ 2>/dev/null || true
+    [ "$status" = 0 ] || echo "gpu-bench-device: results.sh ended with status $status (124: stopped at SSM_BENCH_LIMIT_S)" >&2
+    exit "$status"
+fi
 # SIGKILL 20 s after the SIGTERM, for an `ssm` stuck in the driver.
 SSM_BIN="$(cd "$pack" && pwd)/ssm" timeout -k 20 "${SSM_BENCH_LIMIT_S:-480}" scripts/gpu-bench.sh "$work" || status=$?
 # What finished comes back, also after the time limit (status 124).

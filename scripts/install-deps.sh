@@ -30,6 +30,8 @@ if [ "${1:-}" = "--for-tests" ]; then
     command -v Xvfb >/dev/null 2>&1 || packages+=(xvfb)
     command -v xdotool >/dev/null 2>&1 || packages+=(xdotool)
     command -v import >/dev/null 2>&1 || packages+=(imagemagick)
+    # scripts/results.sh assembles its Markdown with Python 3.11 (tomllib); a test runs it.
+    command -v python3 >/dev/null 2>&1 || packages+=(python3)
     # winit loads these with dlopen, so nothing at build time asks for them.
     if command -v dpkg >/dev/null 2>&1; then
         for library in libxkbcommon-x11-0 libxcursor1 libxi6 libxrandr2 libx11-xcb1; do

@@ -80,6 +80,7 @@ def main():
     parser.add_argument("--height", type=int, default=240, help="image height of every run (default 240)")
     parser.add_argument("--paper-sizes", action="store_true", help="each preset at its paper's viewport instead of --width/--height")
     parser.add_argument("--frames", type=int, default=3, help="frames timed per point after a warm-up (default 3)")
+    parser.add_argument("--output-root", type=Path, default=ROOT, help="write the generated files under this folder, laid out as the workspace (default: the workspace itself; elsewhere README.md is left alone)")
     parser.add_argument("--splice-summary", action="store_true", help="only copy docs/results/summary.md (written by the last full run) into README.md")
     parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, and technique names (default: all)")
     args = parser.parse_args(sys.argv[1:])
@@ -113,7 +114,8 @@ def main():
                 f"- Commit: {commit}\n- Images: {pixels}; {args.frames} timed frames per point after a warm-up; "
                 "ground truth traced afresh (empty cache).\n\n")
 
-    docs = ROOT / "docs"
+    out_root = args.output_root.resolve()
+    docs = out_root / "docs"
     images = docs / "results" / slug if slug else docs / "results"
     images.mkdir(parents=True, exist_ok=True)
     image_link = lambda name: os.path.relpath(images / name, docs)
@@ -182,7 +184,8 @@ def main():
             technique_sections.setdefault(technique, []).append((example, f"the `{example}` example's output, as printed", command, printed))
 
     for technique, sections in sorted(technique_sections.items()):
-        folder = ROOT / "ssm-techniques" / technique
+        folder = out_root / "ssm-techniques" / technique
+        folder.mkdir(parents=True, exist_ok=True)
         text = []
         for name, description, command, out in sections:
             text.append(f"## {name}\n\n{description}\n\n`{shown(command, scratch)}`\n")
@@ -206,7 +209,7 @@ def main():
     if summary_rows:
         table = summary_table(summary_rows, args)
         body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
-        if lavapipe:
+        if lavapipe and out_root == ROOT:
             summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
                        f"([docs/results.md](docs/results.md)).\n")
             (docs / "results" / "summary.md").write_text(summary)
@@ -215,7 +218,7 @@ def main():
     if body:
         target = docs / ("results.md" if lavapipe else f"results-{slug}.md")
         target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(body))
-        print(f"results: wrote {target.relative_to(ROOT)}", file=sys.stderr)
+        print(f"results: wrote {target}", file=sys.stderr)
     shutil.rmtree(scratch / "cache", ignore_errors=True)
 
 

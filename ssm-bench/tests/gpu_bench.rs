@@ -27,6 +27,10 @@ fn pack(test: &str) -> PathBuf {
 }
 
 fn device_script(test: &str, pack: &Path, out: &Path, allow_cpu: bool) -> Output {
+    device_script_with(test, pack, out, allow_cpu, &[])
+}
+
+fn device_script_with(test: &str, pack: &Path, out: &Path, allow_cpu: bool, env: &[(&str, &str)]) -> Output {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/gpu-bench-device.sh");
     let mut command = Command::new("bash");
     command
@@ -43,6 +47,7 @@ fn device_script(test: &str, pack: &Path, out: &Path, allow_cpu: bool) -> Output
     if allow_cpu {
         command.env("SSM_BENCH_ALLOW_CPU", "1");
     }
+    command.envs(env.iter().copied());
     command.output().expect("bash runs the script")
 }
 
@@ -100,4 +105,43 @@ fn the_device_script_hands_back_the_table_and_the_sweeps() {
     let archive = Command::new("tar").arg("-xzOf").arg(out.join("sweeps.tar.gz")).arg("./atty-map-size-time/sweep.csv").output().unwrap();
     let csv = String::from_utf8_lossy(&archive.stdout);
     assert!(csv.lines().next().is_some_and(|h| h.ends_with(",texel_reads,passes_work")), "the sweep's work columns: {csv}");
+}
+
+/// With SSM_BENCH_RESULTS the device script runs scripts/results.sh on the packed `ssm` (no build)
+/// and hands back the results file, headed by its command, adapter, date and commit, leaving the
+/// workspace's own generated files alone.
+#[test]
+fn the_device_script_hands_back_the_results_file() {
+    let (pack, out) = (pack("results"), scratch("results-out"));
+    let readme = Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+    let readme_before = std::fs::read_to_string(&readme).unwrap();
+    let arguments = "--only summary --width 48 --height 36 --frames 1";
+    let output = device_script_with("results", &pack, &out, true, &[("SSM_BENCH_RESULTS", arguments)]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "the script failed: {stderr}");
+    let adapter = std::fs::read_to_string(out.join("adapter.txt")).unwrap();
+    let name = adapter.trim().trim_start_matches("adapter: ").split(" [").next().unwrap().to_owned();
+    // lavapipe's run is docs/results.md; any other adapter's docs/results-<adapter>.md.
+    let file = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .find(|path| path.file_name().is_some_and(|n| n.to_string_lossy().starts_with("results") && n.to_string_lossy().ends_with(".md")))
+        .unwrap_or_else(|| panic!("a results file comes back: {stderr}"));
+    let results = std::fs::read_to_string(&file).unwrap();
+    let head: Vec<&str> = results.lines().take(8).collect();
+    assert!(head[0].contains("scripts/results.sh --output-root") && head[0].contains(arguments), "the command first: {head:?}");
+    assert!(head.iter().any(|line| line.starts_with("- Adapter: ") && line.contains(&name)), "the adapter: {head:?}");
+    assert!(head.iter().any(|line| line.starts_with("- Date: 20")), "the date: {head:?}");
+    assert!(head.iter().any(|line| line.starts_with("- Commit: ") && line.len() > 20), "the commit: {head:?}");
+    // One summary row per technique the framework compares, each with a number on the first scene.
+    for technique in ["hard", "pcss", "multi-sm", "vssm", "sssm", "atty", "pvsm", "wedges"] {
+        let row = results
+            .lines()
+            .find(|line| line.starts_with(&format!("| [`{technique}`]")))
+            .unwrap_or_else(|| panic!("no summary row for {technique}:\n{results}"));
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let error: f64 = cells[5].parse().unwrap_or_else(|_| panic!("an error in `{row}`"));
+        assert!((0.0..=1.0).contains(&error), "{row}");
+    }
+    assert_eq!(std::fs::read_to_string(&readme).unwrap(), readme_before, "README.md is left alone");
 }
