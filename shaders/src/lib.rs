@@ -5,6 +5,14 @@
 //! [`FILES`] lists every file by the path an `// #import` line names it by
 //! (`common/screen_pass.wgsl`). The modules are generated from the folders by `build.rs`: a
 //! new folder of WGSL files needs no line here.
+//!
+//! # Example
+//!
+//! ```
+//! let (_, source) = ssm_shaders::FILES.iter().find(|(path, _)| *path == "common/screen_pass.wgsl").expect("a common file");
+//! assert!(source.contains("fn trivial_visibility"));
+//! assert_eq!(ssm_shaders::hard::HARD, ssm_shaders::FILES.iter().find(|(p, _)| *p == "hard/hard.wgsl").map(|(_, s)| *s).unwrap_or(""));
+//! ```
 
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 

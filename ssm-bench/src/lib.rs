@@ -2,6 +2,18 @@
 //! (the whole command line, for any binary that links techniques and calls it), the registry
 //! (every technique crate linked through the `ssm-techniques` facade), the bench image size, the
 //! rendering of one technique to files, and the charts.
+//!
+//! # Example
+//!
+//! The `ssm` binary of a crate of one's own (what `ssm new --standalone` writes): link the
+//! techniques, then hand over the command line.
+//!
+//! ```no_run
+//! fn main() -> std::process::ExitCode {
+//!     ssm_techniques::link_all(); // or one crate's `ssm_mine::link()`
+//!     ssm_bench::run()
+//! }
+//! ```
 
 pub mod charts;
 mod commands;

@@ -12,6 +12,29 @@
 //! - [`LightDepthMap`]: the light-space depth pass most techniques start from;
 //!   [`ScreenPass`]: a full-screen pass over the G-buffer for one light.
 //! - [`image_io`]: EXR and PNG output.
+//!
+//! Adding a technique: `ssm new <name>` writes a crate that implements the trait
+//! (docs/adding-a-technique.md). The technique crates are used as below; here with the
+//! ground truth this crate holds (`reference`: shadow rays traced on the CPU):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use ssm_core::{GpuContext, Registry, Renderer};
+//!
+//! ssm_core::reference::link();
+//! let gpu = GpuContext::new()?;
+//! let scene = ssm_scene::builtin("parallel-square")?.build();
+//! let info = Registry::global()?.get("reference")?;
+//! let params = info.params_from([("samples", "2"), ("cache", "false")])?;
+//! let mut renderer = Renderer::new(&gpu, &scene, 32, 32, &(info.requirements)(&params)?)?;
+//! let mut technique = renderer.create_technique(info, &params)?;
+//! renderer.render(technique.as_mut(), info.name)?;
+//! // Per pixel, the fraction of the light each point sees (1 lit, 0 in umbra).
+//! let visibility = renderer.read_visibility(0, info.name)?;
+//! assert!(visibility.iter().any(|v| *v == 0.0) && visibility.iter().any(|v| *v == 1.0));
+//! # Ok(())
+//! # }
+//! ```
 
 // The derives name this crate `::ssm_core`, also when used inside it.
 extern crate self as ssm_core;

@@ -5,6 +5,18 @@
 //! registration is in the binary: the linker keeps a crate only when
 //! something calls into it. The list is this crate's `Cargo.toml`: adding a
 //! technique is one line there.
+//!
+//! # Example
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let names = ssm_techniques::link_all();
+//! assert!(names.contains(&"pvsm") && names.contains(&"reference"));
+//! let pcss = ssm_techniques::registry()?.get("pcss")?;
+//! println!("{}: {} parameters", pcss.name, pcss.params.len());
+//! # Ok(())
+//! # }
+//! ```
 
 include!(concat!(env!("OUT_DIR"), "/link_all.rs"));
 

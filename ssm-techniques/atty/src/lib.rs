@@ -21,6 +21,34 @@
 //! shadowing itself through its own micro-patches: the receiver map carries
 //! each receiver's tangent plane, and a patch on or behind it hides nothing
 //! (`receiver_plane`, on by default).
+//!
+//! # Example
+//!
+//! From the command line: `ssm render --scene contact --technique atty --set
+//! atty.occluder_map_size=128 --out out` (`ssm list` gives every parameter). From Rust, through the
+//! framework, as every technique crate is used (`ssm_atty::link()` keeps its registration in
+//! the binary; `ssm_techniques::link_all()` links every crate of the workspace):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use ssm_core::{GpuContext, Registry, Renderer};
+//!
+//! ssm_atty::link();
+//! let gpu = GpuContext::new()?;
+//! let scene = ssm_scene::builtin("contact")?.build();
+//! let info = Registry::global()?.get("atty")?;
+//! let params = info.params_from([("occluder_map_size", "128")])?;
+//! let mut renderer = Renderer::new(&gpu, &scene, 64, 48, &(info.requirements)(&params)?)?;
+//! let mut technique = renderer.create_technique(info, &params)?;
+//! let timings = renderer.render(technique.as_mut(), info.name)?;
+//! // One value per pixel for the scene's first light: 1 lit, 0 in shadow.
+//! let visibility = renderer.read_visibility(0, info.name)?;
+//! assert_eq!(visibility.len(), 64 * 48);
+//! assert!(visibility.iter().all(|v| (0.0..=1.0).contains(v)));
+//! println!("{} in {:.2} ms", info.name, timings.frame_ms());
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod geometry;
 

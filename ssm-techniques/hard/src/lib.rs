@@ -5,6 +5,34 @@
 //! comparison per pixel: visibility is 0 or 1. It is the fast end of every
 //! speed/accuracy plot and the limit every soft technique must reach as the
 //! light shrinks to a point.
+//!
+//! # Example
+//!
+//! From the command line: `ssm render --scene contact --technique hard --set
+//! hard.shadow_map_size=1024 --out out` (`ssm list` gives every parameter). From Rust, through the
+//! framework, as every technique crate is used (`ssm_hard::link()` keeps its registration in
+//! the binary; `ssm_techniques::link_all()` links every crate of the workspace):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use ssm_core::{GpuContext, Registry, Renderer};
+//!
+//! ssm_hard::link();
+//! let gpu = GpuContext::new()?;
+//! let scene = ssm_scene::builtin("contact")?.build();
+//! let info = Registry::global()?.get("hard")?;
+//! let params = info.params_from([("shadow_map_size", "1024")])?;
+//! let mut renderer = Renderer::new(&gpu, &scene, 64, 48, &(info.requirements)(&params)?)?;
+//! let mut technique = renderer.create_technique(info, &params)?;
+//! let timings = renderer.render(technique.as_mut(), info.name)?;
+//! // One value per pixel for the scene's first light: 1 lit, 0 in shadow.
+//! let visibility = renderer.read_visibility(0, info.name)?;
+//! assert_eq!(visibility.len(), 64 * 48);
+//! assert!(visibility.iter().all(|v| (0.0..=1.0).contains(v)));
+//! println!("{} in {:.2} ms", info.name, timings.frame_ms());
+//! # Ok(())
+//! # }
+//! ```
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};

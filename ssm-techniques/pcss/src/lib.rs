@@ -8,6 +8,34 @@
 //! the penumbra width from that average by similar triangles, and filter the
 //! shadow test over it. Cost grows with n² + m² per pixel: the reason
 //! separable and predicted variants exist.
+//!
+//! # Example
+//!
+//! From the command line: `ssm render --scene contact --technique pcss --set
+//! pcss.pcf_kernel=21 --out out` (`ssm list` gives every parameter). From Rust, through the
+//! framework, as every technique crate is used (`ssm_pcss::link()` keeps its registration in
+//! the binary; `ssm_techniques::link_all()` links every crate of the workspace):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use ssm_core::{GpuContext, Registry, Renderer};
+//!
+//! ssm_pcss::link();
+//! let gpu = GpuContext::new()?;
+//! let scene = ssm_scene::builtin("contact")?.build();
+//! let info = Registry::global()?.get("pcss")?;
+//! let params = info.params_from([("pcf_kernel", "21")])?;
+//! let mut renderer = Renderer::new(&gpu, &scene, 64, 48, &(info.requirements)(&params)?)?;
+//! let mut technique = renderer.create_technique(info, &params)?;
+//! let timings = renderer.render(technique.as_mut(), info.name)?;
+//! // One value per pixel for the scene's first light: 1 lit, 0 in shadow.
+//! let visibility = renderer.read_visibility(0, info.name)?;
+//! assert_eq!(visibility.len(), 64 * 48);
+//! assert!(visibility.iter().all(|v| (0.0..=1.0).contains(v)));
+//! println!("{} in {:.2} ms", info.name, timings.frame_ms());
+//! # Ok(())
+//! # }
+//! ```
 
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{

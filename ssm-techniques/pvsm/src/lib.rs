@@ -20,6 +20,34 @@
 //!    and the texel-as-quad filtering of the pixels whose filter reaches it,
 //!    walked top-down over that pyramid (`pvsm_tile_filter`), merged per
 //!    pixel, then the ratio (`pvsm_resolve`).
+//!
+//! # Example
+//!
+//! From the command line: `ssm render --scene contact --technique pvsm --set
+//! pvsm.max_tile_size=1024 --out out` (`ssm list` gives every parameter). From Rust, through the
+//! framework, as every technique crate is used (`ssm_pvsm::link()` keeps its registration in
+//! the binary; `ssm_techniques::link_all()` links every crate of the workspace):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use ssm_core::{GpuContext, Registry, Renderer};
+//!
+//! ssm_pvsm::link();
+//! let gpu = GpuContext::new()?;
+//! let scene = ssm_scene::builtin("contact")?.build();
+//! let info = Registry::global()?.get("pvsm")?;
+//! let params = info.params_from([("max_tile_size", "1024")])?;
+//! let mut renderer = Renderer::new(&gpu, &scene, 64, 48, &(info.requirements)(&params)?)?;
+//! let mut technique = renderer.create_technique(info, &params)?;
+//! let timings = renderer.render(technique.as_mut(), info.name)?;
+//! // One value per pixel for the scene's first light: 1 lit, 0 in shadow.
+//! let visibility = renderer.read_visibility(0, info.name)?;
+//! assert_eq!(visibility.len(), 64 * 48);
+//! assert!(visibility.iter().all(|v| (0.0..=1.0).contains(v)));
+//! println!("{} in {:.2} ms", info.name, timings.frame_ms());
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod kdtree;
 pub mod prediction;

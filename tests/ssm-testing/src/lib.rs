@@ -13,6 +13,26 @@
 //! - [`compare_with_reference`]: image comparison with a tolerance, writing
 //!   `-actual` and `-diff` images on failure; a missing reference image
 //!   fails unless blessed (`SSM_BLESS=1`).
+//!
+//! # Example
+//!
+//! A technique's penumbra against the analytic visibility of `parallel-square` (here the ground
+//! truth, which this crate can reach without a technique crate):
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let gpu = ssm_testing::gpu();
+//! ssm_core::reference::link();
+//! let info = ssm_core::Registry::global()?.get("reference")?;
+//! let scene = ssm_scene::builtin("parallel-square")?.build();
+//! let rendered = ssm_testing::render(&gpu, &scene, info, &[("samples", "8"), ("cache", "false")], 48, 48)?;
+//! let exact = rendered.parallel_square_exact();
+//! let penumbra = ssm_testing::penumbra_mask(&exact);
+//! let error = ssm_testing::mean_abs_difference(&rendered.visibility, &exact, &penumbra);
+//! assert!(error < 0.05, "8x8 stratified rays per pixel: {error}");
+//! # Ok(())
+//! # }
+//! ```
 
 use glam::Vec3;
 use ssm_core::metrics::{ErrorMetrics, compare};
