@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The speed presets on whatever adapter wgpu picks, at 1920×1080 unless told otherwise, gathered
 # into one Markdown table that names the adapter (issue 13: run it on a machine with a GPU and put
-# the table in the README beside the lavapipe one). Every point's work is counted too (`--count-work`,
+# the table beside the lavapipe results; scripts/results.sh, through SSM_BENCH_RESULTS in gpu-bench-device.sh, writes docs/results-<adapter>.md). Every point's work is counted too (`--count-work`,
 # issue 40: one extra, untimed frame per point), so the table and each sweep.csv give times and
 # counted work (invocations, texel reads, per pass in passes_work) side by side.
 #

@@ -16,10 +16,11 @@ pub const PARAMETERS_END: &str = "<!-- /parameters -->";
 /// The technique's requirements cannot be derived from its defaults.
 pub fn parameters_markdown(info: &TechniqueInfo) -> ssm_core::Result<String> {
     let mut text = String::new();
-    text.push_str("Generated from the settings (`ssm list`); `cargo test -p ssm-bench --test docs` checks it and\n");
-    text.push_str("`SSM_BLESS=1` rewrites it. Set each with `--set ");
-    text.push_str(info.name);
-    text.push_str(".<name>=<value>`.\n\n");
+    text.push_str(&format!(
+        "Generated from the settings (`ssm list --parameters-of {name}`; in the ssm checkout `cargo test -p ssm-bench\n\
+         --test docs` checks it and `SSM_BLESS=1` rewrites it). Set each with `--set {name}.<parameter>=<value>`.\n\n",
+        name = info.name
+    ));
     text.push_str("| parameter | default | values | what it does |\n|---|---|---|---|\n");
     for spec in info.params {
         let doc = spec.doc.replace('|', "\\|").replace('\n', " ");

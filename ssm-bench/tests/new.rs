@@ -228,6 +228,17 @@ fn a_standalone_crate_builds_lists_and_renders() {
     for technique in ["probe", "hard", "pcss", "reference"] {
         assert!(listed.lines().any(|l| l.starts_with(&format!("{technique}: "))), "{technique} missing from:\n{listed}");
     }
+    // The README's parameter table is the one the registry generates for the built crate (what the
+    // checkout's docs test demands of every technique README).
+    let table = Command::new(&binary).args(["list", "--parameters-of", "probe"]).output().unwrap();
+    assert!(table.status.success(), "{}", String::from_utf8_lossy(&table.stderr));
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    let table = String::from_utf8_lossy(&table.stdout);
+    assert_eq!(
+        ssm_bench::docs::with_parameters(&readme, &table).as_deref(),
+        Some(readme.as_str()),
+        "README.md's parameter table differs from `ssm list --parameters-of probe` (regenerate ssm-bench/src/commands/new/parameters.md.tmpl):\n{table}"
+    );
     let out = parent.join("render");
     let render = Command::new(&binary)
         .args(["render", "--scene", "parallel-square", "--technique", "probe,pcss", "--width", "48", "--height", "36", "--out"])

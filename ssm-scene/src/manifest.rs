@@ -1,7 +1,7 @@
 //! The TOML scene manifest, and the staging of a bare model file into one.
 //!
 //! A manifest names model files (or built-in primitives) with their transforms
-//! and roles, the lights, and optionally the camera. The README documents the
+//! and roles, the lights, and optionally the camera. The project's docs/scenes.md documents the
 //! format with a complete example; [`Manifest::to_toml`] writes one back.
 
 use std::collections::BTreeMap;

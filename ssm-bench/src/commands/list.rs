@@ -66,6 +66,13 @@ pub(super) fn techniques(format: Format) -> Result<()> {
     Ok(())
 }
 
+/// `ssm list --parameters-of <technique>`: its README's generated parameter table.
+pub(super) fn parameters_markdown(name: &str) -> Result<()> {
+    let info = registry()?.get(name)?;
+    say!("{}", crate::docs::parameters_markdown(info)?.trim_end());
+    Ok(())
+}
+
 /// `ssm scenes`: the built-in scenes, their triangle counts and parameters.
 pub(super) fn scenes(format: Format) -> Result<()> {
     if format == Format::Json {

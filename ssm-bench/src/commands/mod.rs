@@ -31,7 +31,10 @@ mod view;
 /// message and exits the process (status 2), as clap does.
 pub(crate) fn parse_and_run() -> Result<()> {
     match Cli::parse().command {
-        Command::List(args) => list::techniques(args.format),
+        Command::List(args) => match &args.parameters_of {
+            Some(name) => list::parameters_markdown(name),
+            None => list::techniques(args.format.format),
+        },
         Command::Scenes(args) => list::scenes(args.format),
         Command::Render(args) => render::run(&args),
         Command::Compare(args) => compare::run(&args),
@@ -52,7 +55,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// List the registered techniques with their parameters, requirements and whether this adapter runs them.
-    List(FormatArgs),
+    List(ListArgs),
     /// List the built-in scenes and their parameters (`--scene forest:triangles=800000`).
     Scenes(FormatArgs),
     /// Render a scene with one or more techniques and write images and timings.
@@ -78,6 +81,16 @@ enum Format {
     Text,
     /// One JSON document on stdout, for scripts (progress and notes go to stderr).
     Json,
+}
+
+#[derive(clap::Args)]
+struct ListArgs {
+    #[command(flatten)]
+    format: FormatArgs,
+    /// Print only this technique's parameter table, in Markdown, as its README carries it
+    /// between `<!-- parameters -->` and `<!-- /parameters -->`.
+    #[arg(long, value_name = "TECHNIQUE")]
+    parameters_of: Option<String>,
 }
 
 #[derive(clap::Args)]

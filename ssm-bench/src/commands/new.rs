@@ -259,6 +259,16 @@ mod templates {
     pub(super) const MAIN_RS: &str = include_str!("new/main.rs.tmpl");
     pub(super) const SHADER: &str = include_str!("new/technique.wgsl.tmpl");
     pub(super) const README: &str = include_str!("new/README.md.tmpl");
+    /// The README's parameter table as `ssm list --parameters-of` prints it for the template's
+    /// settings (`{{name}}` for the technique's name): the checkout's docs test compares every
+    /// technique README's table with the registry's, so a new crate starts with the right one
+    /// (the standalone test checks this file against the built crate's own output).
+    pub(super) const PARAMETERS: &str = include_str!("new/parameters.md.tmpl");
+
+    /// The README template with its parameter table in place.
+    pub(super) fn readme() -> String {
+        README.replace("{{parameters}}", PARAMETERS)
+    }
     pub(super) const TEST: &str = include_str!("new/test.rs.tmpl");
 }
 
@@ -362,7 +372,7 @@ fn plan_in_tree(name: &TechniqueName, checkout: &Checkout) -> Result<InTreePlan>
     let values = values(name, &layout, &crate_ident);
     let files = vec![
         Planned { path: technique_dir.join("Cargo.toml"), text: fill(templates::CARGO_TOML, &values) },
-        Planned { path: technique_dir.join("README.md"), text: fill(templates::README, &values) },
+        Planned { path: technique_dir.join("README.md"), text: fill(&templates::readme(), &values) },
         Planned { path: technique_dir.join("src/lib.rs"), text: fill(templates::LIB_RS, &values) },
         Planned { path: technique_dir.join("tests").join(format!("{}.rs", name.name)), text: fill(templates::TEST, &values) },
         Planned { path: shader_dir.join(format!("{}.wgsl", name.name)), text: fill(templates::SHADER, &values) },
@@ -527,7 +537,7 @@ fn plan_standalone(name: &TechniqueName, checkout: &Checkout, dir: &Path) -> Res
     let mut files = vec![
         Planned { path: dir.join("Cargo.toml"), text: fill(templates::STANDALONE_CARGO_TOML, &values) },
         Planned { path: dir.join(".gitignore"), text: "/target\n".into() },
-        Planned { path: dir.join("README.md"), text: fill(templates::README, &values) },
+        Planned { path: dir.join("README.md"), text: fill(&templates::readme(), &values) },
         Planned { path: dir.join("src/lib.rs"), text: fill(templates::LIB_RS, &values) },
         Planned { path: dir.join("src/main.rs"), text: fill(templates::MAIN_RS, &values) },
         Planned { path: dir.join("shaders").join(format!("{}.wgsl", name.name)), text: fill(templates::SHADER, &values) },
@@ -633,8 +643,8 @@ mod tests {
             tree_tests: "",
         };
         let values = values(&name, &layout, "ssm_probe");
-        for template in
-            [templates::CARGO_TOML, templates::LIB_RS, templates::MAIN_RS, templates::SHADER, templates::README, templates::TEST]
+        let readme = templates::readme();
+        for template in [templates::CARGO_TOML, templates::LIB_RS, templates::MAIN_RS, templates::SHADER, readme.as_str(), templates::TEST]
         {
             let text = fill(template, &values);
             assert!(!text.contains("{{"), "{}", text.lines().find(|l| l.contains("{{")).unwrap_or_default());
