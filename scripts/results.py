@@ -34,6 +34,16 @@ EXAMPLES = {
     "atty": [("ssm-atty", "atty_work", [])],
     "wedges": [("ssm-wedges", "wedges_work", []), ("ssm-wedges", "fig1", []), ("ssm-wedges", "fig12", [])],
 }
+# The kinds of scene docs/choosing.md discusses: (heading, scene, extra sweep arguments, what it tests).
+SCENE_KINDS = [
+    ("contact shadows", "contact", [], "a box and a sphere resting on the ground: penumbrae from zero width"),
+    ("a large light", "sphere-cube", ["--vary", "scene.light_scale=3"], "overlapping penumbrae of 125 spheres under a light three times the default"),
+    ("thin geometry", "ssm-techniques/pvsm/doc/trellis.toml", ["--vary", "scene.light_scale=25"],
+     "a trellis of bars 0.04 thick, crossing bars touching, under a light 0.5 wide"),
+    ("an interior", "ssm-techniques/vssm/doc/room-lit-from-a-wall.toml", [], "a closed room lit from a wall at a slant, a block and a ball"),
+    ("many triangles", "forest:triangles=200000", [], "16 trees of leaf cards, 200,000 triangles"),
+]
+TECHNIQUES = ["hard", "pcss", "multi-sm", "vssm", "sssm", "atty", "pvsm", "wedges"]
 SUMMARY_BEGIN, SUMMARY_END = "<!-- summary -->", "<!-- /summary -->"
 
 
@@ -82,7 +92,7 @@ def main():
     parser.add_argument("--frames", type=int, default=3, help="frames timed per point after a warm-up (default 3)")
     parser.add_argument("--output-root", type=Path, default=ROOT, help="write the generated files under this folder, laid out as the workspace (default: the workspace itself; elsewhere README.md is left alone)")
     parser.add_argument("--splice-summary", action="store_true", help="only copy docs/results/summary.md (written by the last full run) into README.md")
-    parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, and technique names (default: all)")
+    parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, kinds, and technique names (default: all)")
     args = parser.parse_args(sys.argv[1:])
     only = set(filter(None, args.only.split(",")))
     if args.splice_summary:
@@ -160,7 +170,20 @@ def main():
         shutil.copy(out / "sweep.svg", images / "lights.svg")
         body.append(f"## lights\n\nSeveral lights: every technique at its defaults with 1, 2 and 3 copies of the light.\n\n`{shown(command, scratch)}`\n\n![time against lights]({image_link('lights.svg')})\n\n{sweep_table(out)}\n")
 
-    # 4. Each technique's paper presets (and the examples that reproduce its cost claims).
+    # 4. One scene per kind of scene, every technique at its defaults (docs/choosing.md reads these).
+    if wanted("kinds"):
+        body.append("## kinds\n\nEvery technique at its defaults on one scene of each kind ([docs/choosing.md](choosing.md) "
+                    "draws its advice from these tables). Under each table: the lowest error, the least counted work "
+                    "(texel reads and invocations) and the least time of the run.\n")
+        for heading, scene, extra, what in SCENE_KINDS:
+            out = scratch / f"kind-{re.sub(r'[^a-z0-9]+', '-', heading)}"
+            command = [str(SSM), "sweep", "--scene", scene, *extra, *[a for t in TECHNIQUES for a in ("--vary", t)], *size_args,
+                       "--frames", str(args.frames), "--count-work", "--out", str(out)]
+            run(command, log, env=env)
+            rows = list(csv.DictReader(open(out / "sweep.csv")))
+            body.append(f"### {heading}\n\n{what}.\n\n`{shown(command, scratch)}`\n\n{sweep_table(out)}\n\n{leaders(rows)}\n")
+
+    # 5. Each technique's paper presets (and the examples that reproduce its cost claims).
     technique_sections = {}
     for name, technique, description in presets():
         if technique is None or not wanted(technique):
@@ -205,7 +228,7 @@ def main():
         else:
             body.append(f"## {technique}\n\n" + "\n".join(text).replace("\n## ", "\n### "))
 
-    # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
+    # 6. The summary table (README.md and the results file), joined with docs/summary.toml's words.
     if summary_rows:
         table = summary_table(summary_rows, args)
         body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
@@ -220,6 +243,21 @@ def main():
         target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(body))
         print(f"results: wrote {target}", file=sys.stderr)
     shutil.rmtree(scratch / "cache", ignore_errors=True)
+
+
+def leaders(rows):
+    """One line naming, among `rows` (a sweep.csv's), the lowest error, the least work and the least time."""
+    def best(key, unit):
+        scored = [(float(r[key]), r["technique"]) for r in rows if r.get(key) not in (None, "")]
+        if not scored:
+            return "not measured"
+        value, name = min(scored)
+        return f"`{name}` ({value:,.0f}{unit})" if value >= 1000 else f"`{name}` ({value:.4g}{unit})"
+    for row in rows:
+        counts = [row.get(k) for k in ("vertex_invocations", "fragment_invocations", "compute_invocations", "texel_reads")]
+        row["work"] = str(sum(float(c) for c in counts)) if all(c not in (None, "") for c in counts) else ""
+    return (f"Lowest penumbra error: {best('mae_penumbra', '')}; least counted work: {best('work', ' reads and invocations')}; "
+            f"least time: {best('gpu_ms_median', ' ms')}.")
 
 
 def splice_summary(summary):

@@ -3,13 +3,13 @@
 # scratch, with the `ssm` commands that produce them (issue #42):
 #   docs/results.md and docs/results/*.svg        every technique on three scenes (times and counted
 #                                                 work side by side, per-pass charts, the ground
-#                                                 truth's cost), the trade plot, several lights
+#                                                 truth's cost), the trade plot, several lights, one scene per kind (docs/choosing.md)
 #   ssm-techniques/<t>/results.md (+ results/)    each technique's paper presets and examples
 #   README.md, between <!-- summary --> markers   the summary table (words from docs/summary.toml)
 # On an adapter other than lavapipe (a lent GPU: scripts/gpu-bench-pack.sh) everything goes to one
 # file, docs/results-<adapter>.md, beside the lavapipe one.
 #
-#   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 3] [--only summary,trade,lights,pvsm,...]
+#   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 3] [--only summary,trade,lights,kinds,pvsm,...]
 #   scripts/results.sh --splice-summary   (only copies docs/results/summary.md into README.md)
 #
 # Needs python3 (3.11+, for tomllib). Takes hours on lavapipe at the defaults; --only runs a part.
