@@ -89,7 +89,7 @@ def main():
     parser.add_argument("--width", type=int, default=320, help="image width of every run (default 320)")
     parser.add_argument("--height", type=int, default=240, help="image height of every run (default 240)")
     parser.add_argument("--paper-sizes", action="store_true", help="each preset at its paper's viewport instead of --width/--height")
-    parser.add_argument("--frames", type=int, default=3, help="frames timed per point after a warm-up (default 3)")
+    parser.add_argument("--frames", type=int, default=1, help="frames timed per point after a warm-up (default 1: lavapipe runs every preset in a few hours; a GPU run can afford 5)")
     parser.add_argument("--output-root", type=Path, default=ROOT, help="write the generated files under this folder, laid out as the workspace (default: the workspace itself; elsewhere README.md is left alone)")
     parser.add_argument("--splice-summary", action="store_true", help="only copy docs/results/summary.md (written by the last full run) into README.md")
     parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, kinds, and technique names (default: all)")
@@ -183,19 +183,45 @@ def main():
             rows = list(csv.DictReader(open(out / "sweep.csv")))
             body.append(f"### {heading}\n\n{what}.\n\n`{shown(command, scratch)}`\n\n{sweep_table(out)}\n\n{leaders(rows)}\n")
 
-    # 5. Each technique's paper presets (and the examples that reproduce its cost claims).
-    technique_sections = {}
+    # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
+    if summary_rows:
+        table = summary_table(summary_rows, args)
+        body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
+        if lavapipe and out_root == ROOT:
+            summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
+                       f"([docs/results.md](docs/results.md)).\n")
+            (docs / "results" / "summary.md").write_text(summary)
+            splice_summary(summary)
+    # Written now, and again after each technique on another adapter: a run stopped part-way (a
+    # lent GPU's time limit) keeps what it finished.
+    target = docs / ("results.md" if lavapipe else f"results-{slug}.md")
+
+    def write_results():
+        if body:
+            target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(body))
+            print(f"results: wrote {target}", file=sys.stderr)
+
+    write_results()
+
+    # 6. Each technique's paper presets and the examples that reproduce its cost claims, the
+    # technique's results written as soon as they are done.
+    by_technique = {}
     for name, technique, description in presets():
-        if technique is None or not wanted(technique):
-            continue
-        out = scratch / f"preset-{name}"
-        command = [str(SSM), "sweep", "--preset", name, *size_args, "--frames", str(args.frames), "--count-work", "--out", str(out)]
-        run(command, log, env=env)
-        technique_sections.setdefault(technique, []).append((name, description, command, out))
-    for technique, examples in EXAMPLES.items():
-        if not wanted(technique):
-            continue
-        for crate, example, extra in examples:
+        if technique is not None and wanted(technique):
+            by_technique.setdefault(technique, []).append((name, description))
+    for technique in EXAMPLES:
+        if wanted(technique):
+            by_technique.setdefault(technique, [])
+    # Cheaper techniques first, so that a run stopped part-way has the most to show.
+    order = ["hard", "pcss", "multi-sm", "vssm", "sssm", "wedges", "atty", "pvsm"]
+    for technique, technique_presets in sorted(by_technique.items(), key=lambda item: order.index(item[0]) if item[0] in order else len(order)):
+        sections = []
+        for name, description in technique_presets:
+            out = scratch / f"preset-{name}"
+            command = [str(SSM), "sweep", "--preset", name, *size_args, "--frames", str(args.frames), "--count-work", "--out", str(out)]
+            run(command, log, env=env)
+            sections.append((name, description, command, out))
+        for crate, example, extra in EXAMPLES.get(technique, []):
             binary = EXAMPLES_DIR / example
             command = [str(binary), *extra]
             if not binary.exists():
@@ -204,9 +230,7 @@ def main():
             else:
                 printed = run(command, log, env=env)
             command = ["cargo", "run", "--release", "-p", crate, "--example", example, "--", *extra]
-            technique_sections.setdefault(technique, []).append((example, f"the `{example}` example's output, as printed", command, printed))
-
-    for technique, sections in sorted(technique_sections.items()):
+            sections.append((example, f"the `{example}` example's output, as printed", command, printed))
         folder = out_root / "ssm-techniques" / technique
         folder.mkdir(parents=True, exist_ok=True)
         text = []
@@ -225,23 +249,10 @@ def main():
             text.append(sweep_table(out) + "\n")
         if lavapipe:
             (folder / "results.md").write_text(header(f"{technique}: reproduced figures") + "\n".join(text))
+            print(f"results: wrote {folder / 'results.md'}", file=sys.stderr)
         else:
             body.append(f"## {technique}\n\n" + "\n".join(text).replace("\n## ", "\n### "))
-
-    # 6. The summary table (README.md and the results file), joined with docs/summary.toml's words.
-    if summary_rows:
-        table = summary_table(summary_rows, args)
-        body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
-        if lavapipe and out_root == ROOT:
-            summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
-                       f"([docs/results.md](docs/results.md)).\n")
-            (docs / "results" / "summary.md").write_text(summary)
-            splice_summary(summary)
-
-    if body:
-        target = docs / ("results.md" if lavapipe else f"results-{slug}.md")
-        target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(body))
-        print(f"results: wrote {target}", file=sys.stderr)
+            write_results()
     shutil.rmtree(scratch / "cache", ignore_errors=True)
 
 
