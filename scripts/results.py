@@ -145,6 +145,8 @@ def main():
             # Drop the report's own title and its params column (every technique is at its defaults here).
             report = re.sub(r"^# .*\n", "", report)
             report = without_params(report)
+            # Its own sections sit under this scene's heading.
+            report = re.sub(r"^## ", "#### ", report, flags=re.MULTILINE)
             shutil.copy(out / "passes.svg", images / f"passes-{scene}.svg")
             body.append(f"### `{scene}`\n\n`{shown(command, scratch)}`\n\n{report.strip()}\n\n"
                         f"GPU time per pass: ![passes on {scene}]({image_link(f'passes-{scene}.svg')})\n")
@@ -186,7 +188,7 @@ def main():
     # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
     if summary_rows:
         table = summary_table(summary_rows, args)
-        body.insert(0, "## summary\n\nThe README's summary table.\n\n" + table + "\n")
+        body.insert(0, "## summary\n\nThe README's summary table.\n\n" + summary_table(summary_rows, args, "../") + "\n")
         if lavapipe and out_root == ROOT:
             summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
                        f"([docs/results.md](docs/results.md)).\n")
@@ -298,9 +300,10 @@ def without_params(report):
     return "\n".join(lines)
 
 
-def summary_table(rows, args):
+def summary_table(rows, args, prefix=""):
     """One row per technique: docs/summary.toml's words, then the penumbra error on each summary scene,
-    the time and the texel reads per frame on the first."""
+    the time and the texel reads per frame on the first; links relative to the workspace's root,
+    behind `prefix` (`../` from docs/)."""
     words = {}
     summary_file = ROOT / "docs" / "summary.toml"
     if summary_file.exists():
@@ -316,7 +319,7 @@ def summary_table(rows, args):
             continue
         entry = words.get(name, {})
         first = rows[name].get(scenes[0], {})
-        cells = [f"[`{name}`](ssm-techniques/{name}/README.md)" if (ROOT / "ssm-techniques" / name).is_dir() else f"`{name}`",
+        cells = [f"[`{name}`]({prefix}ssm-techniques/{name}/README.md)" if (ROOT / "ssm-techniques" / name).is_dir() else f"`{name}`",
                  entry.get("best", ""), entry.get("worst", ""), entry.get("cost", "")]
         cells += [rows[name].get(s, {}).get("mae_penumbra", "") and f"{float(rows[name][s]['mae_penumbra']):.4f}" for s in scenes]
         cells.append(first.get("gpu_ms_median", "") and f"{float(first['gpu_ms_median']):.2f}")
