@@ -3,6 +3,46 @@
 //! A technique declares its settings once, as a documented struct; the derive
 //! makes the string parameters (`ssm list`, `--set`, sweeps) from it, so that
 //! no parameter's name, default, range or documentation is written twice.
+//!
+//! # Example
+//!
+//! ```
+//! use ssm_core::{Choice, ParamValues, Settings};
+//!
+//! /// How the taps are spread.
+//! #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+//! enum Pattern {
+//!     /// A regular grid.
+//!     Grid,
+//!     /// A Poisson disc.
+//!     Poisson,
+//! }
+//!
+//! /// A filter's settings: each field a parameter, its doc comment the parameter's meaning.
+//! #[derive(Clone, Copy, Debug, PartialEq, Settings)]
+//! struct FilterSettings {
+//!     /// Taps per axis, count.
+//!     #[param(default = 3, min = 1, max = 16)]
+//!     kernel: u32,
+//!     /// Half the filter's side, shadow-map texels.
+//!     #[param(default = 1.5, min = 0.0, max = 32.0)]
+//!     radius: f32,
+//!     /// Where the taps go.
+//!     #[param(choice, default = "grid")]
+//!     pattern: Pattern,
+//! }
+//!
+//! let names: Vec<&str> = FilterSettings::PARAMS.iter().map(|spec| spec.name).collect();
+//! assert_eq!(names, ["kernel", "radius", "pattern"]);
+//! // What `--set mine.kernel=5 --set mine.pattern=poisson` does.
+//! let mut values = ParamValues::defaults("mine", FilterSettings::PARAMS);
+//! values.set("kernel", "5").unwrap();
+//! values.set("pattern", "poisson").unwrap();
+//! let settings = FilterSettings::from_params(&values).unwrap();
+//! assert_eq!(settings, FilterSettings { kernel: 5, radius: 1.5, pattern: Pattern::Poisson });
+//! // Out of range is a typed error, not a clamp.
+//! assert!(values.set("kernel", "17").is_err());
+//! ```
 
 use proc_macro::TokenStream;
 use proc_macro2::TokenStream as Tokens;
