@@ -25,6 +25,20 @@ fn counted(settings: &[(&str, &str)]) -> (Rendered, FrameWork) {
     (rendered, work)
 }
 
+/// One frame's work in the paper's mode (one micro-patch per occluder texel, the receiver's depth
+/// alone, rectangles to the far plane) with an `n`² occluder map and an `s`² soft shadow map.
+fn counted_paper_mode(n: u32, s: u32) -> FrameWork {
+    let (n, s) = (n.to_string(), s.to_string());
+    counted(&[
+        ("occluder_map_size", &n),
+        ("ssm_size", &s),
+        ("merge_tolerance", "0"),
+        ("receiver_plane", "false"),
+        ("penumbra_bound", "far_plane"),
+    ])
+    .1
+}
+
 fn pass<'a>(work: &'a FrameWork, name: &str) -> &'a PassWork {
     work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()))
 }
@@ -106,13 +120,7 @@ fn reduce_texels(n: u32) -> u64 {
 #[test]
 fn the_paper_mode_lists_one_patch_per_occluder_texel_and_reads_one_texel_per_fragment() {
     let (n, s) = (50, 64);
-    let (_, work) = counted(&[
-        ("occluder_map_size", &n.to_string()),
-        ("ssm_size", &s.to_string()),
-        ("merge_tolerance", "0"),
-        ("receiver_plane", "false"),
-        ("penumbra_bound", "far_plane"),
-    ]);
+    let work = counted_paper_mode(n, s);
     let texels = occluder_texels(n);
     assert!(texels > 0 && texels < u64::from(n * n), "{texels} occluder texels of {}", n * n);
     let patches = pass(&work, "atty_accumulate_patches");
@@ -196,13 +204,7 @@ fn fragments_per_micro_patch_fall_towards_a_point_occluders_footprint_as_the_map
     let mut per_patch = Vec::new();
     let mut totals = Vec::new();
     for n in [40u32, 80, 160] {
-        let (_, work) = counted(&[
-            ("occluder_map_size", &n.to_string()),
-            ("ssm_size", &s.to_string()),
-            ("merge_tolerance", "0"),
-            ("receiver_plane", "false"),
-            ("penumbra_bound", "far_plane"),
-        ]);
+        let work = counted_paper_mode(n, s);
         let patches = pass(&work, "atty_accumulate_patches").atomics;
         let fragments = pass(&work, "atty_accumulate").counted_invocations;
         println!("n = {n}: {patches} patches, {fragments} fragments, {:.1} per patch", fragments as f64 / patches as f64);
