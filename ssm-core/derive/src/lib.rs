@@ -7,6 +7,7 @@
 //! # Example
 //!
 //! ```
+//! # fn main() -> Result<(), ssm_core::ParamError> {
 //! use ssm_core::{Choice, ParamValues, Settings};
 //!
 //! /// How the taps are spread.
@@ -36,12 +37,14 @@
 //! assert_eq!(names, ["kernel", "radius", "pattern"]);
 //! // What `--set mine.kernel=5 --set mine.pattern=poisson` does.
 //! let mut values = ParamValues::defaults("mine", FilterSettings::PARAMS);
-//! values.set("kernel", "5").unwrap();
-//! values.set("pattern", "poisson").unwrap();
-//! let settings = FilterSettings::from_params(&values).unwrap();
+//! values.set("kernel", "5")?;
+//! values.set("pattern", "poisson")?;
+//! let settings = FilterSettings::from_params(&values)?;
 //! assert_eq!(settings, FilterSettings { kernel: 5, radius: 1.5, pattern: Pattern::Poisson });
 //! // Out of range is a typed error, not a clamp.
 //! assert!(values.set("kernel", "17").is_err());
+//! # Ok(())
+//! # }
 //! ```
 
 use proc_macro::TokenStream;
