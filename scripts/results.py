@@ -269,8 +269,20 @@ def leaders(rows):
     for row in rows:
         counts = [row.get(k) for k in ("vertex_invocations", "fragment_invocations", "compute_invocations", "texel_reads")]
         row["work"] = str(sum(float(c) for c in counts)) if all(c not in (None, "") for c in counts) else ""
-    return (f"Lowest penumbra error: {best('mae_penumbra', '')}; least counted work: {best('work', ' reads and invocations')}; "
+    return (f"Lowest error: {lowest_error(rows)}; least counted work: {best('work', ' reads and invocations')}; "
             f"least time: {best('gpu_ms_median', ' ms')}.")
+
+
+def lowest_error(rows):
+    """The technique with the lowest headline error among `rows`, and those tied with it: errors closer
+    than the ground truth's combined noise over their pixels (`truth_noise` of each) are a tie."""
+    scored = [(float(r["mae"]), float(r.get("truth_noise") or 0.0), r["technique"]) for r in rows if r.get("mae") not in (None, "")]
+    if not scored:
+        return "not measured"
+    value, noise, name = min(scored)
+    tied = [f"`{n}` ({v:.4g})" for v, m, n in sorted(scored) if n != name and abs(v - value) < noise + m]
+    text = f"`{name}` ({value:.4g} ± {noise:.2g})"
+    return text + (f", tied within the truth's noise with {', '.join(tied)}" if tied else "")
 
 
 def splice_summary(summary):
@@ -321,11 +333,20 @@ def summary_table(rows, args, prefix=""):
         first = rows[name].get(scenes[0], {})
         cells = [f"[`{name}`]({prefix}ssm-techniques/{name}/README.md)" if (ROOT / "ssm-techniques" / name).is_dir() else f"`{name}`",
                  entry.get("best", ""), entry.get("worst", ""), entry.get("cost", "")]
-        cells += [rows[name].get(s, {}).get("mae_penumbra", "") and f"{float(rows[name][s]['mae_penumbra']):.4f}" for s in scenes]
+        cells += [error_cell(rows[name].get(s, {})) for s in scenes]
         cells.append(first.get("gpu_ms_median", "") and f"{float(first['gpu_ms_median']):.2f}")
         cells.append(first.get("texel_reads", "") and f"{int(float(first['texel_reads'])):,}")
         lines.append("| " + " | ".join(cells) + " |")
-    return head + "\n".join(lines) + f"\n\nMAE: mean absolute error of the visibility over the ground truth's umbra and penumbra; {args.width}×{args.height} pixels.\n"
+    return head + "\n".join(lines) + (f"\n\nMAE: mean absolute error of the visibility over the pixels that the ground truth or the technique "
+                                      f"shadows, ± the ground truth's own error over the same pixels; {args.width}×{args.height} pixels.\n")
+
+
+def error_cell(row):
+    """A row's headline error with the ground truth's noise beside it; empty when not measured."""
+    if row.get("mae") in (None, ""):
+        return ""
+    noise = row.get("truth_noise")
+    return f"{float(row['mae']):.4f}" + (f" ± {float(noise):.4f}" if noise not in (None, "") else "")
 
 
 if __name__ == "__main__":

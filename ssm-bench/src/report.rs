@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use ssm_core::image_io::{write_exr_gray, write_png_gray16, write_png_rgba8};
-use ssm_core::metrics::{ErrorMetrics, compare, flip_map, flip_mean, heat_map};
+use ssm_core::metrics::{ErrorMetrics, compare_with_noise, flip_map, flip_mean, heat_map};
 use ssm_core::{Error, FrameTimings, FrameWork, GBuffer, ParamValues, Renderer, Result, TechniqueInfo, TimingSource};
 
 use crate::median;
@@ -250,7 +250,16 @@ impl Running {
         let requested: Vec<&str> = info.debug_outputs.iter().map(|o| o.name).filter(|name| job.debug.contains(name)).collect();
         let extra_images = if requested.is_empty() { Vec::new() } else { self.technique.debug_outputs(&renderer.gpu, &requested)? };
         for image in &extra_images {
-            if !info.debug_outputs.iter().any(|o| o.name == image.name && o.overlay == image.overlay) {
+            // Light k's image of an output may be named `<name>-light<k>`.
+            let declared = |o: &&ssm_core::DebugOutput| {
+                image.name == o.name
+                    || image
+                        .name
+                        .strip_prefix(o.name)
+                        .and_then(|rest| rest.strip_prefix("-light"))
+                        .is_some_and(|k| k.parse::<usize>().is_ok())
+            };
+            if !info.debug_outputs.iter().filter(declared).any(|o| o.overlay == image.overlay) {
                 return Err(ssm_core::Error::Technique {
                     technique: info.name.to_owned(),
                     message: format!("debug output `{}` is not declared in its TechniqueInfo::debug_outputs as returned", image.name),
@@ -426,6 +435,10 @@ pub const CSV_COLUMNS: &[&str] = &[
     "compute_invocations",
     "texel_reads",
     "passes_work",
+    "mae",
+    "truth_noise",
+    "truth_noise_penumbra",
+    "shadowed_pixels",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -438,7 +451,10 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         .visibility
         .iter()
         .zip(&reference.visibility)
-        .map(|(image, truth)| compare(truth, image, covered, width as usize, height as usize))
+        .enumerate()
+        .map(|(light, (image, truth))| {
+            compare_with_noise(truth, truth_noise(reference, light), image, covered, width as usize, height as usize)
+        })
         .collect();
     Row {
         scene: scene.to_owned(),
@@ -477,7 +493,7 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
                 light: Some(light),
                 gpu_ms_median: measured.gpu_ms_median_for_light(light),
                 gpu_ms_min: None,
-                metrics: compare(truth, image, covered, width, height),
+                metrics: compare_with_noise(truth, truth_noise(reference, light), image, covered, width, height),
                 passes: measured.pass_medians_for_light(light),
                 // Counted over the whole frame: the `all` row holds it.
                 work: None,
@@ -489,13 +505,30 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
     rows
 }
 
+/// The ground truth's noise image of light `light`, when the reference was measured with its
+/// noise output ([`ssm_core::reference::NOISE_OUTPUT`]).
+#[must_use]
+pub fn truth_noise(reference: &Measured, light: usize) -> Option<&[f32]> {
+    let name = if light == 0 {
+        ssm_core::reference::NOISE_OUTPUT.to_owned()
+    } else {
+        format!("{}-light{light}", ssm_core::reference::NOISE_OUTPUT)
+    };
+    reference.extra_images.iter().find(|image| image.name == name).map(|image| image.values.as_slice())
+}
+
 /// The errors of several lights as one: means of the per-pixel measures, the largest error, the pixel counts summed (the `all` row).
 #[must_use]
 pub fn average(all: &[ErrorMetrics]) -> ErrorMetrics {
     let n = all.len().max(1) as f64;
     let mean = |f: &dyn Fn(&ErrorMetrics) -> f64| all.iter().map(f).sum::<f64>() / n;
+    let mean_noise = |f: &dyn Fn(&ErrorMetrics) -> Option<f64>| all.iter().map(f).sum::<Option<f64>>().map(|sum| sum / n);
     ErrorMetrics {
+        mae: mean(&|m| m.mae),
         mae_penumbra: mean(&|m| m.mae_penumbra),
+        truth_noise: mean_noise(&|m| m.truth_noise),
+        truth_noise_penumbra: mean_noise(&|m| m.truth_noise_penumbra),
+        shadowed_pixels: all.iter().map(|m| m.shadowed_pixels).sum(),
         rmse: mean(&|m| m.rmse),
         max_abs: all.iter().map(|m| m.max_abs).fold(0.0, f64::max),
         psnr: mean(&|m| m.psnr),
@@ -559,6 +592,7 @@ impl Row {
         ]
         .into_iter()
         .chain(self.work_fields())
+        .chain([number(Some(m.mae), 6), number(m.truth_noise, 6), number(m.truth_noise_penumbra, 6), m.shadowed_pixels.to_string()])
         .collect()
     }
 
@@ -610,7 +644,11 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         "gpu_ms_min": row.gpu_ms_min.map(finite),
         "cpu_ms": finite(row.cpu_ms),
         "metrics": {
+            "mae": finite(m.mae),
+            "truth_noise": m.truth_noise.map(finite),
             "mae_penumbra": finite(m.mae_penumbra),
+            "truth_noise_penumbra": m.truth_noise_penumbra.map(finite),
+            "shadowed_pixels": m.shadowed_pixels,
             "rmse": finite(m.rmse),
             "max_abs": finite(m.max_abs),
             "psnr": finite(m.psnr),
@@ -706,7 +744,11 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                 gpu_ms_min: optional("gpu_ms_min")?,
                 cpu_ms: float("cpu_ms")?,
                 metrics: ErrorMetrics {
+                    mae: float("mae")?,
                     mae_penumbra: float("mae_penumbra")?,
+                    truth_noise: optional("truth_noise")?,
+                    truth_noise_penumbra: optional("truth_noise_penumbra")?,
+                    shadowed_pixels: whole("shadowed_pixels")?,
                     rmse: float("rmse")?,
                     max_abs: float("max_abs")?,
                     psnr: float("psnr")?,
@@ -775,18 +817,40 @@ fn split_csv_line(line: &str) -> anyhow::Result<Vec<String>> {
 }
 
 /// The columns of the report tables (Markdown and HTML).
-const TABLE_HEADER: [&str; 11] =
-    ["technique", "params", "GPU ms (median)", "GPU ms (min)", "MAE penumbra", "RMSE", "max", "PSNR dB", "SSIM", "> 0.05", "FLIP"];
+const TABLE_HEADER: [&str; 12] = [
+    "technique",
+    "params",
+    "GPU ms (median)",
+    "GPU ms (min)",
+    "MAE (± truth)",
+    "MAE penumbra (± truth)",
+    "RMSE",
+    "max",
+    "PSNR dB",
+    "SSIM",
+    "> 0.05",
+    "FLIP",
+];
+
+/// An error with the ground truth's own error over the same pixels beside it: `0.0123 ± 0.0015`.
+#[must_use]
+pub fn with_noise(error: f64, noise: Option<f64>) -> String {
+    match noise {
+        Some(noise) => format!("{error:.4} ± {noise:.4}"),
+        None => format!("{error:.4}"),
+    }
+}
 
 /// One row of the report tables, as text (the technique name without markup).
-fn table_cells(r: &Row) -> [String; 11] {
+fn table_cells(r: &Row) -> [String; 12] {
     let m = &r.metrics;
     [
         r.technique.clone(),
         r.params.replace(';', "; "),
         number(r.gpu_ms_median, 3),
         number(r.gpu_ms_min, 3),
-        format!("{:.4}", m.mae_penumbra),
+        with_noise(m.mae, m.truth_noise),
+        with_noise(m.mae_penumbra, m.truth_noise_penumbra),
         format!("{:.4}", m.rmse),
         format!("{:.3}", m.max_abs),
         number(Some(m.psnr), 2),
@@ -912,7 +976,7 @@ fn html_work(context: &ReportContext<'_>, rows: &[Row]) -> String {
 #[must_use]
 pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
     let mut out = format!(
-        "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]: {}. Errors are against it, on the same pixels; GPU time is the sum of each technique's timed passes.\n\n",
+        "# ssm compare: `{}`\n\n{}×{}, median of {} frames after one warm-up, on {}.\nGround truth: `reference` [{}]: {}. Errors are against it, on the same pixels; MAE covers the pixels that either the truth or the technique shadows, MAE penumbra the truth's umbra and penumbra; ± is the ground truth's own error over the same pixels (two errors closer than their two ± are a tie). GPU time is the sum of each technique's timed passes.\n\n",
         context.scene, context.size.0, context.size.1, context.frames, context.adapter, context.reference_params, context.reference_cost
     );
     out += &markdown_table(rows);
@@ -979,6 +1043,8 @@ pub fn viewer_data(
                 "technique": r.technique,
                 "light": r.light.map_or_else(|| "all".to_owned(), |l| l.to_string()),
                 "gpu_ms": r.gpu_ms_median.map_or(serde_json::Value::Null, finite),
+                "mae": finite(m.mae),
+                "truth_noise": m.truth_noise.map_or(serde_json::Value::Null, finite),
                 "mae_penumbra": finite(m.mae_penumbra),
                 "rmse": finite(m.rmse),
                 "ssim": finite(m.ssim),
@@ -1018,8 +1084,8 @@ pub fn viewer_data(
         "images": image_sets,
         "rows": table,
         "columns": [
-            ["technique", "technique"], ["light", "light"], ["gpu_ms", "GPU ms"], ["mae_penumbra", "MAE pen."],
-            ["rmse", "RMSE"], ["ssim", "SSIM"], ["psnr", "PSNR dB"], ["umbra_leak", "umbra leak"],
+            ["technique", "technique"], ["light", "light"], ["gpu_ms", "GPU ms"], ["mae", "MAE"],
+            ["truth_noise", "± truth"], ["mae_penumbra", "MAE pen."], ["rmse", "RMSE"], ["ssim", "SSIM"], ["psnr", "PSNR dB"], ["umbra_leak", "umbra leak"],
             ["frac_over_0_05", "> 0.05"], ["flip", "FLIP"], ["passes", "passes, ms"],
         ],
         // The table's columns when it shows counted work instead of milliseconds (`null`: not counted).
@@ -1027,7 +1093,7 @@ pub fn viewer_data(
             ["technique", "technique"], ["light", "light"], ["vertex_invocations", "vertex inv."],
             ["fragment_invocations", "fragment inv."], ["compute_invocations", "compute inv."], ["texel_reads", "texel reads"],
             ["atomics", "atomics"], ["target_bytes", "target bytes"], ["storage_bytes", "storage bytes"],
-            ["mae_penumbra", "MAE pen."], ["passes_work", "passes: reads, invocations"],
+            ["mae", "MAE"], ["passes_work", "passes: reads, invocations"],
         ])),
     });
     format!("// Written by ssm compare: the data of index.html's viewer (viewer.js).\nwindow.SSM_DATA = {data};\n")
@@ -1183,7 +1249,7 @@ pub fn reference_cost(diagnostics: &[(String, f64)]) -> String {
     let get = |key: &str| diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v);
     match (get("reference_rays"), get("reference_trace_ms"), get("reference_rays_per_second")) {
         (Some(rays), Some(ms), Some(rate)) if rays > 0.0 => {
-            format!("{:.1} M shadow rays traced on the CPU in {:.0} ms ({:.1} M rays/s)", rays / 1e6, ms, rate / 1e6)
+            format!("{:.1} M light samples traced on the CPU in {:.0} ms ({:.1} M samples/s)", rays / 1e6, ms, rate / 1e6)
         }
         _ => "read from the cache".into(),
     }
@@ -1215,7 +1281,11 @@ mod tests {
             gpu_ms_min: gpu,
             cpu_ms: 12.5,
             metrics: ErrorMetrics {
+                mae: 0.0234567,
                 mae_penumbra: 0.0123456,
+                truth_noise: gpu.map(|_| 0.0012345),
+                truth_noise_penumbra: Some(0.0023456),
+                shadowed_pixels: 25,
                 rmse: 0.5,
                 max_abs: 1.0,
                 psnr: f64::INFINITY,
@@ -1257,7 +1327,8 @@ mod tests {
         assert_eq!(csv(&back), text);
         assert_eq!(back[0].work, rows[0].work);
         assert_eq!((back[1].work.as_ref(), back[2].work.as_ref()), (None, rows[2].work.as_ref()));
-        let work_columns = |line: &str| -> Vec<String> { split_csv_line(line).unwrap()[CSV_COLUMNS.len() - 5..].to_vec() };
+        let first = CSV_COLUMNS.iter().position(|c| *c == "vertex_invocations").unwrap();
+        let work_columns = |line: &str| -> Vec<String> { split_csv_line(line).unwrap()[first..first + 5].to_vec() };
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             work_columns(lines[1]),

@@ -116,7 +116,7 @@ pub fn trade_preset(registry: &Registry) -> PresetSpec {
         scenes: vec![TRADE_SCENE.into()],
         varies: knobs.iter().map(|(name, knob)| format!("{name}.{knob}")).collect(),
         x_axis: "time".into(),
-        y_axis: ErrorAxis::MaePenumbra,
+        y_axis: ErrorAxis::Mae,
         pixels: PixelSet::All,
         size: None,
     }
@@ -401,6 +401,9 @@ pub fn grid(varies: &[&Vary]) -> Vec<Vec<(String, String)>> {
 /// Which measure is plotted against time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ErrorAxis {
+    /// The headline error: mean absolute error over the pixels the reference or the technique
+    /// shadows (`ErrorMetrics::mae`).
+    Mae,
     /// Mean absolute error over the reference's umbra and penumbra.
     MaePenumbra,
     /// Root-mean-square error.
@@ -418,6 +421,7 @@ impl ErrorAxis {
     #[must_use]
     pub fn of(self, row: &Row) -> f64 {
         match self {
+            Self::Mae => row.metrics.mae,
             Self::MaePenumbra => row.metrics.mae_penumbra,
             Self::Rmse => row.metrics.rmse,
             Self::OneMinusSsim => 1.0 - row.metrics.ssim,
@@ -430,6 +434,7 @@ impl ErrorAxis {
     #[must_use]
     pub fn label(self) -> &'static str {
         match self {
+            Self::Mae => "mean absolute error where either image is shadowed",
             Self::MaePenumbra => "mean absolute error over umbra and penumbra",
             Self::Rmse => "RMSE",
             Self::OneMinusSsim => "1 - SSIM",
@@ -456,6 +461,10 @@ pub struct MarkdownRow {
     pub point: String,
     /// Median time per frame, ms.
     pub ms: f64,
+    /// The headline error against the ground truth ([`ErrorAxis::Mae`]).
+    pub mae: f64,
+    /// The ground truth's own error over the same pixels, when known.
+    pub truth_noise: Option<f64>,
     /// Penumbra MAE against the ground truth.
     pub mae_penumbra: f64,
     /// PSNR against the ground truth, dB.
@@ -475,15 +484,16 @@ pub struct MarkdownRow {
 pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
     let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
     text.push_str(
-        "| sweep | scene | technique | point | ms | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|\n",
+        "| sweep | scene | technique | point | ms | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|\n",
     );
     for row in rows {
         let point = if row.point.is_empty() { "defaults" } else { &row.point };
         text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {:.4} | {:.1} | {} | {} |\n",
+            "| {sweep} | {} | {} | {point} | {:.2} | {} | {:.4} | {:.1} | {} | {} |\n",
             row.scene,
             row.technique,
             row.ms,
+            crate::report::with_noise(row.mae, row.truth_noise),
             row.mae_penumbra,
             row.psnr,
             crate::work::cell(row.texel_reads),
@@ -659,6 +669,8 @@ mod tests {
             technique: technique.into(),
             point: String::new(),
             ms: 12.345,
+            mae: 0.02345,
+            truth_noise: Some(0.00123),
             mae_penumbra: 0.01234,
             psnr: 31.25,
             texel_reads: None,
@@ -667,7 +679,7 @@ mod tests {
         let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
         let lines: Vec<&str> = first.lines().collect();
         assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
-        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0123 | 31.2 | - | 3456 |");
+        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 |");
         assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }
 

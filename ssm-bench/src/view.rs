@@ -194,7 +194,7 @@ struct TruthLookup {
     cache: ReferenceCache,
     cache_dir: PathBuf,
     /// Per light, for the current camera: `None` when not cached.
-    images: Vec<Option<Vec<f32>>>,
+    images: Vec<Option<(Vec<f32>, Vec<f32>)>>,
     covered: Vec<bool>,
 }
 
@@ -354,7 +354,10 @@ impl Live {
         let defaults = ParamValues::defaults(ssm_core::reference::NAME, ssm_core::reference::PARAMS);
         let reference = self.slots.iter().find(|s| s.info.kind == TechniqueKind::GroundTruth).map_or(&defaults, |s| &s.params);
         // The parameters' declared ranges make the conversions exact.
-        let samples = u32::try_from(reference.int("samples")?)?;
+        let sampling = ssm_core::reference::Sampling {
+            samples_per_axis: u32::try_from(reference.int("samples")?)?,
+            refine: u32::try_from(reference.int("refine")?)?,
+        };
         let seed = u64::try_from(reference.int("seed")?)?;
         let footprint = reference.choice("footprint")? == "pixel";
         let points = surface_points(&positions, &normals, &self.renderer.scene.camera, footprint);
@@ -363,7 +366,12 @@ impl Live {
             .scene
             .light_frames
             .iter()
-            .map(|frame| self.truth.cache.cached(&frame.light, &points, samples, seed, &self.truth.cache_dir).map(|image| image.visibility))
+            .map(|frame| {
+                self.truth
+                    .cache
+                    .cached(&frame.light, &points, sampling, seed, &self.truth.cache_dir)
+                    .map(|image| (image.visibility, image.noise))
+            })
             .collect();
         Ok(())
     }
@@ -558,7 +566,7 @@ impl Live {
         let (width, height) = (self.renderer.width(), self.renderer.height());
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         let image = visibility.get(self.light).map_or(&[][..], Vec::as_slice);
-        let truth = self.truth.images.get(self.light).and_then(Option::as_deref);
+        let truth = self.truth.images.get(self.light).and_then(Option::as_ref).map(|(truth, _)| truth.as_slice());
         let (mode, rgba): (ViewMode, Vec<u8>) = match (self.mode, truth) {
             (ViewMode::Shaded, _) => {
                 match self.renderer.shade_on_gpu() {
@@ -604,7 +612,11 @@ impl Live {
             .images
             .iter()
             .zip(visibility)
-            .filter_map(|(truth, image)| truth.as_ref().map(|truth| metrics::compare(truth, image, &self.truth.covered, width, height)))
+            .filter_map(|(truth, image)| {
+                truth
+                    .as_ref()
+                    .map(|(truth, noise)| metrics::compare_with_noise(truth, Some(noise), image, &self.truth.covered, width, height))
+            })
             .collect();
         if !per_light.is_empty() {
             self.report.error = Some(crate::report::average(&per_light));
@@ -799,6 +811,8 @@ impl Live {
                 ui.strong("error against the cached ground truth");
                 egui::Grid::new("view_error").striped(true).show(ui, |ui| {
                     for (name, value) in [
+                        ("MAE (shadowed in either)", error.mae),
+                        ("± the truth's own", error.truth_noise.unwrap_or(f64::NAN)),
                         ("MAE umbra+penumbra", error.mae_penumbra),
                         ("RMSE", error.rmse),
                         ("SSIM", error.ssim),

@@ -36,12 +36,28 @@ pub fn classify(reference: &[f32], covered: &[bool]) -> Vec<ShadowClass> {
         .collect()
 }
 
+/// Below this visibility a pixel counts as shadowed for the headline error ([`ErrorMetrics::mae`]):
+/// it would show darker than a lit one in an 8-bit image (half a step of 1/255 below 1).
+pub const SHADOWED_BELOW: f32 = 1.0 - 0.5 / 255.0;
+
 /// The error numbers of one image against the reference.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ErrorMetrics {
+    /// The headline error: mean absolute error over the covered pixels that the reference or the
+    /// image shadows (visibility below [`SHADOWED_BELOW`] in either), so that a false shadow on a
+    /// lit surface costs as much as a missing one. Every covered pixel would dilute it with the
+    /// lit area the camera happens to frame; the union keeps it to where a shadow is, in either.
+    pub mae: f64,
     /// Mean absolute error over the pixels in umbra or penumbra in the
-    /// reference (the metric of Atty et al., Sec. 5.2.1).
+    /// reference (the metric of Atty et al., Sec. 5.2.1): blind to false shadows.
     pub mae_penumbra: f64,
+    /// The ground truth's own error for [`ErrorMetrics::mae`]'s pixels and metric: the mean of its
+    /// per-pixel noise there (`reference::ReferenceImage::noise`), when known.
+    pub truth_noise: Option<f64>,
+    /// The same for [`ErrorMetrics::mae_penumbra`]'s pixels.
+    pub truth_noise_penumbra: Option<f64>,
+    /// Pixels [`ErrorMetrics::mae`] covers.
+    pub shadowed_pixels: usize,
     /// Root-mean-square error over covered pixels.
     pub rmse: f64,
     /// Largest absolute error.
@@ -65,22 +81,48 @@ pub struct ErrorMetrics {
     pub umbra_pixels: usize,
 }
 
-/// Compares `image` with `reference` (both `width` × `height`, row-major) over the covered pixels.
+/// Compares `image` with `reference` (both `width` × `height`, row-major) over the covered pixels,
+/// without the reference's noise (its `truth_noise` fields are `None`).
 ///
 /// # Panics
 /// If the slices' lengths differ from `width * height`.
 #[must_use]
 pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize, height: usize) -> ErrorMetrics {
+    compare_with_noise(reference, None, image, covered, width, height)
+}
+
+/// As [`compare`], with the reference's own error per pixel (`noise`), averaged over the pixels of
+/// each error into its `truth_noise` fields.
+///
+/// # Panics
+/// If the slices' lengths differ from `width * height`.
+#[must_use]
+pub fn compare_with_noise(
+    reference: &[f32],
+    noise: Option<&[f32]>,
+    image: &[f32],
+    covered: &[bool],
+    width: usize,
+    height: usize,
+) -> ErrorMetrics {
     assert!(reference.len() == width * height && image.len() == reference.len() && covered.len() == reference.len(), "image sizes differ");
+    assert!(noise.is_none_or(|n| n.len() == reference.len()), "noise image size differs");
     let classes = classify(reference, covered);
     let (mut count, mut squared, mut max_abs, mut over, mut signed) = (0usize, 0.0f64, 0.0f64, 0usize, 0.0f64);
-    let (mut shadow_sum, mut shadow_count) = (0.0f64, 0usize);
+    let (mut shadow_sum, mut shadow_count, mut shadow_noise) = (0.0f64, 0usize, 0.0f64);
+    let (mut union_sum, mut union_count, mut union_noise) = (0.0f64, 0usize, 0.0f64);
     let (mut umbra_light, mut umbra_count) = (0.0f64, 0usize);
-    for ((&r, &v), class) in reference.iter().zip(image).zip(&classes) {
+    for (index, ((&r, &v), class)) in reference.iter().zip(image).zip(&classes).enumerate() {
         if *class == ShadowClass::Background {
             continue;
         }
+        let pixel_noise = noise.map_or(0.0, |n| f64::from(n[index]));
         let error = f64::from(v) - f64::from(r);
+        if r < SHADOWED_BELOW || v < SHADOWED_BELOW {
+            union_sum += error.abs();
+            union_noise += pixel_noise;
+            union_count += 1;
+        }
         count += 1;
         squared += error * error;
         signed += error;
@@ -88,6 +130,7 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
         over += usize::from(error.abs() > 0.05);
         if matches!(class, ShadowClass::Penumbra | ShadowClass::Umbra) {
             shadow_sum += error.abs();
+            shadow_noise += pixel_noise;
             shadow_count += 1;
         }
         if *class == ShadowClass::Umbra {
@@ -97,8 +140,13 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
     }
     let n = count.max(1) as f64;
     let mse = squared / n;
+    let mean = |sum: f64, count: usize| if count == 0 { 0.0 } else { sum / count as f64 };
     ErrorMetrics {
-        mae_penumbra: if shadow_count == 0 { 0.0 } else { shadow_sum / shadow_count as f64 },
+        mae: mean(union_sum, union_count),
+        mae_penumbra: mean(shadow_sum, shadow_count),
+        truth_noise: noise.map(|_| mean(union_noise, union_count)),
+        truth_noise_penumbra: noise.map(|_| mean(shadow_noise, shadow_count)),
+        shadowed_pixels: union_count,
         rmse: mse.sqrt(),
         max_abs,
         psnr: if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() },
@@ -110,6 +158,14 @@ pub fn compare(reference: &[f32], image: &[f32], covered: &[bool], width: usize,
         penumbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Penumbra).count(),
         umbra_pixels: classes.iter().filter(|c| **c == ShadowClass::Umbra).count(),
     }
+}
+
+/// Whether two errors measured against the same noisy ground truth are a tie: they differ by
+/// less than the truth's combined noise over their pixels (`noise_a + noise_b`, each the
+/// `truth_noise` of its error). Without a noise estimate, only equal errors tie.
+#[must_use]
+pub fn is_tie(error_a: f64, noise_a: Option<f64>, error_b: f64, noise_b: Option<f64>) -> bool {
+    (error_a - error_b).abs() < noise_a.unwrap_or(0.0) + noise_b.unwrap_or(0.0) || error_a == error_b
 }
 
 /// Mean SSIM over covered pixels: local means, variances and covariance from
@@ -276,6 +332,39 @@ mod tests {
             classify(&reference, &covered),
             vec![ShadowClass::Background, ShadowClass::Lit, ShadowClass::Penumbra, ShadowClass::Umbra]
         );
+    }
+
+    #[test]
+    fn a_false_shadow_costs_the_headline_error_what_a_missing_one_does() {
+        // Lit, lit, a false shadow of 0.4, and a missing one (reference 0.6, image lit).
+        let reference = vec![1.0, 1.0, 1.0, 0.6];
+        let image = vec![1.0, 0.999, 0.6, 1.0];
+        let m = compare(&reference, &image, &[true; 4], 4, 1);
+        assert_eq!(m.shadowed_pixels, 2, "0.999 shows as lit in 8 bits: not a shadow");
+        assert!((m.mae - 0.4).abs() < 1e-6, "{}", m.mae);
+        assert!((m.mae_penumbra - 0.4).abs() < 1e-6, "the penumbra error sees only the missing shadow");
+        let swapped = compare(&image, &reference, &[true; 4], 4, 1);
+        assert!((swapped.mae - m.mae).abs() < 1e-9, "the headline error is symmetric in what it counts");
+        assert!(m.truth_noise.is_none());
+    }
+
+    #[test]
+    fn the_truth_noise_is_averaged_over_each_errors_own_pixels() {
+        let reference = vec![1.0, 0.5, 0.0, 1.0];
+        let image = vec![0.5, 0.5, 0.0, 1.0];
+        let noise = vec![0.0, 0.02, 0.0, 0.0];
+        let m = compare_with_noise(&reference, Some(&noise), &image, &[true; 4], 4, 1);
+        // Headline pixels: 0 (false shadow), 1 and 2; penumbra-and-umbra pixels: 1 and 2.
+        assert!((m.truth_noise.unwrap() - 0.02 / 3.0).abs() < 1e-9, "{:?}", m.truth_noise);
+        assert!((m.truth_noise_penumbra.unwrap() - 0.01).abs() < 1e-9, "{:?}", m.truth_noise_penumbra);
+    }
+
+    #[test]
+    fn errors_closer_than_the_combined_noise_tie() {
+        assert!(is_tie(0.010, Some(0.002), 0.013, Some(0.002)));
+        assert!(!is_tie(0.010, Some(0.001), 0.013, Some(0.001)));
+        assert!(!is_tie(0.010, None, 0.0101, None));
+        assert!(is_tie(0.01, None, 0.01, None));
     }
 
     #[test]

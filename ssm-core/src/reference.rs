@@ -1,16 +1,24 @@
 //! The ground truth: for each pixel, the fraction of the rectangular light
-//! visible from the surface point seen there, by casting N×N stratified,
-//! jittered rays to the light against every triangle of the scene (roles do
-//! not matter: everything blocks light), on the CPU, with a CWBVH (`obvhs`)
-//! and all cores (`rayon`).
+//! visible from the surface point seen there, by casting stratified, jittered
+//! rays to the light against every triangle of the scene (roles do not
+//! matter: everything blocks light), on the CPU, with a CWBVH (`obvhs`) and
+//! all cores (`rayon`).
+//!
+//! Each pixel is estimated twice, by two independent sets of N×N strata,
+//! each refined where the visibility varies across the light (M×M rays in a
+//! stratum whose result in the other set differs from a neighbour's); the
+//! estimate is their mean and its noise half their difference, so every
+//! error measured against the truth can carry the truth's own error over the
+//! same pixels ([`GroundTruth::estimate`], [`ReferenceImage::noise`]).
 //!
 //! Deterministic: each pixel's jitter comes from a fixed seed and the pixel's
 //! index, so the result does not depend on thread scheduling, and it is cached
 //! on disk under a hash of everything that changes it.
 //!
-//! A pixel's rays share their origin, so they are not traced one by one where
-//! that can be avoided, with the same answer ray for ray: the triangles in the
-//! pyramid from the point to the light are gathered from the BVH once (none:
+//! A pixel's rays share their origin (one on each side of its tangent plane),
+//! so they are not traced one by one where that can be avoided, with the same
+//! answer ray for ray: the triangles in the pyramid from the point to the light
+//! (or to the part of it on one side of the plane) are gathered from the BVH once (none:
 //! lit; one that covers the pyramid: dark; a few: each ray tested against
 //! them; too many: the light cut into quarters, each with its own pyramid),
 //! and rays that still traverse the BVH first try the triangles that blocked
@@ -33,11 +41,12 @@ use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 use ssm_scene::{RectLight, Scene};
 
+mod coverage;
 mod traversal;
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 3;
+pub const REFERENCE_VERSION: u32 = 4;
 
 /// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
 /// more, the part is cut further or its rays traverse the BVH one by one.
@@ -121,19 +130,95 @@ impl PreparedTriangle {
 /// One pixel's rays, all from one origin: the light, the strata and their jitter.
 struct PixelRays<'a> {
     light: &'a RectLight,
-    origin: Vec3,
+    /// The ray origin for samples on the front of the point's tangent plane (offset along its
+    /// normal), and for those behind (offset against it).
+    origins: [Vec3; 2],
+    /// The point's tangent plane: position and normal.
+    plane: (Vec3, Vec3),
+    /// The point is on a closed mesh: samples behind its tangent plane are blocked.
+    closed: bool,
     n: u32,
-    /// Jitter of stratum (i, j) at j·n + i.
-    jitter: Vec<Vec2>,
+    /// The part of the light the N×N strata divide: the whole light, or one stratum of a coarser
+    /// grid being refined.
+    window: Window,
+    /// Per set of rays, the jitter of stratum (i, j) at j·n + i. The sets share the pyramids and
+    /// their triangles, which do not depend on the jitter.
+    jitter: Vec<Vec<Vec2>>,
     recent: RecentBlockers,
+    /// Per set, each stratum's visible fraction at j·n + i: its ray's answer (0 or 1), or the
+    /// exact fraction where a shortcut decided the stratum's whole part of the light.
+    strata: Vec<Vec<f32>>,
+    /// Per stratum, whether a shortcut decided it exactly (the same value in every set).
+    exact: Vec<bool>,
+    /// The triangles each stratum's rays were tested against (an index into `lists`: every
+    /// triangle a ray into that part of the light can cross), or [`NO_LIST`] where they went
+    /// through the BVH or a shortcut decided them.
+    stratum_list: Vec<u32>,
+    lists: Vec<Vec<u32>>,
 }
 
+/// A square part of the light in its coordinates ([-1, 1]² is the whole light).
+#[derive(Clone, Copy)]
+struct Window {
+    min: Vec2,
+    size: f32,
+}
+
+impl Window {
+    /// The whole light.
+    const LIGHT: Self = Self { min: Vec2::NEG_ONE, size: 2.0 };
+
+    /// The point at `cell` (stratum coordinates: (i, j) plus the jitter) of an N×N grid over this
+    /// window. For the whole light, `cell / n · 2 − 1`, the per-ray traversal's formula, bit for bit.
+    fn at(self, cell: Vec2, n: u32) -> Vec2 {
+        cell / n as f32 * self.size + self.min
+    }
+
+    /// The corner of stratum `index` (in the j·n + i order) of an N×N grid over this window, and
+    /// the stratum as a window of its own.
+    fn stratum(self, index: u32, n: u32) -> Self {
+        let step = self.size / n as f32;
+        Self { min: Vec2::new((index % n) as f32, (index / n) as f32) * step + self.min, size: step }
+    }
+}
+
+/// Most triangles in a stratum's pyramid whose covered area [`coverage`] computes exactly.
+const EXACT_CANDIDATES: usize = 2;
+/// An exactly computed visible fraction this close to 0 or 1 is rounding: it is snapped.
+const COVERAGE_SNAP: f64 = 1e-5;
+/// No candidate list: [`PixelRays::stratum_list`] of a stratum whose rays go through the BVH.
+const NO_LIST: u32 = u32::MAX;
+
 impl PixelRays<'_> {
-    /// The light sample of stratum (i, j), as visibility_per_ray places it.
-    fn sample(&self, i: u32, j: u32) -> Vec3 {
-        let jitter = self.jitter[(j * self.n + i) as usize];
-        let stratum = (Vec2::new(i as f32, j as f32) + jitter) / self.n as f32 * 2.0 - Vec2::ONE;
-        self.light.point(stratum.x, stratum.y)
+    /// Whether `sample` lies on the front side of the tangent plane (rays to it leave from `origins[0]`).
+    fn in_front(&self, sample: Vec3) -> bool {
+        self.plane.1.dot(sample - self.plane.0) >= 0.0
+    }
+
+    /// The light sample of stratum (i, j) of set `set`, as visibility_per_ray places it.
+    fn sample(&self, set: usize, i: u32, j: u32) -> Vec3 {
+        let at = self.window.at(Vec2::new(i as f32, j as f32) + self.jitter[set][(j * self.n + i) as usize], self.n);
+        self.light.point(at.x, at.y)
+    }
+
+    /// Records the exact visible fraction `value` for every stratum of `region` ([i0, i1) × [j0, j1)) in every set.
+    fn mark(&mut self, region: [u32; 4], value: f32) {
+        for (_, _, index) in Self::indices(region, self.n) {
+            self.set_exact(index, value);
+        }
+    }
+
+    /// Records the exact visible fraction `value` of stratum `index` in every set.
+    fn set_exact(&mut self, index: usize, value: f32) {
+        for strata in &mut self.strata {
+            strata[index] = value;
+        }
+        self.exact[index] = true;
+    }
+
+    /// The strata of `region`, as indices j·n + i.
+    fn indices([i0, i1, j0, j1]: [u32; 4], n: u32) -> impl Iterator<Item = (u32, u32, usize)> {
+        (j0..j1).flat_map(move |j| (i0..i1).map(move |i| (i, j, (j * n + i) as usize)))
     }
 }
 
@@ -237,28 +322,30 @@ impl ReferenceCache {
         &self,
         light: &RectLight,
         points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
+        sampling: Sampling,
         seed: u64,
         cache_dir: &Path,
     ) -> Option<ReferenceImage> {
-        let bytes = std::fs::read(self.file(light, points, samples_per_axis, seed, cache_dir)).ok()?;
-        (bytes.len() == points.len() * 4).then(|| {
-            let visibility = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-            ReferenceImage { visibility, rays: 0, elapsed: Duration::ZERO, cached: true }
+        let bytes = std::fs::read(self.file(light, points, sampling, seed, cache_dir)).ok()?;
+        (bytes.len() == points.len() * 8).then(|| {
+            let mut values: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            let noise = values.split_off(points.len());
+            ReferenceImage { visibility: values, noise, rays: 0, elapsed: Duration::ZERO, cached: true }
         })
     }
 
-    fn file(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64, cache_dir: &Path) -> PathBuf {
-        cache_dir.join(format!("{:016x}.f32", self.key(light, points, samples_per_axis, seed)))
+    fn file(&self, light: &RectLight, points: &[Option<SurfacePoint>], sampling: Sampling, seed: u64, cache_dir: &Path) -> PathBuf {
+        cache_dir.join(format!("{:016x}.f32", self.key(light, points, sampling, seed)))
     }
 
-    fn key(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> u64 {
+    fn key(&self, light: &RectLight, points: &[Option<SurfacePoint>], sampling: Sampling, seed: u64) -> u64 {
         let mut hasher = Fnv64::new();
         hasher.write(&REFERENCE_VERSION.to_le_bytes());
         hasher.write(&self.geometry_hash.to_le_bytes());
         hasher.write_f32s(&[light.centre.x, light.centre.y, light.centre.z, light.u_axis.x, light.u_axis.y, light.u_axis.z]);
         hasher.write_f32s(&[light.v_axis.x, light.v_axis.y, light.v_axis.z, light.half_size.x, light.half_size.y]);
-        hasher.write(&samples_per_axis.to_le_bytes());
+        hasher.write(&sampling.samples_per_axis.to_le_bytes());
+        hasher.write(&sampling.refine.to_le_bytes());
         hasher.write(&seed.to_le_bytes());
         hasher.write(&(points.len() as u64).to_le_bytes());
         for point in points {
@@ -329,12 +416,72 @@ impl PixelFootprint {
     }
 }
 
+/// How the ground truth samples each pixel ([`GroundTruth::estimate`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampling {
+    /// N: each of the two independent sets has N×N strata, one jittered ray each.
+    pub samples_per_axis: u32,
+    /// M: a stratum where the visibility varies gets M×M jittered rays instead of its one (1: no refinement).
+    pub refine: u32,
+}
+
+impl Sampling {
+    /// The `reference` technique's defaults: two sets of 12×12 strata, 2×2 rays in a stratum where
+    /// the visibility varies.
+    pub const DEFAULT: Self = Self { samples_per_axis: 12, refine: 2 };
+
+    /// Two plain stratified sets of `samples_per_axis`² rays, without refinement.
+    #[must_use]
+    pub const fn uniform(samples_per_axis: u32) -> Self {
+        Self { samples_per_axis, refine: 1 }
+    }
+}
+
+/// One pixel's ground truth: the estimate and its own error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelEstimate {
+    /// The visible fraction of the light, (A + B)/2 of the two independent estimates.
+    pub visibility: f32,
+    /// |A − B|/2: an estimate of the estimate's absolute error (for Gaussian errors its
+    /// expectation is E|visibility − exact|, and its square is unbiased for the variance).
+    pub noise: f32,
+    /// Light samples evaluated.
+    pub rays: u64,
+}
+
+/// The mean of the strata's visible fractions.
+fn visible_fraction(strata: &[f32]) -> f32 {
+    strata.iter().sum::<f32>() / strata.len().max(1) as f32
+}
+
+/// The strata of an N×N set where the visibility varies: those whose result differs from one of
+/// their four neighbours'.
+fn varying_strata(strata: &[f32], n: u32) -> Vec<bool> {
+    let n = n as i64;
+    let visible = |i: i64, j: i64| strata[(j * n + i) as usize];
+    (0..n * n)
+        .map(|index| {
+            let (i, j) = (index % n, index / n);
+            let own = visible(i, j);
+            [(-1, 0), (1, 0), (0, -1), (0, 1)].iter().any(|(di, dj)| {
+                let (x, y) = (i + di, j + dj);
+                x >= 0 && y >= 0 && x < n && y < n && visible(x, y) != own
+            })
+        })
+        .collect()
+}
+
 /// The result of tracing one image.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceImage {
     /// Visibility per pixel, row-major; 1 for pixels without a surface point.
     pub visibility: Vec<f32>,
-    /// Shadow rays cast (0 when read from the cache).
+    /// The estimate's own error per pixel ([`PixelEstimate::noise`]): the mean over a set of
+    /// pixels estimates the ground truth's mean absolute error there, the mean of its squares
+    /// its mean squared error.
+    pub noise: Vec<f32>,
+    /// Light samples evaluated, refinements included (0 when read from the cache). The BVH
+    /// shortcuts decide many of them without casting a ray of their own.
     pub rays: u64,
     /// Wall time spent tracing.
     pub elapsed: Duration,
@@ -474,122 +621,20 @@ impl GroundTruth {
             || self.first_blocker(&ray, &mut recent.traversal_stack).map(|blocker| recent.push(blocker)).is_some()
     }
 
-    /// Visible fraction of `light` from `point`, with `samples_per_axis`² stratified
+    /// Visible fraction of `light` from `point`, with one set of `samples_per_axis`² stratified
     /// samples jittered by `rng`. Points behind the light's plane see none of it.
     /// With a footprint, each sample also starts from its own point of the
     /// pixel's footprint on the tangent plane (stratified too, the pixel's
     /// strata paired with the light's in a random order): the visibility
     /// averaged over the pixel, what a screen-space prefilter aims at.
+    /// [`GroundTruth::estimate`] is what the ground truth traces: two such sets, refined where
+    /// the visibility varies, with the noise they imply.
     #[must_use]
     pub fn visibility(&self, light: &RectLight, point: &SurfacePoint, samples_per_axis: u32, rng: &mut SplitMix64) -> f32 {
         if point.footprint.is_none() && (point.position - light.centre).dot(light.normal()) <= 0.0 {
             return 0.0;
         }
-        let n = samples_per_axis.max(1);
-        if point.footprint.is_none()
-            && let Some(shortcut) = self.pyramid_visibility(light, point, n, rng)
-        {
-            return shortcut;
-        }
-        self.visibility_of_rays(light, point, n, rng, true)
-    }
-
-    /// The shortcut of [`GroundTruth::visibility`] for a point (no footprint) whose N² rays
-    /// all leave one origin (the light wholly on one side of its tangent plane): the pyramid from
-    /// the origin to the light, then to its quarters where it holds too many triangles
-    /// ([`GroundTruth::count_visible`]). A point light casts one ray for all N². `None` leaves
-    /// the pixel to the per-ray traversal.
-    fn pyramid_visibility(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64) -> Option<f32> {
-        let corners = [light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)];
-        // One origin for every sample: the side rule is affine in the sample, so the corners decide.
-        let first_side = point.normal.dot(corners[0] - point.position) >= 0.0;
-        if corners.iter().any(|c| (point.normal.dot(*c - point.position) >= 0.0) != first_side) {
-            return None;
-        }
-        if point.closed && !first_side {
-            // The whole light is behind the seen side of a solid's surface.
-            return Some(0.0);
-        }
-        let side = if first_side { 1.0 } else { -1.0 };
-        let origin = point.position + point.normal * (side * self.surface_offset);
-        if light.is_point() {
-            return Some(if self.unoccluded(origin, light.centre) { 1.0 } else { 0.0 });
-        }
-        // The jitter of every stratum, drawn in the order visibility_per_ray draws it.
-        let jitter: Vec<Vec2> = (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect();
-        let mut rays = PixelRays { light, origin, n, jitter, recent: RecentBlockers::default() };
-        let visible = self.count_visible(&mut rays, [0, n, 0, n], None, 0);
-        Some(visible as f32 / (n * n) as f32)
-    }
-
-    /// How many of the rays to the strata [i0, i1) × [j0, j1) reach the light, from the
-    /// triangles in the pyramid from the origin to that part of the light (`parent`: those of
-    /// the enclosing part, or `None` to gather them from the BVH). None in it: every ray reaches
-    /// the light. One triangle that the four corner rays all cross: it covers the pyramid (a
-    /// convex triangle, a convex cone), none does. A few: each ray is tested against them.
-    /// Otherwise the part is cut into quarters. Exact: a triangle a ray crosses is always among
-    /// the candidates, and each ray is decided by the same test as the BVH's.
-    fn count_visible(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32) -> u32 {
-        let [i0, i1, j0, j1] = region;
-        let strata = (i1 - i0) * (j1 - j0);
-        if strata == 0 {
-            return 0;
-        }
-        let scale = 2.0 / rays.n as f32;
-        let (s0, s1, t0, t1) = (i0 as f32 * scale - 1.0, i1 as f32 * scale - 1.0, j0 as f32 * scale - 1.0, j1 as f32 * scale - 1.0);
-        let corners = [rays.light.point(s0, t0), rays.light.point(s1, t0), rays.light.point(s1, t1), rays.light.point(s0, t1)];
-        let gathered = Pyramid::new(rays.origin, corners, rays.light).and_then(|pyramid| {
-            let mut found = Vec::new();
-            let complete = match parent {
-                Some(parent) => {
-                    found.extend(parent.iter().copied().filter(|slot| self.may_cross(*slot, &pyramid)));
-                    true
-                }
-                // Gathering from the BVH costs a traversal: only for the whole light and its quarters.
-                None if depth <= 1 => self.pyramid_candidates(&pyramid, GATHER_LIMIT, &mut found),
-                None => false,
-            };
-            complete.then_some(found)
-        });
-        match gathered {
-            Some(candidates) if candidates.is_empty() => strata,
-            Some(candidates) if candidates.iter().any(|slot| corners.iter().all(|c| self.blocked_by(rays.origin, *c, &[*slot]))) => 0,
-            Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
-                let mut visible = 0;
-                for j in j0..j1 {
-                    for i in i0..i1 {
-                        if !self.blocked_by(rays.origin, rays.sample(i, j), &candidates) {
-                            visible += 1;
-                        }
-                    }
-                }
-                visible
-            }
-            Some(candidates) => self.count_quarters(rays, region, Some(&candidates), depth),
-            None if strata > 1 && depth == 0 => self.count_quarters(rays, region, None, depth),
-            None => {
-                // Too many triangles even here: each ray through the BVH.
-                let mut visible = 0;
-                for j in j0..j1 {
-                    for i in i0..i1 {
-                        if !self.blocked_remembering(rays.origin, rays.sample(i, j), &mut rays.recent) {
-                            visible += 1;
-                        }
-                    }
-                }
-                visible
-            }
-        }
-    }
-
-    /// [`GroundTruth::count_visible`] of the four quarters of `region`.
-    fn count_quarters(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32) -> u32 {
-        let [i0, i1, j0, j1] = region;
-        let (im, jm) = ((i0 + i1).div_ceil(2), (j0 + j1).div_ceil(2));
-        [[i0, im, j0, jm], [im, i1, j0, jm], [i0, im, jm, j1], [im, i1, jm, j1]]
-            .into_iter()
-            .map(|quarter| self.count_visible(rays, quarter, parent, depth + 1))
-            .sum()
+        visible_fraction(&self.stratified(light, point, samples_per_axis.max(1), rng, true))
     }
 
     /// [`GroundTruth::visibility`] one ray at a time through the BVH: the definition the
@@ -599,13 +644,311 @@ impl GroundTruth {
         if point.footprint.is_none() && (point.position - light.centre).dot(light.normal()) <= 0.0 {
             return 0.0;
         }
-        self.visibility_of_rays(light, point, n, rng, false)
+        visible_fraction(&self.stratified(light, point, n.max(1), rng, false))
     }
 
-    /// The N² rays of a pixel, each through the BVH; with `remember`, each ray first tries the
+    /// The estimate the ground truth traces for one pixel, and its own error.
+    ///
+    /// Two independent stratified sets of `samples_per_axis`² jittered rays, A and B. Each set is
+    /// then refined where the visibility varies across the light: a stratum whose result in the
+    /// other set differs from one of its four neighbours' (an edge of the visible region crosses
+    /// it or passes near) is decided exactly when at most two triangles can block its rays (the
+    /// area their projection covers, [`coverage`]), and otherwise gets `refine`² fresh jittered
+    /// rays in sub-strata instead of its one.
+    /// Each set is unbiased, since which strata it refines depends only on the other set's rays;
+    /// the estimate is (A + B)/2 and its noise |A − B|/2, whose mean over pixels estimates the
+    /// mean absolute error of the estimate (and its square the variance, pixel by pixel). Lit and
+    /// umbra pixels that the BVH shortcuts decide exactly have no noise; a point light casts one
+    /// ray. A pixel footprint is sampled without refinement (its strata pair light and pixel
+    /// points at random).
+    #[must_use]
+    pub fn estimate(&self, light: &RectLight, point: &SurfacePoint, sampling: Sampling, rng: &mut SplitMix64) -> PixelEstimate {
+        if point.footprint.is_none() && (point.position - light.centre).dot(light.normal()) <= 0.0 {
+            return PixelEstimate { visibility: 0.0, noise: 0.0, rays: 0 };
+        }
+        let n = sampling.samples_per_axis.max(1);
+        let shortcuts = self.traversal == Traversal::Shortcuts;
+        let mut set_rngs = [rng.fork(), rng.fork()];
+        let refine_seeds = [rng.next_u64(), rng.next_u64()];
+        // The two sets share the pyramid shortcuts' gathers (the same triangles for any jitter).
+        let shared = (shortcuts && point.footprint.is_none()).then(|| self.pyramid_visibility(light, point, n, &mut set_rngs));
+        let (strata, exact, lists, stratum_list) = match shared {
+            Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list),
+            None => {
+                let strata = set_rngs.iter_mut().map(|rng| self.visibility_of_rays(light, point, n, rng, shortcuts)).collect();
+                (strata, vec![false; (n * n) as usize], Vec::new(), vec![NO_LIST; (n * n) as usize])
+            }
+        };
+        let refine = if point.footprint.is_some() { 1 } else { sampling.refine.max(1) };
+        let mut rays = 2 * u64::from(n * n);
+        let mut sets = [0.0f32; 2];
+        let mut recent = RecentBlockers::default();
+        for (k, set) in sets.iter_mut().enumerate() {
+            if refine == 1 {
+                *set = visible_fraction(&strata[k]);
+                continue;
+            }
+            let mask = varying_strata(&strata[1 - k], n);
+            let mut sum = 0.0f32;
+            for (index, (&value, &varies)) in strata[k].iter().zip(&mask).enumerate() {
+                if !varies || exact[index] {
+                    // Exact: a shortcut decided every ray of this part of the light.
+                    sum += value;
+                    continue;
+                }
+                rays += u64::from(refine * refine - 1);
+                let mut sub_rng = SplitMix64::for_pixel(refine_seeds[k], index as u64);
+                let jitter: Vec<Vec2> = (0..refine * refine).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())).collect();
+                let window = Window::LIGHT.stratum(index as u32, n);
+                let list = lists.get(stratum_list[index] as usize).map(Vec::as_slice);
+                let open = if shortcuts {
+                    // The stratum exactly, from the area its few triangles cover; else as a light
+                    // of its own, M×M strata, through the same shortcuts, from the triangles its
+                    // rays were tested against (or, without a list, the BVH, as its rays were).
+                    let mut sub = self.sub_rays(light, point, refine, window, jitter, std::mem::take(&mut recent));
+                    let origin = sub.origins[usize::from(!sub.in_front(light.point(window.min.x, window.min.y)))];
+                    let visible = match list.and_then(|list| self.exact_stratum(&sub, origin, window, list)) {
+                        Some(visible) => {
+                            rays -= u64::from(refine * refine - 1);
+                            visible
+                        }
+                        None => {
+                            self.count_visible(&mut sub, [0, refine, 0, refine], list, 1, false);
+                            visible_fraction(&sub.strata[0])
+                        }
+                    };
+                    recent = sub.recent;
+                    visible
+                } else {
+                    let visible = (0..refine * refine).filter(|cell| {
+                        let at = window.at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
+                        self.light_sample_visible(light, point, at, None)
+                    });
+                    visible.count() as f32 / (refine * refine) as f32
+                };
+                sum += open;
+            }
+            *set = sum / (n * n) as f32;
+        }
+        PixelEstimate { visibility: 0.5 * (sets[0] + sets[1]), noise: 0.5 * (sets[0] - sets[1]).abs(), rays }
+    }
+
+    /// Whether the ray from `point` to the light's point at `at` (in [-1, 1]² along its axes)
+    /// reaches it, as [`GroundTruth::visibility_of_rays`] decides one sample of a point without a
+    /// footprint; with `recent`, the pixel's last blockers are tried first (the same answer).
+    fn light_sample_visible(&self, light: &RectLight, point: &SurfacePoint, at: Vec2, recent: Option<&mut RecentBlockers>) -> bool {
+        let sample = light.point(at.x, at.y);
+        let side = if point.normal.dot(sample - point.position) >= 0.0 { 1.0 } else { -1.0 };
+        if point.closed && side < 0.0 {
+            return false;
+        }
+        let origin = point.position + point.normal * (side * self.surface_offset);
+        match recent {
+            Some(recent) => !self.blocked_remembering(origin, sample, recent),
+            None => self.unoccluded(origin, sample),
+        }
+    }
+
+    /// One set of N² stratified samples of a point in front of the light: each stratum's result
+    /// (0 or 1) at j·n + i. With `shortcuts`, a point without a footprint goes through
+    /// the pyramid shortcuts ([`GroundTruth::pyramid_visibility`]); otherwise each ray goes
+    /// through the BVH.
+    fn stratified(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64, shortcuts: bool) -> Vec<f32> {
+        if shortcuts && point.footprint.is_none() {
+            return self.pyramid_visibility(light, point, n, std::slice::from_mut(rng)).strata.swap_remove(0);
+        }
+        self.visibility_of_rays(light, point, n, rng, shortcuts)
+    }
+
+    /// The shortcut of [`GroundTruth::visibility`] for a point without a footprint: the pyramid
+    /// from the point to the light, then to its quarters where it holds too many triangles or the
+    /// point's tangent plane cuts it (each part on one side of the plane has one ray origin;
+    /// [`GroundTruth::count_visible`]). A point light casts one ray for all N². One set of rays
+    /// per generator of `rngs`, each drawing its jitter as visibility_per_ray does; the sets share
+    /// the gathers.
+    fn pyramid_visibility<'a>(&self, light: &'a RectLight, point: &SurfacePoint, n: u32, rngs: &mut [SplitMix64]) -> PixelRays<'a> {
+        let mut rays = self.sub_rays(light, point, n, Window::LIGHT, Vec::new(), RecentBlockers::default());
+        rays.strata = vec![vec![0.0; (n * n) as usize]; rngs.len()];
+        if light.is_point() {
+            let front = rays.in_front(light.centre);
+            let open = (front || !point.closed) && self.unoccluded(rays.origins[usize::from(!front)], light.centre);
+            rays.mark([0, n, 0, n], if open { 1.0 } else { 0.0 });
+            return rays;
+        }
+        // The jitter of every stratum, drawn in the order visibility_per_ray draws it.
+        rays.jitter = rngs.iter_mut().map(|rng| (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()).collect();
+        self.count_visible(&mut rays, [0, n, 0, n], None, 0, true);
+        rays
+    }
+
+    /// The exact visible fraction of the part `stratum` of the light seen from `origin`, when the
+    /// pyramid from `origin` to that part holds at most [`EXACT_CANDIDATES`] of `candidates`
+    /// (every triangle a ray into the enclosing part can cross): 1 less the share of the stratum
+    /// their central projection onto the light's plane covers ([`coverage::covered_share`]).
+    /// `None` with more, or for a degenerate pyramid.
+    fn exact_stratum(&self, rays: &PixelRays<'_>, origin: Vec3, stratum: Window, candidates: &[u32]) -> Option<f32> {
+        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
+        let corners = [
+            rays.light.point(min.x, min.y),
+            rays.light.point(max.x, min.y),
+            rays.light.point(max.x, max.y),
+            rays.light.point(min.x, max.y),
+        ];
+        let pyramid = Pyramid::new(origin, corners, rays.light)?;
+        let mut inside = candidates.iter().filter(|slot| self.may_cross(**slot, &pyramid));
+        let found: [Option<&u32>; EXACT_CANDIDATES + 1] = std::array::from_fn(|_| inside.next());
+        if found[EXACT_CANDIDATES].is_some() {
+            return None;
+        }
+        let triangles: Vec<[Vec3; 3]> = found
+            .iter()
+            .flatten()
+            .map(|slot| {
+                let triangle = &self.triangles[self.bvh.primitive_indices[**slot as usize] as usize];
+                [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
+            })
+            .collect();
+        // Within rounding of all or nothing (two triangles sharing an edge, each clipped on its
+        // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and lit
+        // stay exact, at a cost of at most 1e-5 of a stratum.
+        let visible = 1.0 - coverage::covered_share(rays.light, origin, &triangles, [min, max]);
+        Some(if visible < COVERAGE_SNAP {
+            0.0
+        } else if visible > 1.0 - COVERAGE_SNAP {
+            1.0
+        } else {
+            visible as f32
+        })
+    }
+
+    /// The rays of one set of N×N strata over `window` of the light from `point`, with `jitter`
+    /// (empty: drawn later), for [`GroundTruth::count_visible`].
+    fn sub_rays<'a>(
+        &self,
+        light: &'a RectLight,
+        point: &SurfacePoint,
+        n: u32,
+        window: Window,
+        jitter: Vec<Vec2>,
+        recent: RecentBlockers,
+    ) -> PixelRays<'a> {
+        let offset = point.normal * self.surface_offset;
+        let count = (n * n) as usize;
+        PixelRays {
+            light,
+            origins: [point.position + offset, point.position - offset],
+            plane: (point.position, point.normal),
+            closed: point.closed,
+            n,
+            window,
+            jitter: vec![jitter],
+            recent,
+            strata: vec![vec![0.0; count]],
+            exact: vec![false; count],
+            stratum_list: vec![NO_LIST; count],
+            lists: Vec::new(),
+        }
+    }
+
+    /// Which of the rays of every set to the strata [i0, i1) × [j0, j1) reach the light, from the
+    /// triangles in the pyramid from the origin to that part of the light (`parent`: those of
+    /// the enclosing part, or `None` to gather them from the BVH). None in it: every ray reaches
+    /// the light. One triangle that the four corner rays all cross: it covers the pyramid (a
+    /// convex triangle, a convex cone), none does. A few: each ray is tested against them.
+    /// Otherwise the part is cut into quarters. Exact: a triangle a ray crosses is always among
+    /// the candidates, and each ray is decided by the same test as the BVH's.
+    fn count_visible(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32, may_gather: bool) {
+        let [i0, i1, j0, j1] = region;
+        let strata = (i1 - i0) * (j1 - j0);
+        if strata == 0 {
+            return;
+        }
+        let (scale, min) = (rays.window.size / rays.n as f32, rays.window.min);
+        let (s0, s1, t0, t1) = (i0 as f32 * scale + min.x, i1 as f32 * scale + min.x, j0 as f32 * scale + min.y, j1 as f32 * scale + min.y);
+        let corners = [rays.light.point(s0, t0), rays.light.point(s1, t0), rays.light.point(s1, t1), rays.light.point(s0, t1)];
+        // The side of the tangent plane is affine in the sample, so the corners decide a part's.
+        let front = rays.in_front(corners[0]);
+        if corners.iter().any(|c| rays.in_front(*c) != front) {
+            if strata > 1 {
+                // The plane cuts this part: each quarter has a side of its own, or is cut further.
+                self.count_quarters(rays, region, None, depth, may_gather);
+                return;
+            }
+            for set in 0..rays.strata.len() {
+                for (i, j, index) in PixelRays::indices(region, rays.n) {
+                    let sample = rays.sample(set, i, j);
+                    let open = (rays.in_front(sample) || !rays.closed)
+                        && !self.blocked_remembering(rays.origins[usize::from(!rays.in_front(sample))], sample, &mut rays.recent);
+                    rays.strata[set][index] = if open { 1.0 } else { 0.0 };
+                }
+            }
+            return;
+        }
+        if rays.closed && !front {
+            // Behind the seen side of a solid's surface.
+            rays.mark(region, 0.0);
+            return;
+        }
+        let origin = rays.origins[usize::from(!front)];
+        let gathered = Pyramid::new(origin, corners, rays.light).and_then(|pyramid| {
+            let mut found = Vec::new();
+            let complete = match parent {
+                Some(parent) => {
+                    found.extend(parent.iter().copied().filter(|slot| self.may_cross(*slot, &pyramid)));
+                    true
+                }
+                // Gathering from the BVH costs a traversal: only for the whole light, its quarters
+                // and the parts the tangent plane leaves whole.
+                None if may_gather => self.pyramid_candidates(&pyramid, GATHER_LIMIT, &mut found),
+                None => false,
+            };
+            complete.then_some(found)
+        });
+        match gathered {
+            Some(candidates) if candidates.is_empty() => rays.mark(region, 1.0),
+            Some(candidates) if candidates.iter().any(|slot| corners.iter().all(|c| self.blocked_by(origin, *c, &[*slot]))) => {
+                rays.mark(region, 0.0);
+            }
+            Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
+                for set in 0..rays.strata.len() {
+                    for (i, j, index) in PixelRays::indices(region, rays.n) {
+                        let open = !self.blocked_by(origin, rays.sample(set, i, j), &candidates);
+                        rays.strata[set][index] = if open { 1.0 } else { 0.0 };
+                    }
+                }
+                let list = rays.lists.len() as u32;
+                for (_, _, index) in PixelRays::indices(region, rays.n) {
+                    rays.stratum_list[index] = list;
+                }
+                rays.lists.push(candidates);
+            }
+            Some(candidates) => self.count_quarters(rays, region, Some(&candidates), depth, false),
+            None if strata > 1 && depth == 0 => self.count_quarters(rays, region, None, depth, true),
+            None => {
+                // Too many triangles even here: each ray through the BVH.
+                for set in 0..rays.strata.len() {
+                    for (i, j, index) in PixelRays::indices(region, rays.n) {
+                        let open = !self.blocked_remembering(origin, rays.sample(set, i, j), &mut rays.recent);
+                        rays.strata[set][index] = if open { 1.0 } else { 0.0 };
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`GroundTruth::count_visible`] of the four quarters of `region`.
+    fn count_quarters(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32, may_gather: bool) {
+        let [i0, i1, j0, j1] = region;
+        let (im, jm) = ((i0 + i1).div_ceil(2), (j0 + j1).div_ceil(2));
+        for quarter in [[i0, im, j0, jm], [im, i1, j0, jm], [i0, im, jm, j1], [im, i1, jm, j1]] {
+            self.count_visible(rays, quarter, parent, depth + 1, may_gather);
+        }
+    }
+
+    /// The N² rays of a pixel, each through the BVH, each stratum's result; with `remember`, each ray first tries the
     /// last few triangles that blocked the pixel's rays (neighbouring rays mostly hit the same
     /// ones), which changes no answer: a ray one of them blocks is blocked.
-    fn visibility_of_rays(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64, remember: bool) -> f32 {
+    fn visibility_of_rays(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64, remember: bool) -> Vec<f32> {
         let n = n.max(1);
         let mut recent = RecentBlockers::default();
         // With a footprint, the pixel's strata in a random order: a fixed pairing with the
@@ -620,7 +963,7 @@ impl GroundTruth {
             }
             None => Vec::new(),
         };
-        let mut visible = 0u32;
+        let mut strata = vec![0.0f32; (n * n) as usize];
         for j in 0..n {
             for i in 0..n {
                 let jitter = Vec2::new(rng.next_f32(), rng.next_f32());
@@ -647,55 +990,53 @@ impl GroundTruth {
                 }
                 let origin = position + point.normal * (side * self.surface_offset);
                 let open = if remember { !self.blocked_remembering(origin, sample, &mut recent) } else { self.unoccluded(origin, sample) };
-                if open {
-                    visible += 1;
-                }
+                strata[(j * n + i) as usize] = if open { 1.0 } else { 0.0 };
             }
         }
-        visible as f32 / (n * n) as f32
+        strata
     }
 
-    /// Traces every pixel (`None`: no surface, visibility 1) on all cores.
+    /// Traces every pixel (`None`: no surface, visibility 1, noise 0) on all cores, each as
+    /// [`GroundTruth::estimate`] with its own generator seeded from `seed` and its index.
     #[must_use]
-    pub fn trace(&self, light: &RectLight, points: &[Option<SurfacePoint>], samples_per_axis: u32, seed: u64) -> ReferenceImage {
+    pub fn trace(&self, light: &RectLight, points: &[Option<SurfacePoint>], sampling: Sampling, seed: u64) -> ReferenceImage {
         let start = Instant::now();
-        let visibility: Vec<f32> = points
+        let estimates: Vec<PixelEstimate> = points
             .par_iter()
             .enumerate()
             .map(|(index, point)| match point {
-                Some(point) => {
-                    let rng = &mut SplitMix64::for_pixel(seed, index as u64);
-                    match self.traversal {
-                        Traversal::Shortcuts => self.visibility(light, point, samples_per_axis, rng),
-                        Traversal::PerRay => self.visibility_per_ray(light, point, samples_per_axis, rng),
-                    }
-                }
-                None => 1.0,
+                Some(point) => self.estimate(light, point, sampling, &mut SplitMix64::for_pixel(seed, index as u64)),
+                None => PixelEstimate { visibility: 1.0, noise: 0.0, rays: 0 },
             })
             .collect();
-        let traced = points.iter().filter(|p| p.is_some()).count() as u64;
-        let rays = traced * u64::from(samples_per_axis.max(1)).pow(2);
-        ReferenceImage { visibility, rays, elapsed: start.elapsed(), cached: false }
+        ReferenceImage {
+            visibility: estimates.iter().map(|e| e.visibility).collect(),
+            noise: estimates.iter().map(|e| e.noise).collect(),
+            rays: estimates.iter().map(|e| e.rays).sum(),
+            elapsed: start.elapsed(),
+            cached: false,
+        }
     }
 
     /// As [`GroundTruth::trace`], through a cache in `cache_dir` keyed by a hash
-    /// of the geometry, the light, the points, the sample count, the seed and
+    /// of the geometry, the light, the points, the sampling, the seed and
     /// [`REFERENCE_VERSION`]. A cache that cannot be read or written is ignored.
     #[must_use]
     pub fn trace_cached(
         &self,
         light: &RectLight,
         points: &[Option<SurfacePoint>],
-        samples_per_axis: u32,
+        sampling: Sampling,
         seed: u64,
         cache_dir: &Path,
     ) -> ReferenceImage {
-        if let Some(image) = self.cache.cached(light, points, samples_per_axis, seed, cache_dir) {
+        if let Some(image) = self.cache.cached(light, points, sampling, seed, cache_dir) {
             return image;
         }
-        let file = self.cache.file(light, points, samples_per_axis, seed, cache_dir);
-        let image = self.trace(light, points, samples_per_axis, seed);
-        let bytes: Vec<u8> = image.visibility.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let file = self.cache.file(light, points, sampling, seed, cache_dir);
+        let image = self.trace(light, points, sampling, seed);
+        // The visibility, then the noise.
+        let bytes: Vec<u8> = image.visibility.iter().chain(&image.noise).flat_map(|v| v.to_le_bytes()).collect();
         // Write then rename, so that a concurrent reader never sees half a file.
         let partial = file.with_extension(format!("partial{}", std::process::id()));
         if std::fs::create_dir_all(cache_dir).is_ok() && std::fs::write(&partial, bytes).is_ok() {
@@ -787,6 +1128,14 @@ impl SplitMix64 {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
+    }
+
+    /// An independent generator seeded from this one's next output.
+    pub fn fork(&mut self) -> Self {
+        let state = self.next_u64();
+        let mut forked = Self { state };
+        forked.next_u64();
+        forked
     }
 
     /// A float uniform in `[0, 1)`.
@@ -949,8 +1298,13 @@ pub const NAME: &str = "reference";
 pub const PARAMS: &[crate::ParamSpec] = &[
     crate::ParamSpec {
         name: "samples",
-        kind: crate::ParamKind::Int { default: 16, min: 1, max: 256 },
-        doc: "light samples per axis (N): N×N stratified, jittered shadow rays per pixel",
+        kind: crate::ParamKind::Int { default: 12, min: 1, max: 256 },
+        doc: "light samples per axis (N): two independent sets of N×N stratified, jittered shadow rays per pixel, whose difference is the noise reported",
+    },
+    crate::ParamSpec {
+        name: "refine",
+        kind: crate::ParamKind::Int { default: 2, min: 1, max: 16 },
+        doc: "rays per axis (M) in a stratum where the visibility varies (its result in the other set differs from a neighbour's): M×M instead of one; 1 = plain stratified sampling",
     },
     crate::ParamSpec { name: "seed", kind: crate::ParamKind::Int { default: 1, min: 0, max: i64::MAX }, doc: "seed of the jitter" },
     crate::ParamSpec {
@@ -973,7 +1327,7 @@ pub const PARAMS: &[crate::ParamSpec] = &[
 /// The ground truth as a technique: traces on the CPU, uploads, copies into the target.
 struct ReferenceTechnique {
     truth: GroundTruth,
-    samples_per_axis: u32,
+    sampling: Sampling,
     seed: u64,
     cache_dir: Option<PathBuf>,
     /// The G-buffer's points, read once: the scene and camera are static.
@@ -987,6 +1341,8 @@ struct ReferenceTechnique {
     upload: crate::ScreenPass,
     /// Each light's traced image, kept: the scene and camera are static, so later frames only copy it into the target.
     traced_per_light: Vec<Option<ReferenceImage>>,
+    /// The view's width and height.
+    size: (u32, u32),
 }
 
 impl ReferenceTechnique {
@@ -1020,7 +1376,7 @@ impl crate::ShadowTechnique for ReferenceTechnique {
             self.traced_per_light.resize(light + 1, None);
         }
         if self.traced_per_light[light].is_none() {
-            let (samples, seed) = (self.samples_per_axis, self.seed);
+            let (samples, seed) = (self.sampling, self.seed);
             let cache_dir = self.cache_dir.clone();
             let points = self.points(frame)?.to_vec();
             let image = match &cache_dir {
@@ -1039,6 +1395,24 @@ impl crate::ShadowTechnique for ReferenceTechnique {
         }
         self.upload.encode(frame, light, output, Some(&traced_group), None);
         Ok(())
+    }
+
+    /// The noise of light 0 as `truth_noise`, and of light k as `truth_noise-light<k>`.
+    fn debug_outputs(&mut self, _gpu: &crate::GpuContext, requested: &[&str]) -> crate::Result<Vec<crate::ExtraImage>> {
+        if !requested.contains(&NOISE_OUTPUT) {
+            return Ok(Vec::new());
+        }
+        let (width, height) = self.size;
+        Ok(self
+            .traced_per_light
+            .iter()
+            .enumerate()
+            .filter_map(|(light, image)| {
+                let image = image.as_ref()?;
+                let name = if light == 0 { NOISE_OUTPUT.to_owned() } else { format!("{NOISE_OUTPUT}-light{light}") };
+                Some(crate::ExtraImage { name, width, height, values: image.noise.clone(), overlay: false })
+            })
+            .collect())
     }
 
     /// Totals over the lights traced so far: rays, trace time, rays per second, and how many came from the cache.
@@ -1098,7 +1472,10 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
                 wanted: "Traversal",
             })?,
         ),
-        samples_per_axis: u32::try_from(params.int("samples")?).unwrap_or(16),
+        sampling: Sampling {
+            samples_per_axis: u32::try_from(params.int("samples")?).unwrap_or(Sampling::DEFAULT.samples_per_axis),
+            refine: u32::try_from(params.int("refine")?).unwrap_or(Sampling::DEFAULT.refine),
+        },
         seed: u64::try_from(params.int("seed")?).unwrap_or(1),
         cache_dir: params.bool("cache")?.then(default_cache_dir),
         points: None,
@@ -1106,23 +1483,30 @@ fn create(setup: &crate::TechniqueSetup<'_>) -> crate::Result<Box<dyn crate::Sha
         traced,
         upload,
         traced_per_light: Vec::new(),
+        size: (width, height),
     }))
 }
 
 /// The registration of the ground truth.
 pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     name: NAME,
-    summary: "ground truth: N×N stratified jittered shadow rays per pixel on the CPU (CWBVH, all cores), cached on disk",
-    paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling)",
+    summary: "ground truth: two independent sets of N×N stratified jittered shadow rays per pixel, refined where the visibility varies, on the CPU (CWBVH, all cores), cached on disk, with its own noise per pixel",
+    paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling, refined where the visibility varies)",
     kind: crate::TechniqueKind::GroundTruth,
     params: PARAMS,
     requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,
     presets: &[],
     trade: None,
-    debug_outputs: &[],
+    debug_outputs: &[crate::DebugOutput { name: NOISE_OUTPUT, doc: NOISE_DOC, overlay: false }],
     uniforms: &[],
     limits: &[],
 };
+
+/// The debug output holding the ground truth's own error per pixel ([`ReferenceImage::noise`]);
+/// every command that measures errors asks for it.
+pub const NOISE_OUTPUT: &str = "truth_noise";
+
+const NOISE_DOC: &str = "the ground truth's own error per pixel, |A − B|/2 of its two independent estimates (visibility units): its mean over pixels estimates the truth's mean absolute error there";
 
 crate::register_technique!(INFO);

@@ -212,7 +212,7 @@ pub struct Preset {
     pub varies: &'static [&'static str],
     /// The plot's x axis: `time` or a varied parameter (`mine.map_size`).
     pub x_axis: &'static str,
-    /// The plot's y axis: `mae-penumbra`, `rmse`, `one-minus-ssim`, `flip` or `time`.
+    /// The plot's y axis: `mae` (the headline error), `mae-penumbra`, `rmse`, `one-minus-ssim`, `flip` or `time`.
     pub y_axis: &'static str,
     /// Which pixels the errors cover: `all` or `receivers`.
     pub pixels: &'static str,
@@ -225,7 +225,7 @@ impl Preset {
     /// A preset with the usual axes (time against penumbra error, all pixels); set
     /// the other fields with struct update syntax.
     pub const DEFAULT: Self =
-        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae-penumbra", pixels: "all", size: None };
+        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae", pixels: "all", size: None };
 }
 
 /// Size and field offsets of a Rust struct uploaded as a uniform

@@ -92,7 +92,7 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
 
     let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)) + 1);
     progress.set_message(format!("{} (ground truth)", reference_info.name));
-    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
+    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
     let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
     let size = (args.size.width, args.size.height);
     report::write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;

@@ -46,7 +46,7 @@ pub(super) struct SweepArgs {
     /// Fixed parameter assignment `<technique>.<param>=<value>` (also `reference.samples=N`); repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
-    /// The measure on the y axis (`time` for the papers' timing figures); default: the preset's, else mae-penumbra.
+    /// The measure on the y axis (`time` for the papers' timing figures); default: the preset's, else mae (the headline error).
     #[arg(long, value_enum)]
     error: Option<sweep::ErrorAxis>,
     /// The x axis: `time`, or a varied parameter as `<technique>.<param>` (`scene.light_scale`); default: the preset's, else time.
@@ -174,7 +174,7 @@ fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&
     if x_axis != "time" && !plan.varied.contains(&x_axis) {
         bail!("--x {x_axis}: not a varied parameter (give `time` or one of the --vary parameters as <technique>.<param>)");
     }
-    let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::MaePenumbra);
+    let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::Mae);
     let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(report::PixelSet::All);
     let size = sweep::image_size(args.size.width, args.size.height, preset.as_ref());
     Ok(ResolvedSweep { scene_spec, specs, out, plan, x_axis, error, pixels, size })
@@ -221,7 +221,7 @@ fn run_sweep(
         };
         let mut renderer = Renderer::new(gpu, &scene, sweep.size.0, sweep.size.1, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
-        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[])?;
+        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
         let covered = report::pixel_mask(&renderer, sweep.pixels)?;
         let size = sweep.size;
         // Under <out>/images/<scene point>/ when asked: the ground truth, then each technique's points.
@@ -304,6 +304,8 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 technique: row.technique.clone(),
                 point: point.join(" "),
                 ms: sweep::time_of(row),
+                mae: row.metrics.mae,
+                truth_noise: row.metrics.truth_noise,
                 mae_penumbra: row.metrics.mae_penumbra,
                 psnr: row.metrics.psnr,
                 texel_reads: totals.and_then(|t| t.texel_reads),

@@ -1,0 +1,217 @@
+//! The exact share of a rectangle of the light that a few triangles hide from a point: each
+//! triangle's central projection from the point onto the light's plane is a convex polygon (the
+//! triangle first cut to the slab between the point's plane and the light's, parallel to the
+//! light, where a segment from the point to the light can meet it), and the share is the area of
+//! their union inside the rectangle. One or two triangles: the union by inclusion–exclusion. In
+//! f64, so that a corner near the point's plane, which projects far away, keeps its precision.
+
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use ssm_scene::RectLight;
+
+/// Share of `rect` (light coordinates: [-1, 1]² is the whole light, `[min, max]`) hidden from
+/// `origin` by the union of `triangles` (at most two), in [0, 1]. `origin` must be in front of
+/// the light (positive distance along its normal).
+pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
+    let rect = [min.as_dvec2(), max.as_dvec2()];
+    let area = (rect[1].x - rect[0].x) * (rect[1].y - rect[0].y);
+    if area <= 0.0 {
+        return 0.0;
+    }
+    let clipped: Vec<Vec<DVec2>> = triangles.iter().map(|t| clip_to_rect(&project(light, origin, t), rect)).collect();
+    let covered = match clipped.as_slice() {
+        [] => 0.0,
+        [a] => polygon_area(a),
+        [a, b] => polygon_area(a) + polygon_area(b) - polygon_area(&clip_convex(a, b)),
+        _ => unreachable!("at most two triangles"),
+    };
+    (covered / area).clamp(0.0, 1.0)
+}
+
+/// The central projection from `origin` onto the light's plane, in light coordinates (u / half
+/// width, v / half height), of the part of `triangle` strictly between the plane through `origin`
+/// parallel to the light and the light's own plane; empty when none of it is.
+fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3]) -> Vec<DVec2> {
+    let (centre, normal) = (light.centre.as_dvec3(), light.normal().as_dvec3());
+    let origin = origin.as_dvec3();
+    let height = (origin - centre).dot(normal);
+    if height <= 0.0 {
+        return Vec::new();
+    }
+    // t: the fraction of the way from the origin to the light's plane (0 at the origin's plane).
+    let t_of = |p: DVec3| 1.0 - (p - centre).dot(normal) / height;
+    // A corner at t → 0 projects to infinity: keep t above a bound that leaves the projection in
+    // f64's range and far outside any light (the rectangle clip removes it).
+    const T_MIN: f64 = 1e-9;
+    let mut polygon: Vec<(DVec3, f64)> = triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))).collect();
+    polygon = clip_by(&polygon, |(_, t)| t - T_MIN);
+    polygon = clip_by(&polygon, |(_, t)| 1.0 - t);
+    let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
+    let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
+    polygon
+        .iter()
+        .map(|(p, t)| {
+            let on_light = origin + (*p - origin) / *t;
+            DVec2::new((on_light - centre).dot(u_axis) / half.x, (on_light - centre).dot(v_axis) / half.y)
+        })
+        .collect()
+}
+
+/// Sutherland–Hodgman against one half-space: keeps the part of `polygon` where `inside` ≥ 0
+/// (`inside` affine along edges), interpolating position and t.
+fn clip_by(polygon: &[(DVec3, f64)], inside: impl Fn(&(DVec3, f64)) -> f64) -> Vec<(DVec3, f64)> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (k, current) in polygon.iter().enumerate() {
+        let next = &polygon[(k + 1) % polygon.len()];
+        let (a, b) = (inside(current), inside(next));
+        if a >= 0.0 {
+            out.push(*current);
+        }
+        if (a >= 0.0) != (b >= 0.0) {
+            let s = a / (a - b);
+            out.push((current.0 + (next.0 - current.0) * s, current.1 + (next.1 - current.1) * s));
+        }
+    }
+    out
+}
+
+/// The part of `polygon` inside the rectangle `[min, max]`.
+fn clip_to_rect(polygon: &[DVec2], [min, max]: [DVec2; 2]) -> Vec<DVec2> {
+    let mut out = polygon.to_vec();
+    for (axis, bound, keep_above) in [(0, min.x, true), (0, max.x, false), (1, min.y, true), (1, max.y, false)] {
+        out = clip_2d(&out, |p| if keep_above { p[axis] - bound } else { bound - p[axis] });
+    }
+    out
+}
+
+/// Sutherland–Hodgman in the plane: the part of `polygon` where `inside` ≥ 0.
+fn clip_2d(polygon: &[DVec2], inside: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (k, &current) in polygon.iter().enumerate() {
+        let next = polygon[(k + 1) % polygon.len()];
+        let (a, b) = (inside(current), inside(next));
+        if a >= 0.0 {
+            out.push(current);
+        }
+        if (a >= 0.0) != (b >= 0.0) {
+            out.push(current + (next - current) * (a / (a - b)));
+        }
+    }
+    out
+}
+
+/// The part of convex `subject` inside convex `clip` (either winding).
+fn clip_convex(subject: &[DVec2], clip: &[DVec2]) -> Vec<DVec2> {
+    if clip.len() < 3 || subject.len() < 3 {
+        return Vec::new();
+    }
+    let orientation = signed_area(clip).signum();
+    if orientation == 0.0 {
+        return Vec::new();
+    }
+    let mut out = subject.to_vec();
+    for (k, &a) in clip.iter().enumerate() {
+        let b = clip[(k + 1) % clip.len()];
+        let edge = b - a;
+        out = clip_2d(&out, |p| orientation * edge.perp_dot(p - a));
+        if out.is_empty() {
+            break;
+        }
+    }
+    out
+}
+
+/// Signed area (positive counter-clockwise).
+fn signed_area(polygon: &[DVec2]) -> f64 {
+    0.5 * polygon.iter().enumerate().map(|(k, p)| p.perp_dot(polygon[(k + 1) % polygon.len()])).sum::<f64>()
+}
+
+fn polygon_area(polygon: &[DVec2]) -> f64 {
+    if polygon.len() < 3 { 0.0 } else { signed_area(polygon).abs() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn light() -> RectLight {
+        RectLight::try_facing(Vec3::new(0.0, 4.0, 0.0), Vec3::NEG_Y, Vec3::X, Vec2::new(2.0, 1.0), 1.0).unwrap()
+    }
+
+    /// The share of `rect` hidden, by rays through a fine grid of the rectangle (the definition).
+    fn counted(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
+        const N: usize = 400;
+        let mut hidden = 0usize;
+        for j in 0..N {
+            for i in 0..N {
+                let at = min + (max - min) * Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+                let target = light.point(at.x, at.y);
+                let blocked = triangles.iter().any(|t| segment_crosses(origin, target, t));
+                hidden += usize::from(blocked);
+            }
+        }
+        hidden as f64 / (N * N) as f64
+    }
+
+    /// Möller–Trumbore on the open segment.
+    fn segment_crosses(origin: Vec3, target: Vec3, [a, b, c]: &[Vec3; 3]) -> bool {
+        let (origin, direction) = (origin.as_dvec3(), (target - origin).as_dvec3());
+        let (e1, e2) = (b.as_dvec3() - a.as_dvec3(), c.as_dvec3() - a.as_dvec3());
+        let p = direction.cross(e2);
+        let det = e1.dot(p);
+        if det.abs() < 1e-15 {
+            return false;
+        }
+        let s = origin - a.as_dvec3();
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = direction.dot(q) / det;
+        let t = e2.dot(q) / det;
+        u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < 1.0
+    }
+
+    fn random(state: &mut u64) -> f32 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// On random triangles (one or two, some crossing the light's plane or the point's), seen from
+    /// random points through random parts of the light, the exact share matches the share of a
+    /// 400² grid of rays within the grid's resolution.
+    #[test]
+    fn the_exact_share_is_what_rays_through_a_fine_grid_find() {
+        let light = light();
+        let mut state = 7u64;
+        let mut nonzero = 0;
+        for case in 0..300 {
+            let point = |state: &mut u64| Vec3::new(random(state) * 4.0 - 2.0, random(state) * 5.0 - 0.5, random(state) * 4.0 - 2.0);
+            let origin = Vec3::new(point(&mut state).x * 0.3, -1.0 + random(&mut state) * 0.5, point(&mut state).z * 0.3);
+            let triangles: Vec<[Vec3; 3]> = (0..1 + case % 2).map(|_| [point(&mut state), point(&mut state), point(&mut state)]).collect();
+            let corner = Vec2::new(random(&mut state), random(&mut state)) * 2.0 - Vec2::ONE;
+            let size = 0.1 + random(&mut state);
+            let rect = [corner, (corner + Vec2::splat(size)).min(Vec2::ONE)];
+            let exact = covered_share(&light, origin, &triangles, rect);
+            let rays = counted(&light, origin, &triangles, rect);
+            nonzero += usize::from(exact > 0.01 && exact < 0.99);
+            assert!(
+                (exact - rays).abs() < 0.01,
+                "case {case}: exact {exact}, rays {rays}, triangles {triangles:?}, origin {origin}, rect {rect:?}"
+            );
+        }
+        assert!(nonzero > 50, "too few partly hidden cases ({nonzero}) to test anything");
+    }
+
+    #[test]
+    fn a_triangle_covering_the_view_hides_everything_and_one_behind_the_light_nothing() {
+        let light = light();
+        let origin = Vec3::ZERO;
+        let big = [Vec3::new(-50.0, 2.0, -50.0), Vec3::new(50.0, 2.0, -50.0), Vec3::new(0.0, 2.0, 80.0)];
+        let rect = [Vec2::NEG_ONE, Vec2::ONE];
+        assert!((covered_share(&light, origin, &[big], rect) - 1.0).abs() < 1e-12);
+        let beyond = big.map(|p| p + Vec3::Y * 3.0);
+        assert_eq!(covered_share(&light, origin, &[beyond], rect), 0.0);
+        // Two copies of one triangle hide what one does.
+        let half = [Vec3::new(0.0, 2.0, -5.0), Vec3::new(5.0, 2.0, -5.0), Vec3::new(0.0, 2.0, 5.0)];
+        let one = covered_share(&light, origin, &[half], rect);
+        assert!((covered_share(&light, origin, &[half, half], rect) - one).abs() < 1e-12 && one > 0.1);
+    }
+}
