@@ -1115,6 +1115,8 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     summary: "ground truth: N×N stratified jittered shadow rays per pixel on the CPU (CWBVH, all cores), cached on disk",
     paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling)",
     kind: crate::TechniqueKind::GroundTruth,
+    // Rays to points all over the light, blocked behind a closed surface (SurfacePoint::closed).
+    light_sampling: crate::LightSampling::PerSample,
     params: PARAMS,
     requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,
