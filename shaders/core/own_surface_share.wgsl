@@ -4,12 +4,15 @@
 // leave behind it are blocked), which a map seen from the centre cannot show. With s the fraction
 // of the light in front of the plane (light_share_in_front), at a covered pixel of a closed mesh
 // that no shared rule answers (unlit_by_rule) and with 0 < s < 1:
-// - the light's centre on or in front of the plane: V = s * V_technique. The technique's map sees
-//   the other occluders; a convex solid's own surface lies behind the tangent plane, so it is not
+// - the light's centre in front of the plane: V = s * V_technique. The technique's map sees the
+//   other occluders; a convex solid's own surface lies behind the tangent plane, so it is not
 //   among them, and the product charges the technique only for what it models;
-// - the centre behind the plane: V = s. The technique's map sees the solid's own front from the
-//   centre, so its value says nothing of the front part of the light. The limit: other occluders
-//   of that front part are not seen there.
+// - the centre behind the plane, or on it: V = s. From behind, the technique's map sees the
+//   solid's own front from the centre, so its value says nothing of the front part of the light.
+//   On the plane (within the positions' rounding, CENTRE_ON_PLANE), the map sees the surface
+//   edge-on and techniques answer the degenerate view as they happen to (hard 1, wedges 0.5 from
+//   the solid's own silhouette, which the product would charge twice). The limit: other
+//   occluders of the front part are not seen there.
 // Elsewhere the technique's value is kept.
 
 // #import common/screen_pass.wgsl
@@ -21,6 +24,10 @@
 // one texel: the G-buffer's two per invocation inside the target, the technique's visibility
 // where it is scaled; a store writes one r32float, 4 bytes.
 @group(2) @binding(1) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// How far in front of the plane, as a fraction of the scene's diagonal, the light's centre must be
+// for the technique's value to count: the G-buffer's positions' rounding at the scene's scale.
+const CENTRE_ON_PLANE: f32 = 1e-6;
 
 @compute @workgroup_size(8, 8)
 fn own_surface_share(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -36,7 +43,7 @@ fn own_surface_share(@builtin(global_invocation_id) id: vec3<u32>) {
         let share = light_share_in_front(frame, point.position, point.normal);
         if (share > 0.0 && share < 1.0) {
             var with_share = share;
-            if (light_centre_height(frame, point.position, point.normal) >= 0.0) {
+            if (light_centre_height(frame, point.position, point.normal) > scene_length(frame, CENTRE_ON_PLANE)) {
                 with_share = share * textureLoad(visibility, texel).x;
                 reads += 1u;
             }
