@@ -1,13 +1,15 @@
 //! Counted work (`--count-work`): for every registered technique, one counting frame
 //! ([`Renderer::count_work`]) gives each pass's invocations from pipeline statistics (lavapipe has
 //! them, so they must be there) and, for every technique of the workspace, the texel reads its
-//! shaders count; and it leaves the same visibility as a timed frame: counting changes no result.
+//! shaders count (the framework's own-surface share pass included, after every technique that
+//! samples the light from its centre); and it leaves the same visibility as a timed frame:
+//! counting changes no result.
 //! Where the work is known by hand it is asserted exactly.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use ssm_core::{Renderer, Requirements, TechniqueKind};
+use ssm_core::{Renderer, Requirements, TechniqueKind, own_surface_share_label};
 use ssm_integration_tests::{MUST_RUN_ON_LAVAPIPE, missing_must_run, registry, render_or_refusal};
 use ssm_scene::builtin;
 use ssm_testing::gpu;
@@ -51,6 +53,20 @@ fn every_technique_counts_its_passes_and_counting_changes_no_result() {
         if MUST_RUN_ON_LAVAPIPE.contains(&info.name) && !(work.shader_counts && work.total(|p| p.texel_reads) > 0) {
             failures.push(format!("{}: its shaders count no texel reads", info.name));
         }
+        // The framework's own-surface share follows every technique that samples the light from
+        // its centre, once per light, with its reads counted (two G-buffer texels per pixel at
+        // least), and no other.
+        let share = work.passes.iter().find(|p| p.name == own_surface_share_label(info.name));
+        match (info.gets_own_surface_share(), share) {
+            (true, Some(pass)) => {
+                if pass.runs != 1 || (work.shader_counts && pass.texel_reads < 2 * u64::from(WIDTH * HEIGHT)) {
+                    failures.push(format!("{}: own-surface share ran {} times, {} texel reads", info.name, pass.runs, pass.texel_reads));
+                }
+            }
+            (true, None) => failures.push(format!("{}: no own-surface share pass in {}", info.name, work.passes_column())),
+            (false, Some(_)) => failures.push(format!("{}: samples the light per point, yet got the own-surface share", info.name)),
+            (false, None) => {}
+        }
         if let Some(pass) = work.passes.iter().find(|p| p.runs == 0) {
             failures.push(format!("{}: pass {} counted without running", info.name, pass.name));
         }
@@ -67,7 +83,8 @@ fn every_technique_counts_its_passes_and_counting_changes_no_result() {
 
 /// hard's work by hand: its shadow-map pass draws the scene's vertices once per light (4
 /// triangles, no index reuse), and its lookup is one full-screen triangle that shades every pixel
-/// and stores one R32Float texel per pixel; the shadow map stores one R32Float texel per texel.
+/// and stores one R32Float texel per pixel; the shadow map stores one R32Float texel per texel;
+/// the framework's own-surface share after it reads two G-buffer texels per pixel.
 /// Fragment invocations are at least one per pixel: Vulkan lets an implementation count helper
 /// invocations (lavapipe reports 3,456 for 64x48 = 3,072 pixels), so no upper bound is exact.
 #[test]
@@ -95,5 +112,11 @@ fn hard_shadow_mapping_work_is_counted_exactly() {
         WIDTH * HEIGHT
     );
     assert_eq!(lookup.target_bytes, u64::from(WIDTH * HEIGHT) * 4, "one R32Float texel per pixel");
+    // The framework's own-surface share: one invocation per pixel (64 x 48 is whole 8 x 8 groups),
+    // each reading the G-buffer's two texels; parallel-square has no closed mesh, so nothing more
+    // is read or stored.
+    let share = pass(&own_surface_share_label("hard"));
+    let pixels = u64::from(WIDTH * HEIGHT);
+    assert_eq!((share.runs, share.compute_invocations, share.texel_reads, share.storage_bytes), (1, pixels, 2 * pixels, 0));
     assert_eq!(work.uncounted_passes, 0);
 }

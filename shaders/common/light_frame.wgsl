@@ -77,6 +77,50 @@ fn light_behind_surface(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) 
     return centre_height + corner_reach < 0.0;
 }
 
+// Height of the light's centre above the plane through `world` with normal `normal`.
+fn light_centre_height(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) -> f32 {
+    return dot(frame.centre.xyz - world, normal);
+}
+
+// The fraction of the light's area strictly in front of the plane through `world` with normal
+// `normal`: 1 wholly in front, 0 wholly behind. Its points are at heights h + a A + b B above the
+// plane (h the centre's, A and B the half sides' reaches along the normal, a and b uniform in
+// [-1, 1]), so the fraction is sum_of_uniforms_cdf(h, A, B). CPU twin:
+// ssm_scene::RectLight::share_in_front_of_plane.
+fn light_share_in_front(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) -> f32 {
+    let reach_u = abs(frame.u_axis.w * dot(frame.u_axis.xyz, normal));
+    let reach_v = abs(frame.v_axis.w * dot(frame.v_axis.xyz, normal));
+    return sum_of_uniforms_cdf(light_centre_height(frame, world, normal), reach_u, reach_v);
+}
+
+// P(a A + b B < t) for a, b independent and uniform in [-1, 1], A, B >= 0: the sum's cumulative
+// distribution, piecewise in t with the larger reach first. No piece subtracts nearly equal terms
+// (a tube's B far below A keeps its precision), B = 0 never divides (its corner pieces are empty
+// and caught by the first two tests), and A = B = 0 gives the step t > 0. CPU twin:
+// ssm_scene::sum_of_uniforms_cdf.
+fn sum_of_uniforms_cdf(t: f32, first: f32, second: f32) -> f32 {
+    let a = max(first, second);
+    let b = min(first, second);
+    // Distances to the lowest and highest heights, B added last so that A's rounding keeps it.
+    let below = (t + a) + b;
+    if (below <= 0.0) {
+        return 0.0;
+    }
+    let above = (a - t) + b;
+    if (above <= 0.0) {
+        return 1.0;
+    }
+    // A > 0 here, and B > 0 in the corners (with B = 0, t <= -A and t > A returned above). Each
+    // corner is half a product of two ratios in (0, 1]: no overflow.
+    if (t <= b - a) {
+        return 0.5 * min(below / (2.0 * a), 1.0) * min(below / (2.0 * b), 1.0);
+    }
+    if (t <= a - b) {
+        return clamp((t + a) / (2.0 * a), 0.0, 1.0);
+    }
+    return 1.0 - 0.5 * min(above / (2.0 * a), 1.0) * min(above / (2.0 * b), 1.0);
+}
+
 // The receiver's tangent plane as seen from the light, prepared once per receiver point so that
 // each tap costs one multiply-add and a division: along the ray from the light's centre through
 // shadow-map coordinates `uv`, the plane's linear depth is numerator / (c.x + c.y u + c.z v)

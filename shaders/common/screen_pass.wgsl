@@ -45,6 +45,10 @@ fn screen_point_at(texel: vec2<i32>) -> ScreenPoint {
 // camera (a light in a closed box seen from outside: an engine culls it, and a
 // frame's maps could not show it where the box's walls meet the ground, nor
 // past the frame's widest angle); -1 where the technique must compute it.
+// Where the light straddles a closed surface's tangent plane, the solid hides the part behind
+// it: the framework gives that share after the technique's passes, to every technique that
+// samples the light from its centre (core/own_surface_share.wgsl states the rule and its
+// limit), so a technique need not model it.
 fn trivial_visibility(point: ScreenPoint) -> f32 {
     if (!point.covered) {
         return 1.0;

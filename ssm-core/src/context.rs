@@ -85,6 +85,7 @@ struct SharedObjects {
     gbuffer_layout: wgpu::BindGroupLayout,
     texture_layout: wgpu::BindGroupLayout,
     render_pipelines: Mutex<HashMap<String, wgpu::RenderPipeline>>,
+    compute_pipelines: Mutex<HashMap<String, wgpu::ComputePipeline>>,
 }
 
 impl SharedObjects {
@@ -103,6 +104,7 @@ impl SharedObjects {
                 entries: &[texture_entry(0)],
             }),
             render_pipelines: Mutex::new(HashMap::new()),
+            compute_pipelines: Mutex::new(HashMap::new()),
         }
     }
 }
@@ -197,6 +199,27 @@ impl GpuContext {
         }
         let pipeline = build(self)?;
         if let Ok(mut cache) = self.shared.render_pipelines.lock() {
+            cache.insert(key.to_owned(), pipeline.clone());
+        }
+        Ok(pipeline)
+    }
+
+    /// The compute pipeline cached under `key`, built by `build` the first time it is asked for
+    /// on this device, as [`GpuContext::cached_render_pipeline`] (the framework's own-surface
+    /// share, run after every technique that samples the light from its centre).
+    ///
+    /// # Errors
+    /// Whatever `build` returns.
+    pub fn cached_compute_pipeline(
+        &self,
+        key: &str,
+        build: impl FnOnce(&Self) -> crate::Result<wgpu::ComputePipeline>,
+    ) -> crate::Result<wgpu::ComputePipeline> {
+        if let Some(pipeline) = self.shared.compute_pipelines.lock().ok().and_then(|cache| cache.get(key).cloned()) {
+            return Ok(pipeline);
+        }
+        let pipeline = build(self)?;
+        if let Ok(mut cache) = self.shared.compute_pipelines.lock() {
             cache.insert(key.to_owned(), pipeline.clone());
         }
         Ok(pipeline)

@@ -49,6 +49,7 @@ pub mod image_io;
 mod light_depth;
 mod light_frame;
 pub mod metrics;
+mod own_surface;
 mod params;
 pub mod passes;
 pub mod read_counts;
@@ -72,14 +73,15 @@ pub use light_depth::{
     screen_space_requirements,
 };
 pub use light_frame::{LightFrame, LightFrameUniform, MAX_HALF_ANGLE_TANGENT, MAX_WIDENED_HALF_ANGLE_TANGENT};
+pub use own_surface::{OWN_SURFACE_SHARE_PASS, own_surface_share_label};
 pub use params::{Choice, ParamError, ParamKind, ParamSpec, ParamValue, ParamValues, Settings, concat_params};
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
-    DebugOutput, ExtraImage, KnownLimit, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup,
-    UniformCheck, UniformStruct,
+    DebugOutput, ExtraImage, KnownLimit, LightSampling, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, UniformCheck, UniformStruct,
 };
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 pub use work::{FrameWork, PassWork, ShaderWork};

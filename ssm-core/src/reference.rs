@@ -1493,6 +1493,8 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     summary: "ground truth: two independent sets of N×N stratified jittered shadow rays per pixel, refined where the visibility varies, on the CPU (CWBVH, all cores), cached on disk, with its own noise per pixel",
     paper: "Monte Carlo estimate of the visible fraction of the light (stratified sampling, refined where the visibility varies)",
     kind: crate::TechniqueKind::GroundTruth,
+    // Rays to points all over the light, blocked behind a closed surface (SurfacePoint::closed).
+    light_sampling: crate::LightSampling::PerSample,
     params: PARAMS,
     requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,

@@ -46,7 +46,7 @@ pub struct Renderer {
 
 impl Renderer {
     /// Uploads `scene` for `width` × `height` images and builds the shared
-    /// inputs `needs` asks for (the union of the techniques' requirements, plus
+    /// inputs `needs` asks for (the union of the techniques' [`TechniqueInfo::needs`], plus
     /// the G-buffer when shaded images or positions will be read).
     ///
     /// # Errors
@@ -104,8 +104,10 @@ impl Renderer {
         if messages.is_empty() { Ok(()) } else { Err(Error::Gpu { during: during.into(), messages }) }
     }
 
-    /// Creates a technique with `params`, after checking its requirements
-    /// against the device and the shared inputs built.
+    /// Creates a technique with `params`, after checking what it needs
+    /// ([`TechniqueInfo::needs`]) against the device and the shared inputs built. A technique
+    /// that samples the light from its centre comes followed by the framework's own-surface
+    /// share ([`LightSampling::Centre`](crate::LightSampling::Centre)).
     ///
     /// # Errors
     /// [`Error::MissingFeatures`], [`Error::LimitTooLow`], [`Error::UndeclaredRequirement`],

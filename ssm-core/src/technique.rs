@@ -195,6 +195,23 @@ pub enum TechniqueKind {
     GroundTruth,
 }
 
+/// Where on the light a technique takes its visibility from, which decides what the framework
+/// adds to it: the surface's own share of the light (`ssm-core/src/own_surface.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSampling {
+    /// From the light's centre: one map, one frame or one set of silhouettes for the whole light
+    /// (hard, pcss, vssm, sssm, atty, pvsm, wedges, and a new technique by default). Such a map
+    /// cannot show the part of the light that a closed surface's own solid hides behind its
+    /// tangent plane, so the framework gives it, in closed form, after the technique's passes:
+    /// one compute pass per light, `<technique>_own_surface_share`, timed and counted with them.
+    /// The technique needs the G-buffer for it ([`TechniqueInfo::needs`]).
+    Centre,
+    /// From points all over the light, each with the shared rules applied per point (multi-sm's
+    /// map per light sample, the ground truth's rays): the surface's own share is in its answer
+    /// already, and is not charged twice.
+    PerSample,
+}
+
 /// A named sweep a technique declares beside its parameters (the studies of
 /// its paper), discovered by `ssm sweep --list-presets` and the preset benches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -274,6 +291,9 @@ pub struct TechniqueInfo {
     pub paper: &'static str,
     /// Real-time technique or ground truth.
     pub kind: TechniqueKind,
+    /// Where on the light it takes its visibility from: [`LightSampling::Centre`] gets the
+    /// framework's own-surface share after its passes, [`LightSampling::PerSample`] does not.
+    pub light_sampling: LightSampling,
     /// Its parameters.
     pub params: &'static [ParamSpec],
     /// Its requirements, which may depend on the parameter values.
@@ -313,6 +333,28 @@ pub struct KnownLimit {
 }
 
 impl TechniqueInfo {
+    /// Whether the framework follows the technique's passes with the own-surface share: it
+    /// samples the light from its centre and is not the ground truth.
+    #[must_use]
+    pub fn gets_own_surface_share(&self) -> bool {
+        self.light_sampling == LightSampling::Centre && self.kind != TechniqueKind::GroundTruth
+    }
+
+    /// What a renderer must build for the technique with `params`: its
+    /// [`requirements`](TechniqueInfo::requirements), and the G-buffer that the framework's
+    /// own-surface share reads when it [gets one](TechniqueInfo::gets_own_surface_share).
+    ///
+    /// # Errors
+    /// Whatever its requirements reject.
+    pub fn needs(&self, params: &ParamValues) -> Result<Requirements> {
+        let requirements = (self.requirements)(params)?;
+        Ok(if self.gets_own_surface_share() {
+            requirements.union(Requirements { gbuffer: true, ..Requirements::NONE })
+        } else {
+            requirements
+        })
+    }
+
     /// Every parameter at its default.
     #[must_use]
     pub fn default_params(&self) -> ParamValues {
@@ -372,7 +414,7 @@ pub(crate) fn create_checked(
     params: &ParamValues,
     count_work: bool,
 ) -> Result<Box<dyn ShadowTechnique>> {
-    let requirements = (info.requirements)(params)?;
+    let requirements = info.needs(params)?;
     requirements.check_device(info.name, gpu)?;
     if requirements.gbuffer && shared.gbuffer.is_none() {
         return Err(Error::UndeclaredRequirement { technique: info.name.into(), input: "G-buffer (the renderer was built without it)" });
@@ -389,7 +431,11 @@ pub(crate) fn create_checked(
             input: "occluder/receiver roles (the renderer was built without them)",
         });
     }
-    let technique = (info.create)(&TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params, count_work })?;
+    let setup = TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params, count_work };
+    let mut technique = (info.create)(&setup)?;
+    if info.gets_own_surface_share() {
+        technique = crate::own_surface::with_own_surface_share(technique, &setup, info.name)?;
+    }
     let messages = gpu.take_errors();
     if messages.is_empty() { Ok(technique) } else { Err(Error::Gpu { during: format!("creating technique `{}`", info.name), messages }) }
 }

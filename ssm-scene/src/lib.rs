@@ -91,7 +91,7 @@ pub use adjacency::{Adjacency, Edge, NO_FACE};
 pub use builtin::{BUILTIN_SCENES, BuiltinArgs, BuiltinParam, BuiltinScene, builtin, parse_builtin};
 pub use camera::Camera;
 pub use error::{Result, SceneError};
-pub use light::RectLight;
+pub use light::{RectLight, sum_of_uniforms_cdf};
 pub use loaders::{LoadedModel, Placement, load_model};
 pub use manifest::{CameraSpec, LightSpec, Manifest, ObjectSpec, Scale, framing_camera, stage_model};
 pub use mesh::{Mesh, fan_to_list, generate_normals, strip_to_list};

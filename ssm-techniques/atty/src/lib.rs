@@ -963,6 +963,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "soft shadow maps: occluder micro-patches back-projected onto the light, accumulated on the GPU (one- and two-sided)",
     paper: "Atty et al. 2006, Soft Shadow Maps: Efficient Sampling of Light Source Visibility (CGF 25(4))",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: AttySettings::PARAMS,
     requirements,
     create,

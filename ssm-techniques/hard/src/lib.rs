@@ -153,6 +153,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "hard shadow mapping from the light's centre, slope-scaled bias (baseline)",
     paper: "Williams 1978, Casting curved shadows on curved surfaces",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: HardSettings::PARAMS,
     requirements,
     create,

@@ -274,6 +274,9 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "average of K hard shadow maps from stratified points on the light (baseline; converges as K grows)",
     paper: "Heckbert and Herf 1997, Simulating soft shadows with graphics hardware (the reference of Shen et al. 2011 and Buades et al. 2015)",
     kind: TechniqueKind::Realtime,
+    // A map per light sample, each with the shared rules for that point light (multi_sm.wgsl):
+    // the own surface's share is in its answer, not charged twice.
+    light_sampling: ssm_core::LightSampling::PerSample,
     params: MultiSmSettings::PARAMS,
     requirements,
     create,

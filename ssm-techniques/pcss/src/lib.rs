@@ -308,6 +308,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "percentage-closer soft shadows: n×n blocker search, m×m PCF sized by the penumbra estimate (baseline)",
     paper: "Fernando 2005, Percentage-closer soft shadows (SIGGRAPH sketch)",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: PcssSettings::PARAMS,
     requirements,
     create,

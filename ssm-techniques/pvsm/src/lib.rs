@@ -1504,6 +1504,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "predicted virtual soft shadow maps: perceptual resolution prediction, kd-tree tiles, texel-as-quad filtering, analytic anisotropic anti-aliasing",
     paper: "Shen, Guennebaud, Yang and Feng 2011, Predicted Virtual Soft Shadow Maps with High Quality Filtering (CGF 30(2), Eurographics)",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: PvsmSettings::PARAMS,
     requirements,
     create,

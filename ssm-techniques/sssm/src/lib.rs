@@ -800,6 +800,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "separable soft shadow mapping: separable blocker search reusing rows (α) and separable screen-space blur (β)",
     paper: "Buades, Gumbau and Chover 2015, Separable soft shadow mapping (The Visual Computer)",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: SssmSettings::PARAMS,
     requirements,
     create,

@@ -306,6 +306,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "variance soft shadow mapping: PCSS's search and filter from the moments' summed-area table, Chebyshev's blocker estimate, the kernel subdivided (baseline)",
     paper: "Yang, Dong, Feng, Seidel and Kautz 2010, Variance Soft Shadow Mapping (CGF 29(7), Pacific Graphics)",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: VssmSettings::PARAMS,
     requirements,
     create,

@@ -1158,6 +1158,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "penumbra wedges (soft shadow volumes) with GPU silhouettes and z-fail umbra; blending=forest blends overlapping penumbrae, blending=none silhouette_buffers=1 is the plain penumbra wedges",
     paper: "Forest, Barthe and Paulin 2006, Realistic soft shadows by penumbra-wedges blending (Graphics Hardware); Akenine-Möller and Assarsson 2002; Assarsson and Akenine-Möller 2003",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: WedgesSettings::PARAMS,
     requirements,
     create,

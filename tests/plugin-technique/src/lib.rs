@@ -140,6 +140,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "plug-in example: a hard shadow map from ssm-core's LightDepthMap and ScreenPass",
     paper: "Williams 1978 (as a plug-in example)",
     kind: TechniqueKind::Realtime,
+    // One view of the light from its centre: the framework adds the own surface's share.
+    light_sampling: ssm_core::LightSampling::Centre,
     params: PARAMS,
     requirements: |params| Ok(Requirements { gbuffer: true, max_texture_size: map_size(params)?, ..Requirements::NONE }),
     create,

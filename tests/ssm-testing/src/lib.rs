@@ -72,7 +72,7 @@ pub fn render(
     height: u32,
 ) -> ssm_core::Result<Rendered> {
     let params = technique.params_from(settings.iter().copied())?;
-    let needs = (technique.requirements)(&params)?.union(Requirements { gbuffer: true, ..Requirements::NONE });
+    let needs = technique.needs(&params)?.union(Requirements { gbuffer: true, ..Requirements::NONE });
     let mut renderer = Renderer::new(gpu, scene, width, height, &needs)?;
     let mut instance = renderer.create_technique(technique, &params)?;
     renderer.render(instance.as_mut(), technique.name)?;
