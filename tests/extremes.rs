@@ -6,10 +6,15 @@
 //!   ([`EXPECTED_REFUSALS`]); the techniques of `MUST_RUN_ON_LAVAPIPE` (tests/support.rs) must run everywhere
 //!   else, and any other error fails. Visibility that is not finite or not in [0, 1] comes back from the
 //!   readback as [`Error::InvalidOutput`], which fails like any other error;
-//! - its mean absolute error against the ground truth, over the pixels a surface covers, is at
+//! - its headline error against the ground truth (`ErrorMetrics::mae`: over the pixels that the
+//!   truth or the technique shadows, so that a shadow drawn where there is none counts), is at
 //!   most [`COMMON_BOUND`] for every light of the scene, or the looser bound its registration
 //!   declares for that scene ([`ssm_core::KnownLimit`], with the paper's reason). A declaration
 //!   that names no scene here, or that the technique no longer needs, fails too;
+//! - on every scene with a penumbra, every soft-shadow technique beats hard shadows (a lower error,
+//!   beyond the ground truth's noise), unless it declares a limit there; and hard shadows fail the
+//!   scenes whose penumbra they cannot draw ([`HARD_MUST_FAIL`]), so that the bound tells a soft
+//!   technique from none;
 //! - what every correct technique must satisfy there holds, whatever its approximation ([`Expect`]):
 //!   a light facing away lights nothing, a point light casts no penumbra, no light leaves a
 //!   sealed box.
@@ -20,26 +25,79 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3};
+use ssm_core::metrics::{compare_with_noise, is_tie};
+use ssm_core::reference::{GroundTruth, Sampling, surface_points};
 use ssm_core::{Error, TechniqueInfo, TechniqueKind};
 use ssm_integration_tests::{missing_must_run, registry, render_or_refusal};
 use ssm_scene::{Instance, Manifest, Mesh, RectLight, Role, Scene, SceneError, builtin, primitives};
-use ssm_testing::{Rendered, at, gpu, pixel_of, reference, render};
+use ssm_testing::{Rendered, at, gpu, pixel_of, render};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;
 
-/// Rays per axis of the ground truth. Its per-pixel error is at most 4/N where one occluder edge
-/// crosses the light and its mean over a penumbra below N^-1.5 (tests/reference.rs): 0.011 at
-/// N = 8, a ninth of [`COMMON_BOUND`].
+/// Rays per axis of each of the ground truth's two sets (refined where the visibility varies): its
+/// own error is reported beside every technique's and decides ties with hard shadows.
 const REFERENCE_SAMPLES: u32 = 8;
 
-/// The mean absolute error against the ground truth that every technique must meet on every
-/// scene here unless its registration declares a looser one: the acceptance bound of the
-/// project's issue #39 for the extreme cases. A technique that inverts a shadow (lit where the
-/// truth is dark) over a tenth of the image exceeds it; a soft-shadow approximation's error
-/// (the penumbra's shape, a pixel of aliasing along each edge) stays well below it on these
-/// scenes, whose penumbrae cover a small part of the view.
+/// The mean absolute error against the ground truth, over the pixels either shadows, that every
+/// technique must meet on every scene here unless its registration declares a looser one (hard
+/// shadows need not where there is a penumbra: they are the baseline there). A shadow drawn at
+/// 0.6 over the lit part of a floor exceeds it on every scene (seen: 0.22 to 0.40), and so do hard
+/// shadows under a large light (0.28) or a tube (0.25 to 0.34).
 const COMMON_BOUND: f32 = 0.1;
+
+/// The hard-shadow techniques: the baseline every other technique must beat where there is a
+/// penumbra (the plug-in test's `plugin-hard` is one too). Every other registered real-time
+/// technique is a soft-shadow technique.
+const HARD_SHADOW_TECHNIQUES: &[&str] = &["hard", "plugin-hard"];
+
+/// The scenes whose penumbra covers so much of the shadow that a hard shadow exceeds
+/// [`COMMON_BOUND`]: each hard-shadow technique must fail them, which shows that the bound tells a
+/// soft technique from none.
+const HARD_MUST_FAIL: &[&str] =
+    &["light far larger than the occluder", "tube light along the occluder's side", "tube light across the scene at 30 degrees"];
+
+/// A scene has a penumbra to compare soft techniques on when at least this share of its covered
+/// pixels is in a visible penumbra (between 0.02 and 0.98) in the ground truth.
+const PENUMBRA_SHARE: f32 = 0.01;
+
+/// (technique, scene, what is wrong): failures this matrix finds that the workspace has not fixed
+/// yet. Each is reported when the test runs and must still fail: one that passes fails the test
+/// until its line is removed. They are bugs or missing features of the implementation, not limits
+/// of the papers (those are `KnownLimit`s, declared by the technique with the paper's reason).
+const OPEN_FAILURES: &[(&str, &str, &str)] = &[
+    // Tube lights: the filter, search region or micro-patch projection follows the longer side only.
+    ("atty", "tube light along the occluder's side", "the light frame's fit refuses a 1000:1 light"),
+    ("atty", "tube light across the scene at 30 degrees", "the light frame's fit refuses a 1000:1 light"),
+    ("pcss", "tube light along the occluder's side", "search and filter regions ignore the short side"),
+    ("pcss", "tube light across the scene at 30 degrees", "search and filter regions ignore the short side"),
+    ("pvsm", "tube light along the occluder's side", "kernel shape ignores the short side"),
+    ("pvsm", "tube light across the scene at 30 degrees", "kernel shape ignores the short side"),
+    ("sssm", "tube light along the occluder's side", "separable search and blur ignore the short side"),
+    ("sssm", "tube light across the scene at 30 degrees", "separable search and blur ignore the short side"),
+    ("vssm", "tube light along the occluder's side", "filter region ignores the short side"),
+    ("vssm", "tube light across the scene at 30 degrees", "filter region ignores the short side"),
+    // The light frame stops at 84 degrees off the light's normal: the floor past it reads lit.
+    ("atty", "light resting on the receiver", "no texel past the frame's widest angle"),
+    ("multi-sm", "light resting on the receiver", "no texel past the frame's widest angle"),
+    ("pcss", "light resting on the receiver", "no texel past the frame's widest angle"),
+    ("pvsm", "light resting on the receiver", "no texel past the frame's widest angle"),
+    ("sssm", "light resting on the receiver", "no texel past the frame's widest angle"),
+    ("vssm", "light resting on the receiver", "no texel past the frame's widest angle"),
+    // Under a near-point light the penumbra is a pixel or two wide: these blur or alias it more
+    // than a hard shadow errs by (to investigate: minimum filter sizes, map resolution).
+    ("atty", "thin bars under a near-point light", "no better than a hard shadow"),
+    ("multi-sm", "thin bars under a near-point light", "worse than a hard shadow"),
+    ("pcss", "thin bars under a near-point light", "worse than a hard shadow"),
+    ("pvsm", "thin bars under a near-point light", "worse than a hard shadow"),
+    ("sssm", "thin bars under a near-point light", "no better than a hard shadow: both blurs skipped under half a pixel"),
+    ("vssm", "thin bars under a near-point light", "worse than a hard shadow"),
+    // Each to investigate.
+    ("sssm", "light far larger than the occluder", "error just above the bound where either shadows"),
+    ("atty", "three lights", "error far above the other techniques' on three lights"),
+    ("atty", "wall lit at grazing angles", "error above the bound where either shadows"),
+    ("multi-sm", "light inside a closed room", "worse than a hard shadow in a closed room"),
+];
 
 /// (technique, scene, what its refusal must say): the refusals this matrix expects, each asserted
 /// by its error's variant and a phrase of its reason. A technique that stops refusing a scene
@@ -84,10 +142,14 @@ struct Case {
     name: &'static str,
     scene: Scene,
     expect: Expect,
+    /// The framework answers this scene for every technique alike (a light sealed in a closed
+    /// mesh is culled: `LightFrame::sealed`): it tests the framework, not the techniques, and is
+    /// reported as such.
+    framework_rule: Option<&'static str>,
 }
 
 fn case(name: &'static str, scene: Scene, expect: Expect) -> Case {
-    Case { name, scene, expect }
+    Case { name, scene, expect, framework_rule: None }
 }
 
 fn from_manifest(name: &str, text: &str) -> Scene {
@@ -126,6 +188,18 @@ fn extreme_cases() -> Vec<Case> {
         case("point light", parallel_square_with(square_light(above, down, 0.0), 2.0), Expect::NoPenumbra),
         case("light far larger than the occluder", parallel_square_with(square_light(above, down, 50.0), 2.0), Expect::Bound),
         case("tiny light", parallel_square_with(square_light(above, down, 1e-4), 2.0), Expect::NoPenumbra),
+        // Tubes 1000 times longer than wide: a penumbra as wide as the tube along it, none across
+        // it. Every filter, search region and projection must follow both of the light's sides.
+        case(
+            "tube light along the occluder's side",
+            parallel_square_with(RectLight::try_facing(above, down, Vec3::X, Vec2::new(4.0, 0.004), 1.0).unwrap(), 2.0),
+            Expect::Bound,
+        ),
+        case(
+            "tube light across the scene at 30 degrees",
+            parallel_square_with(RectLight::try_facing(above, down, Vec3::new(0.866, 0.0, 0.5), Vec2::new(4.0, 0.004), 1.0).unwrap(), 2.0),
+            Expect::Bound,
+        ),
         case(
             "grazing light",
             parallel_square_with(square_light(Vec3::new(-12.0, 0.25, 0.0), Vec3::new(1.0, -0.02, 0.0), 1.0), 2.0),
@@ -231,17 +305,20 @@ fn extreme_cases() -> Vec<Case> {
     // A light sealed inside a closed box that rests on the ground, the camera outside: the ground
     // outside and the box's walls see none of it, also where the ground runs to the horizon, past
     // the widest view a light frame takes (MAX_HALF_ANGLE_TANGENT).
-    cases.push(case(
-        "light sealed inside a box",
-        from_manifest(
-            "sealed",
-            "[camera]\nposition = [0.0, 3.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
+    cases.push(Case {
+        framework_rule: Some("a light sealed in a closed mesh is culled for every technique (LightFrame::sealed)"),
+        ..case(
+            "light sealed inside a box",
+            from_manifest(
+                "sealed",
+                "[camera]\nposition = [0.0, 3.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
              [[light]]\ncentre = [0.0, 0.8, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 0.5]\n\
              [[object]]\nprimitive = \"box\"\nsize = [2.0, 1.0, 2.0]\ntranslate = [0.0, 0.5, 0.0]\nrole = \"both\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [80.0, 80.0]\nrole = \"receiver\"\n",
-        ),
-        Expect::NoLightEscapes,
-    ));
+            ),
+            Expect::NoLightEscapes,
+        )
+    });
     // The same light enclosed by five separate quads on the ground (open surfaces, so no closed
     // mesh seals it and each technique's own maps must keep the light in): the ground outside
     // reads 0; the walls' outer sides, sheets lit from either side, read lit.
@@ -394,6 +471,47 @@ fn refusal_expected(technique: &str, case_name: &str, error: &Error) -> bool {
     })
 }
 
+/// Whether `case`, with this share of its pixels in penumbra, asks every soft technique to beat hard
+/// shadows: it has a penumbra, and no framework rule answers it for every technique alike.
+fn beats_hard_needed(case: &Case, penumbra_share: f32) -> bool {
+    penumbra_share >= PENUMBRA_SHARE && case.framework_rule.is_none()
+}
+
+/// The ground truth of a scene's view: each light's visibility and noise, and the covered pixels.
+struct Truth {
+    images: Vec<(Vec<f32>, Vec<f32>)>,
+    covered: Vec<bool>,
+}
+
+impl Truth {
+    fn of(gpu: &ssm_core::GpuContext, scene: &Scene) -> Self {
+        let needs = ssm_core::Requirements { gbuffer: true, ..ssm_core::Requirements::NONE };
+        let renderer = ssm_core::Renderer::new(gpu, scene, WIDTH, HEIGHT, &needs).unwrap();
+        let positions = renderer.read_positions().unwrap();
+        let points = surface_points(&positions, &renderer.read_normals().unwrap(), &renderer.scene.camera, false);
+        let tracer = GroundTruth::new(scene);
+        let sampling = Sampling { samples_per_axis: REFERENCE_SAMPLES, ..Sampling::DEFAULT };
+        let images = scene
+            .lights
+            .iter()
+            .map(|light| {
+                let image = tracer.trace(light, &points, sampling, 1);
+                (image.visibility, image.noise)
+            })
+            .collect();
+        Self { images, covered: positions.iter().map(|p| p[3] > 0.5).collect() }
+    }
+
+    /// The largest share, over the lights, of covered pixels in a visible penumbra (between 0.02 and 0.98).
+    fn penumbra_share(&self) -> f32 {
+        let covered = self.covered.iter().filter(|c| **c).count().max(1) as f32;
+        self.images
+            .iter()
+            .map(|(image, _)| image.iter().zip(&self.covered).filter(|(v, c)| **c && **v > 0.02 && **v < 0.98).count() as f32 / covered)
+            .fold(0.0, f32::max)
+    }
+}
+
 #[test]
 fn every_technique_is_near_the_ground_truth_on_every_extreme() {
     let gpu = gpu();
@@ -413,12 +531,17 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
         }
     }
 
+    for name in HARD_MUST_FAIL {
+        if !names.contains(name) {
+            failures.push(format!("HARD_MUST_FAIL names `{name}`, which is no case of the matrix"));
+        }
+    }
+
     let mut report = Vec::new();
     for case in &cases {
-        let truth = reference(&gpu, &case.scene, REFERENCE_SAMPLES, (WIDTH, HEIGHT));
-        let covered = truth.coverage();
-        let truth_images: Vec<Vec<f32>> =
-            (0..case.scene.lights.len()).map(|light| truth.renderer.read_visibility(light, "reference").unwrap()).collect();
+        let truth = Truth::of(&gpu, &case.scene);
+        let penumbra = truth.penumbra_share();
+        let mut errors: Vec<(&'static TechniqueInfo, f64, Option<f64>)> = Vec::new();
         for info in registry.iter() {
             if info.kind == TechniqueKind::GroundTruth {
                 // The ground truth is what the others are measured against.
@@ -433,7 +556,7 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
                     Ok(Some(rendered)) => rendered,
                     Ok(None) => continue,
                     Err(message) => {
-                        failures.push(message);
+                        failures.push(format!("{} / {}: {message}", info.name, case.name));
                         continue;
                     }
                 },
@@ -441,25 +564,48 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
             if EXPECTED_REFUSALS.iter().any(|(name, scene, _)| *name == info.name && *scene == case.name) {
                 failures.push(format!("{} / {}: renders, but this test expects a refusal: update EXPECTED_REFUSALS", info.name, case.name));
             }
-            // The largest error over the scene's lights.
-            let mut worst = 0.0f32;
-            for (light, truth_image) in truth_images.iter().enumerate() {
-                let image = rendered.renderer.read_visibility(light, info.name);
-                match image {
-                    Ok(image) => worst = worst.max(ssm_testing::mean_abs_difference(&image, truth_image, &covered)),
+            // The largest headline error over the scene's lights, with the truth's noise there.
+            let (mut worst, mut worst_noise) = (0.0f64, None);
+            for (light, (truth_image, noise)) in truth.images.iter().enumerate() {
+                match rendered.renderer.read_visibility(light, info.name) {
+                    Ok(image) => {
+                        let metrics = compare_with_noise(truth_image, Some(noise), &image, &truth.covered, WIDTH as usize, HEIGHT as usize);
+                        if metrics.mae >= worst {
+                            (worst, worst_noise) = (metrics.mae, metrics.truth_noise);
+                        }
+                    }
                     Err(e) => failures.push(format!("{} / {} / light {light}: {e}", info.name, case.name)),
                 }
             }
+            errors.push((info, worst, worst_noise));
             let (bound, reason) = bound_of(info, case.name);
-            report.push(format!("{:>12} {:>7.4} (bound {bound}) {}", info.name, worst, case.name));
-            if worst > bound {
+            let (bound, common) = (f64::from(bound), f64::from(COMMON_BOUND));
+            report.push(format!(
+                "{:>12} {:>7.4} ± {:.4} (bound {bound}) {}{}",
+                info.name,
+                worst,
+                worst_noise.unwrap_or(0.0),
+                case.name,
+                case.framework_rule.map_or(String::new(), |rule| format!(" [framework cull: {rule}]"))
+            ));
+            let hard_technique = HARD_SHADOW_TECHNIQUES.contains(&info.name);
+            if hard_technique && HARD_MUST_FAIL.contains(&case.name) {
+                if worst <= common {
+                    failures.push(format!(
+                        "{} / {}: a hard shadow meets the common bound ({worst:.4} <= {common}): the case no longer tells soft shadows from hard",
+                        info.name, case.name
+                    ));
+                }
+            } else if hard_technique && beats_hard_needed(case, penumbra) {
+                // The baseline where there is a penumbra: it cannot draw one, and is not asked to.
+            } else if worst > bound {
                 failures.push(format!(
-                    "{} / {}: mean |error| {worst:.4} against the ground truth, above {bound}{}",
+                    "{} / {}: mean |error| {worst:.4} against the ground truth where either shadows, above {bound}{}",
                     info.name,
                     case.name,
                     reason.map_or(String::new(), |r| format!(" (its declared limit: {r})"))
                 ));
-            } else if reason.is_some() && worst <= COMMON_BOUND {
+            } else if reason.is_some() && worst <= common && !beats_hard_needed(case, penumbra) {
                 failures.push(format!(
                     "{} / {}: mean |error| {worst:.4} meets the common bound {COMMON_BOUND}: remove its declared limit",
                     info.name, case.name
@@ -472,9 +618,53 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
                 failures.push(panic.downcast_ref::<String>().cloned().unwrap_or_else(|| format!("{name} / {}: check failed", case.name)));
             }
         }
+        // Where there is a penumbra, every soft technique beats hard shadows beyond the truth's noise.
+        if beats_hard_needed(case, penumbra) {
+            let hard = errors.iter().find(|(info, _, _)| info.name == HARD_SHADOW_TECHNIQUES[0]).map(|(_, e, n)| (*e, *n));
+            let Some((hard_error, hard_noise)) = hard else {
+                failures.push(format!("{}: hard shadows did not run, so no technique can be compared with them", case.name));
+                continue;
+            };
+            for (info, error, noise) in &errors {
+                if HARD_SHADOW_TECHNIQUES.contains(&info.name) || bound_of(info, case.name).1.is_some() {
+                    continue;
+                }
+                if !(*error < hard_error && !is_tie(*error, *noise, hard_error, hard_noise)) {
+                    failures.push(format!(
+                        "{} / {}: error {error:.4} does not beat hard shadows' {hard_error:.4} beyond the truth's noise ({:.4} + {:.4}), on a scene with {:.1}% of its pixels in penumbra",
+                        info.name,
+                        case.name,
+                        noise.unwrap_or(0.0),
+                        hard_noise.unwrap_or(0.0),
+                        penumbra * 100.0
+                    ));
+                }
+            }
+        }
     }
-    println!("mean |error| against the ground truth ({WIDTH}x{HEIGHT}, {REFERENCE_SAMPLES}² rays):\n{}", report.join("\n"));
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    println!(
+        "mean |error| where the truth or the technique shadows, ± the truth's own ({WIDTH}x{HEIGHT}, two sets of {REFERENCE_SAMPLES}² rays):\n{}",
+        report.join("\n")
+    );
+    // The open failures: each must still fail (so that the list stays true), and is reported.
+    let open = |message: &str| OPEN_FAILURES.iter().position(|(technique, case, _)| message.starts_with(&format!("{technique} / {case}:")));
+    let mut still_failing = vec![false; OPEN_FAILURES.len()];
+    let mut unexpected = Vec::new();
+    for message in failures {
+        match open(&message) {
+            Some(index) => {
+                still_failing[index] = true;
+                println!("open failure ({}): {message}", OPEN_FAILURES[index].2);
+            }
+            None => unexpected.push(message),
+        }
+    }
+    for ((technique, case, _), failing) in OPEN_FAILURES.iter().zip(still_failing) {
+        if !failing {
+            unexpected.push(format!("{technique} / {case}: listed in OPEN_FAILURES but passes: remove its line"));
+        }
+    }
+    assert!(unexpected.is_empty(), "{}", unexpected.join("\n"));
 }
 
 /// Non-finite geometry and lights are refused with a typed error before any rendering, by every technique.
