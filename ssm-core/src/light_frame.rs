@@ -230,14 +230,21 @@ fn widest_tangents(points: &[Vec3]) -> Vec2 {
     points.iter().fold(Vec2::splat(1e-3), |tan, p| tan.max(Vec2::new(p.x.abs(), p.y.abs()) / p.z))
 }
 
+/// Most the frame's shape follows a long light's: beyond it the frame keeps this aspect ratio.
+/// A tube 1000 times longer than wide shaped exactly would stretch the frame 1000 times past the
+/// scene along its length (past the widest angle, where the shadow is lost); at this ratio the
+/// frame still spends its texels on the scene, finest across the tube, where its penumbra is
+/// narrowest.
+pub const MAX_FRAME_ASPECT: f32 = 8.0;
+
 /// Tangents given the light's aspect ratio (Atty et al., Sec. 3.2; point lights
-/// are square) and a small margin, so that geometry on the boundary is not lost
-/// to rasterisation rules.
+/// are square; at most [`MAX_FRAME_ASPECT`]) and a small margin, so that
+/// geometry on the boundary is not lost to rasterisation rules.
 fn light_shaped_tangents(light: &RectLight, tan_half: Vec2) -> Vec2 {
     let shaped = if light.is_point() {
         Vec2::splat(tan_half.max_element())
     } else {
-        let aspect = light.half_size.x / light.half_size.y;
+        let aspect = (light.half_size.x / light.half_size.y).clamp(1.0 / MAX_FRAME_ASPECT, MAX_FRAME_ASPECT);
         Vec2::new(tan_half.x.max(tan_half.y * aspect), tan_half.y.max(tan_half.x / aspect))
     };
     shaped * 1.02
@@ -397,6 +404,24 @@ mod tests {
     }
 
     /// A tile's clip space maps its part of the map onto the whole viewport.
+    /// A tube 1000 times longer than wide over `parallel-square`: the frame follows its shape up
+    /// to MAX_FRAME_ASPECT, so it stays within the widest angle, where
+    /// shaping it exactly would stretch it past the widest angle (and lose the shadow).
+    #[test]
+    fn a_tube_lights_frame_keeps_to_the_scene() {
+        let scene = builtin("parallel-square").unwrap().build();
+        for u_hint in [Vec3::X, Vec3::Z, Vec3::new(0.866, 0.0, 0.5)] {
+            let tube = RectLight::try_facing(Vec3::new(0.0, 4.0, 0.0), -Vec3::Y, u_hint, Vec2::new(4.0, 0.004), 1.0).unwrap();
+            let receivers = Aabb { min: Vec3::new(-4.0, 0.0, -4.0), max: Vec3::new(4.0, 0.0, 4.0) };
+            let occluder = [Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, 0.5), Vec3::new(-0.5, 2.0, 0.5)];
+            let frame = LightFrame::fit_with_occluders(&tube, &scene.bounds(), &receivers, &occluder);
+            let ratio = frame.tan_half.x / frame.tan_half.y;
+            println!("{u_hint}: tangents {}, aspect {ratio}", frame.tan_half);
+            assert!(frame.tan_half.max_element() <= MAX_HALF_ANGLE_TANGENT, "{u_hint}: {}", frame.tan_half);
+            assert!((1.0..=MAX_FRAME_ASPECT * 1.001).contains(&ratio), "{u_hint}: aspect {ratio}");
+        }
+    }
+
     #[test]
     fn a_tile_frame_maps_its_rectangle_onto_the_viewport() {
         let scene = builtin("parallel-square").unwrap().build();
