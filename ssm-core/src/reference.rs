@@ -683,6 +683,9 @@ impl GroundTruth {
         let mut rays = 2 * u64::from(n * n);
         let mut sets = [0.0f32; 2];
         let mut recent = RecentBlockers::default();
+        let (mut jitter, mut candidates) = (Vec::new(), Vec::new());
+        let offset = point.normal * self.surface_offset;
+        let origins = [point.position + offset, point.position - offset];
         for (k, set) in sets.iter_mut().enumerate() {
             if refine == 1 {
                 *set = visible_fraction(&strata[k]);
@@ -698,27 +701,42 @@ impl GroundTruth {
                 }
                 rays += u64::from(refine * refine - 1);
                 let mut sub_rng = SplitMix64::for_pixel(refine_seeds[k], index as u64);
-                let jitter: Vec<Vec2> = (0..refine * refine).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())).collect();
+                jitter.clear();
+                jitter.extend((0..refine * refine).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())));
                 let window = Window::LIGHT.stratum(index as u32, n);
                 let list = lists.get(stratum_list[index] as usize).map(Vec::as_slice);
                 let open = if shortcuts {
-                    // The stratum exactly, from the area its few triangles cover; else as a light
-                    // of its own, M×M strata, through the same shortcuts, from the triangles its
-                    // rays were tested against (or, without a list, the BVH, as its rays were).
-                    let mut sub = self.sub_rays(light, point, refine, window, jitter, std::mem::take(&mut recent));
-                    let origin = sub.origins[usize::from(!sub.in_front(light.point(window.min.x, window.min.y)))];
-                    let visible = match list.and_then(|list| self.exact_stratum(&sub, origin, window, list)) {
-                        Some(visible) => {
-                            rays -= u64::from(refine * refine - 1);
-                            visible
+                    // The stratum exactly, from the area its few triangles cover; else M×M rays
+                    // against the triangles its ray was tested against (those of its part of the
+                    // light that can cross its own pyramid), or without a list through the BVH,
+                    // as its ray went.
+                    match list {
+                        Some(list) => {
+                            // A stratum with a list lies on one side of the tangent plane.
+                            let origin =
+                                origins[usize::from(point.normal.dot(light.point(window.min.x, window.min.y) - point.position) < 0.0)];
+                            let candidates = self.stratum_candidates(light, origin, window, list, &mut candidates);
+                            if candidates.len() <= EXACT_CANDIDATES {
+                                rays -= u64::from(refine * refine - 1);
+                                self.exact_coverage(light, origin, window, candidates)
+                            } else {
+                                let visible = (0..refine * refine).filter(|cell| {
+                                    let at = window
+                                        .at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
+                                    !self.blocked_by(origin, light.point(at.x, at.y), candidates)
+                                });
+                                visible.count() as f32 / (refine * refine) as f32
+                            }
                         }
                         None => {
-                            self.count_visible(&mut sub, [0, refine, 0, refine], list, 1, false);
-                            visible_fraction(&sub.strata[0])
+                            let visible = (0..refine * refine).filter(|cell| {
+                                let at =
+                                    window.at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
+                                self.light_sample_visible(light, point, at, Some(&mut recent))
+                            });
+                            visible.count() as f32 / (refine * refine) as f32
                         }
-                    };
-                    recent = sub.recent;
-                    visible
+                    }
                 } else {
                     let visible = (0..refine * refine).filter(|cell| {
                         let at = window.at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
@@ -781,44 +799,55 @@ impl GroundTruth {
         rays
     }
 
-    /// The exact visible fraction of the part `stratum` of the light seen from `origin`, when the
-    /// pyramid from `origin` to that part holds at most [`EXACT_CANDIDATES`] of `candidates`
-    /// (every triangle a ray into the enclosing part can cross): 1 less the share of the stratum
-    /// their central projection onto the light's plane covers ([`coverage::covered_share`]).
-    /// `None` with more, or for a degenerate pyramid.
-    fn exact_stratum(&self, rays: &PixelRays<'_>, origin: Vec3, stratum: Window, candidates: &[u32]) -> Option<f32> {
-        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
-        let corners = [
-            rays.light.point(min.x, min.y),
-            rays.light.point(max.x, min.y),
-            rays.light.point(max.x, max.y),
-            rays.light.point(min.x, max.y),
-        ];
-        let pyramid = Pyramid::new(origin, corners, rays.light)?;
-        let mut inside = candidates.iter().filter(|slot| self.may_cross(**slot, &pyramid));
-        let found: [Option<&u32>; EXACT_CANDIDATES + 1] = std::array::from_fn(|_| inside.next());
-        if found[EXACT_CANDIDATES].is_some() {
-            return None;
+    /// The triangles of `list` (every triangle a ray into an enclosing part of the light can
+    /// cross) that can cross a ray from `origin` into the part `stratum`: `list` itself when it
+    /// holds at most [`EXACT_CANDIDATES`], else those that meet the stratum's pyramid, in `found`.
+    fn stratum_candidates<'l>(
+        &self,
+        light: &RectLight,
+        origin: Vec3,
+        stratum: Window,
+        list: &'l [u32],
+        found: &'l mut Vec<u32>,
+    ) -> &'l [u32] {
+        if list.len() <= EXACT_CANDIDATES {
+            return list;
         }
-        let triangles: Vec<[Vec3; 3]> = found
+        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
+        let corners = [light.point(min.x, min.y), light.point(max.x, min.y), light.point(max.x, max.y), light.point(min.x, max.y)];
+        match Pyramid::new(origin, corners, light) {
+            Some(pyramid) => {
+                found.clear();
+                found.extend(list.iter().copied().filter(|slot| self.may_cross(*slot, &pyramid)));
+                found
+            }
+            None => list,
+        }
+    }
+
+    /// The exact visible fraction of the part `stratum` of the light seen from `origin`, hidden
+    /// only by `triangles` (at most [`EXACT_CANDIDATES`], BVH slots): 1 less the share of the
+    /// stratum their central projection onto the light's plane covers ([`coverage::covered_share`]).
+    fn exact_coverage(&self, light: &RectLight, origin: Vec3, stratum: Window, triangles: &[u32]) -> f32 {
+        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
+        let corners: Vec<[Vec3; 3]> = triangles
             .iter()
-            .flatten()
             .map(|slot| {
-                let triangle = &self.triangles[self.bvh.primitive_indices[**slot as usize] as usize];
+                let triangle = &self.triangles[self.bvh.primitive_indices[*slot as usize] as usize];
                 [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
             })
             .collect();
         // Within rounding of all or nothing (two triangles sharing an edge, each clipped on its
-        // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and lit
-        // stay exact, at a cost of at most 1e-5 of a stratum.
-        let visible = 1.0 - coverage::covered_share(rays.light, origin, &triangles, [min, max]);
-        Some(if visible < COVERAGE_SNAP {
+        // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and
+        // lit stay exact, at a cost of at most 1e-5 of a stratum.
+        let visible = 1.0 - coverage::covered_share(light, origin, &corners, [min, max]);
+        if visible < COVERAGE_SNAP {
             0.0
         } else if visible > 1.0 - COVERAGE_SNAP {
             1.0
         } else {
             visible as f32
-        })
+        }
     }
 
     /// The rays of one set of N×N strata over `window` of the light from `point`, with `jitter`
