@@ -794,10 +794,10 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
 ];
 
-/// The registration.
 /// Why a light 1000 times longer than wide is beyond the method (the extremes matrix's tube cases).
 const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis";
 
+/// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
     summary: "separable soft shadow mapping: separable blocker search reusing rows (α) and separable screen-space blur (β)",
