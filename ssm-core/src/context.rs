@@ -194,14 +194,7 @@ impl GpuContext {
         key: &str,
         build: impl FnOnce(&Self) -> crate::Result<wgpu::RenderPipeline>,
     ) -> crate::Result<wgpu::RenderPipeline> {
-        if let Some(pipeline) = self.shared.render_pipelines.lock().ok().and_then(|cache| cache.get(key).cloned()) {
-            return Ok(pipeline);
-        }
-        let pipeline = build(self)?;
-        if let Ok(mut cache) = self.shared.render_pipelines.lock() {
-            cache.insert(key.to_owned(), pipeline.clone());
-        }
-        Ok(pipeline)
+        self.cached(&self.shared.render_pipelines, key, build)
     }
 
     /// The compute pipeline cached under `key`, built by `build` the first time it is asked for
@@ -215,11 +208,22 @@ impl GpuContext {
         key: &str,
         build: impl FnOnce(&Self) -> crate::Result<wgpu::ComputePipeline>,
     ) -> crate::Result<wgpu::ComputePipeline> {
-        if let Some(pipeline) = self.shared.compute_pipelines.lock().ok().and_then(|cache| cache.get(key).cloned()) {
+        self.cached(&self.shared.compute_pipelines, key, build)
+    }
+
+    /// The pipeline cached in `cache` under `key`, built by `build` the first time (a cache that
+    /// cannot be locked is passed by: the pipeline is built and not kept).
+    fn cached<P: Clone>(
+        &self,
+        cache: &Mutex<HashMap<String, P>>,
+        key: &str,
+        build: impl FnOnce(&Self) -> crate::Result<P>,
+    ) -> crate::Result<P> {
+        if let Some(pipeline) = cache.lock().ok().and_then(|cache| cache.get(key).cloned()) {
             return Ok(pipeline);
         }
         let pipeline = build(self)?;
-        if let Ok(mut cache) = self.shared.compute_pipelines.lock() {
+        if let Ok(mut cache) = cache.lock() {
             cache.insert(key.to_owned(), pipeline.clone());
         }
         Ok(pipeline)
