@@ -653,7 +653,7 @@ impl GroundTruth {
     /// then refined where the visibility varies across the light: a stratum whose result in the
     /// other set differs from one of its four neighbours' (an edge of the visible region crosses
     /// it or passes near) is decided exactly when at most two triangles can block its rays (the
-    /// area their projection covers, [`coverage`]), and otherwise gets `refine`² fresh jittered
+    /// area their projection covers, `reference/coverage.rs`), and otherwise gets `refine`² fresh jittered
     /// rays in sub-strata instead of its one.
     /// Each set is unbiased, since which strata it refines depends only on the other set's rays;
     /// the estimate is (A + B)/2 and its noise |A − B|/2, whose mean over pixels estimates the
