@@ -81,6 +81,21 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     ("pvsm", "thin bars under a near-point light", "worse than a hard shadow"),
     ("sssm", "thin bars under a near-point light", "no better than a hard shadow: both blurs skipped under half a pixel"),
     ("vssm", "thin bars under a near-point light", "worse than a hard shadow"),
+    // Interiors.
+    (
+        "pvsm",
+        "room lit from a wall over a table",
+        "the blocker search falls back on the coarse map's nearest depths, the walls beside the light",
+    ),
+    (
+        "pvsm",
+        "corridor lit from its ceiling",
+        "the blocker search falls back on the coarse map's nearest depths, the walls beside the light",
+    ),
+    ("atty", "room lit from a wall over a table", "no better than a hard shadow in a room lit from a wall"),
+    ("atty", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
+    ("pcss", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
+    ("sssm", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
     // Each to investigate.
     ("sssm", "light far larger than the occluder", "error just above the bound where either shadows"),
     ("atty", "three lights", "error far above the other techniques' on three lights"),
@@ -288,6 +303,35 @@ fn extreme_cases() -> Vec<Case> {
              [[light]]\ncentre = [0.3, 2.7, -0.2]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.8, 0.6]\n\
              [[object]]\nprimitive = \"box\"\nsize = [8.0, 3.0, 8.0]\ntranslate = [0.0, 1.5, 0.0]\nrole = \"both\"\n\
              [[object]]\nprimitive = \"box\"\nsize = [1.0, 0.8, 1.0]\ntranslate = [0.5, 0.4, -0.5]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    // Interiors, the camera inside: a closed room lit from a wall over a table (the light's normal
+    // tilted down, so the floor and the wall beside the light lie near 90 degrees off it), and a
+    // closed corridor lit from its ceiling with a block on its floor.
+    cases.push(case(
+        "room lit from a wall over a table",
+        from_manifest(
+            "wall-lit-room",
+            "[camera]\nposition = [2.5, 1.7, 2.5]\ntarget = [-1.0, 0.5, -1.0]\n\
+             [[light]]\ncentre = [-3.9, 2.0, 0.0]\nnormal = [1.0, -0.3, 0.0]\nsize = [0.6, 0.6]\n\
+             [[object]]\nprimitive = \"box\"\nsize = [8.0, 3.0, 8.0]\ntranslate = [0.0, 1.5, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [1.6, 0.08, 1.0]\ntranslate = [-1.2, 0.8, -0.4]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.1, 0.76, 0.1]\ntranslate = [-1.9, 0.38, -0.8]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.1, 0.76, 0.1]\ntranslate = [-0.5, 0.38, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"sphere\"\nsize = [0.4]\ntranslate = [0.5, 0.4, -1.5]\nrole = \"both\"\n",
+        ),
+        Expect::Bound,
+    ));
+    cases.push(case(
+        "corridor lit from its ceiling",
+        from_manifest(
+            "corridor",
+            "[camera]\nposition = [0.0, 1.6, 4.5]\ntarget = [0.0, 0.6, -3.0]\n\
+             [[light]]\ncentre = [0.0, 2.45, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.5, 1.2]\n\
+             [[object]]\nprimitive = \"box\"\nsize = [2.0, 2.5, 10.0]\ntranslate = [0.0, 1.25, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"box\"\nsize = [0.6, 0.9, 0.6]\ntranslate = [0.3, 0.45, -1.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"sphere\"\nsize = [0.3]\ntranslate = [-0.5, 0.3, 1.2]\nrole = \"both\"\n",
         ),
         Expect::Bound,
     ));
