@@ -183,7 +183,7 @@ impl Window {
 }
 
 /// Most triangles in a stratum's pyramid whose covered area [`coverage`] computes exactly.
-const EXACT_CANDIDATES: usize = 2;
+const EXACT_CANDIDATES: usize = 4;
 /// An exactly computed visible fraction this close to 0 or 1 is rounding: it is snapped.
 const COVERAGE_SNAP: f64 = 1e-5;
 /// No candidate list: [`PixelRays::stratum_list`] of a stratum whose rays go through the BVH.
@@ -652,7 +652,7 @@ impl GroundTruth {
     /// Two independent stratified sets of `samples_per_axis`² jittered rays, A and B. Each set is
     /// then refined where the visibility varies across the light: a stratum whose result in the
     /// other set differs from one of its four neighbours' (an edge of the visible region crosses
-    /// it or passes near) is decided exactly when at most two triangles can block its rays (the
+    /// it or passes near) is decided exactly when at most four triangles can block its rays (the
     /// area their projection covers, `reference/coverage.rs`), and otherwise gets `refine`² fresh jittered
     /// rays in sub-strata instead of its one.
     /// Each set is unbiased, since which strata it refines depends only on the other set's rays;

@@ -2,14 +2,14 @@
 //! triangle's central projection from the point onto the light's plane is a convex polygon (the
 //! triangle first cut to the slab between the point's plane and the light's, parallel to the
 //! light, where a segment from the point to the light can meet it), and the share is the area of
-//! their union inside the rectangle. One or two triangles: the union by inclusion–exclusion. In
+//! their union inside the rectangle, by inclusion–exclusion over the triangles' subsets. In
 //! f64, so that a corner near the point's plane, which projects far away, keeps its precision.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use ssm_scene::RectLight;
 
 /// Share of `rect` (light coordinates: [-1, 1]² is the whole light, `[min, max]`) hidden from
-/// `origin` by the union of `triangles` (at most two), in [0, 1]. `origin` must be in front of
+/// `origin` by the union of `triangles` (a few: inclusion–exclusion visits every subset), in [0, 1]. `origin` must be in front of
 /// the light (positive distance along its normal).
 pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
     let rect = [min.as_dvec2(), max.as_dvec2()];
@@ -17,13 +17,21 @@ pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3;
     if area <= 0.0 {
         return 0.0;
     }
-    let clipped: Vec<Vec<DVec2>> = triangles.iter().map(|t| clip_to_rect(&project(light, origin, t), rect)).collect();
-    let covered = match clipped.as_slice() {
-        [] => 0.0,
-        [a] => polygon_area(a),
-        [a, b] => polygon_area(a) + polygon_area(b) - polygon_area(&clip_convex(a, b)),
-        _ => unreachable!("at most two triangles"),
-    };
+    let clipped: Vec<Vec<DVec2>> =
+        triangles.iter().map(|t| clip_to_rect(&project(light, origin, t), rect)).filter(|polygon| polygon.len() >= 3).collect();
+    // Inclusion–exclusion over every non-empty subset: the area of its polygons' intersection,
+    // added for an odd count and taken away for an even one.
+    let mut covered = 0.0;
+    for subset in 1u32..(1 << clipped.len()) {
+        let mut members = (0..clipped.len()).filter(|k| subset & (1 << k) != 0);
+        let Some(first) = members.next() else { continue };
+        let mut common = clipped[first].clone();
+        for k in members {
+            common = clip_convex(&common, &clipped[k]);
+        }
+        let sign = if subset.count_ones() % 2 == 1 { 1.0 } else { -1.0 };
+        covered += sign * polygon_area(&common);
+    }
     (covered / area).clamp(0.0, 1.0)
 }
 
@@ -174,7 +182,7 @@ mod tests {
         (*state >> 40) as f32 / (1u64 << 24) as f32
     }
 
-    /// On random triangles (one or two, some crossing the light's plane or the point's), seen from
+    /// On random triangles (one to four, some crossing the light's plane or the point's), seen from
     /// random points through random parts of the light, the exact share matches the share of a
     /// 400² grid of rays within the grid's resolution.
     #[test]
@@ -185,7 +193,7 @@ mod tests {
         for case in 0..300 {
             let point = |state: &mut u64| Vec3::new(random(state) * 4.0 - 2.0, random(state) * 5.0 - 0.5, random(state) * 4.0 - 2.0);
             let origin = Vec3::new(point(&mut state).x * 0.3, -1.0 + random(&mut state) * 0.5, point(&mut state).z * 0.3);
-            let triangles: Vec<[Vec3; 3]> = (0..1 + case % 2).map(|_| [point(&mut state), point(&mut state), point(&mut state)]).collect();
+            let triangles: Vec<[Vec3; 3]> = (0..1 + case % 4).map(|_| [point(&mut state), point(&mut state), point(&mut state)]).collect();
             let corner = Vec2::new(random(&mut state), random(&mut state)) * 2.0 - Vec2::ONE;
             let size = 0.1 + random(&mut state);
             let rect = [corner, (corner + Vec2::splat(size)).min(Vec2::ONE)];
