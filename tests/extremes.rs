@@ -75,7 +75,6 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     ("vssm", "light resting on the receiver", "no texel past the frame's widest angle"),
     // Under a near-point light the penumbra is a pixel or two wide: these blur or alias it more
     // than a hard shadow errs by (to investigate: minimum filter sizes, map resolution).
-    ("atty", "thin bars under a near-point light", "no better than a hard shadow"),
     ("multi-sm", "thin bars under a near-point light", "worse than a hard shadow"),
     ("pcss", "thin bars under a near-point light", "worse than a hard shadow"),
     ("pvsm", "thin bars under a near-point light", "worse than a hard shadow"),

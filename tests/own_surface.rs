@@ -241,7 +241,7 @@ const RERENDER_TOLERANCE: f32 = 1e-5;
 
 /// On a sphere and a turned box standing alone under a large light, the pixels where the light
 /// straddles the surface's tangent plane: every technique that samples the light from its centre
-/// is within 0.05 of the truth there (0.33–0.38 before the share, issue 47), on each object, and
+/// is within 0.05 of the truth there (0.33–0.38 before the share), on each object, and
 /// multi-sm, which renders a map per light sample, is within 0.05 and left unchanged (not charged
 /// twice).
 #[test]

@@ -4,7 +4,7 @@
 //! On a closed mesh, where the light straddles the surface's tangent plane, the solid hides the
 //! part of the light behind that plane: the ground truth counts it (its rays that leave behind
 //! the plane are blocked), but a map seen from the light's centre cannot, and every single-centre
-//! technique was off by the same 0.33–0.38 there (issue 47). The share in front of the plane is
+//! technique was off by the same 0.33–0.38 there. The share in front of the plane is
 //! known in closed form from the light's rectangle and the plane
 //! (`light_share_in_front` in `shaders/common/light_frame.wgsl`), so the framework answers it for
 //! every such technique alike, in one compute pass per light after the technique's
