@@ -132,7 +132,8 @@ pub fn output_requirements() -> Requirements {
     Requirements { gbuffer: true, ..Requirements::NONE }
 }
 
-/// What the renderer must build for `techniques` (the union of their requirements) and for the
+/// What the renderer must build for `techniques` (the union of what each needs, the framework's
+/// own-surface share included: `TechniqueInfo::needs`) and for the
 /// outputs every command reads ([`output_requirements`]).
 ///
 /// # Errors
@@ -140,7 +141,7 @@ pub fn output_requirements() -> Requirements {
 pub fn requirements_of<'a>(techniques: impl IntoIterator<Item = (&'a TechniqueInfo, &'a ParamValues)>) -> ssm_core::Result<Requirements> {
     let mut needs = output_requirements();
     for (info, params) in techniques {
-        needs = needs.union((info.requirements)(params)?);
+        needs = needs.union(info.needs(params)?);
     }
     Ok(needs)
 }
