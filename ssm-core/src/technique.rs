@@ -239,7 +239,7 @@ pub struct Preset {
 }
 
 impl Preset {
-    /// A preset with the usual axes (time against penumbra error, all pixels); set
+    /// A preset with the usual axes (time against the headline error, all pixels); set
     /// the other fields with struct update syntax.
     pub const DEFAULT: Self =
         Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae", pixels: "all", size: None };

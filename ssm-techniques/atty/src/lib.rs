@@ -980,6 +980,10 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     limits: &[],
 };
 
+/// The error Atty et al.'s figures plot (Sec. 5.2.1): the mean absolute error over the pixels in
+/// umbra or penumbra in the ground truth, not the workspace's headline error.
+const PAPER_ERROR: &str = "mae-penumbra";
+
 /// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps.
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
@@ -988,6 +992,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
         x_axis: "atty.occluder_map_size",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
@@ -1006,6 +1011,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255"],
         x_axis: "scene.light_scale",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
@@ -1015,6 +1021,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
         x_axis: "scene.occluder_lift",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
@@ -1024,6 +1031,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.occluder_shift=-1,-0.5,-0.25,0,0.25,0.5,1", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
         x_axis: "scene.occluder_shift",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
@@ -1033,6 +1041,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.segments:rings=4:3,16:8,64:32,256:128,512:256", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
         x_axis: "scene.segments",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
@@ -1042,6 +1051,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         scenes: &["floating-sphere"],
         varies: &["scene.light_scale=1,2,3,4", "atty.occluder_map_size=32,64,128", "atty.two_sided=true"],
         x_axis: "scene.light_scale",
+        y_axis: PAPER_ERROR,
         pixels: "receivers",
         ..ssm_core::Preset::DEFAULT
     },
