@@ -138,9 +138,6 @@ struct PixelRays<'a> {
     /// The point is on a closed mesh: samples behind its tangent plane are blocked.
     closed: bool,
     n: u32,
-    /// The part of the light the N×N strata divide: the whole light, or one stratum of a coarser
-    /// grid being refined.
-    window: Window,
     /// Per set of rays, the jitter of stratum (i, j) at j·n + i. The sets share the pyramids and
     /// their triangles, which do not depend on the jitter.
     jitter: Vec<Vec<Vec2>>,
@@ -157,7 +154,8 @@ struct PixelRays<'a> {
     lists: Vec<Vec<u32>>,
 }
 
-/// A square part of the light in its coordinates ([-1, 1]² is the whole light).
+/// A square part of the light in its coordinates ([-1, 1]² is the whole light): the light, or one
+/// of its strata being refined.
 #[derive(Clone, Copy)]
 struct Window {
     min: Vec2,
@@ -174,11 +172,21 @@ impl Window {
         cell / n as f32 * self.size + self.min
     }
 
-    /// The corner of stratum `index` (in the j·n + i order) of an N×N grid over this window, and
-    /// the stratum as a window of its own.
+    /// Stratum `index` (in the j·n + i order) of an N×N grid over this window, as a window of its own.
     fn stratum(self, index: u32, n: u32) -> Self {
         let step = self.size / n as f32;
         Self { min: Vec2::new((index % n) as f32, (index / n) as f32) * step + self.min, size: step }
+    }
+
+    /// Its corners, in order around it.
+    fn corners(self, light: &RectLight) -> [Vec3; 4] {
+        let (min, max) = (self.min, self.min + Vec2::splat(self.size));
+        [light.point(min.x, min.y), light.point(max.x, min.y), light.point(max.x, max.y), light.point(min.x, max.y)]
+    }
+
+    /// The points of an M×M grid over it, cell (a, b) moved by `jitter[b·m + a]` (in cell units).
+    fn jittered(self, jitter: &[Vec2], m: u32) -> impl Iterator<Item = Vec2> + '_ {
+        (0..m * m).map(move |cell| self.at(Vec2::new((cell % m) as f32, (cell / m) as f32) + jitter[cell as usize], m))
     }
 }
 
@@ -197,7 +205,7 @@ impl PixelRays<'_> {
 
     /// The light sample of stratum (i, j) of set `set`, as visibility_per_ray places it.
     fn sample(&self, set: usize, i: u32, j: u32) -> Vec3 {
-        let at = self.window.at(Vec2::new(i as f32, j as f32) + self.jitter[set][(j * self.n + i) as usize], self.n);
+        let at = Window::LIGHT.at(Vec2::new(i as f32, j as f32) + self.jitter[set][(j * self.n + i) as usize], self.n);
         self.light.point(at.x, at.y)
     }
 
@@ -680,12 +688,12 @@ impl GroundTruth {
             }
         };
         let refine = if point.footprint.is_some() { 1 } else { sampling.refine.max(1) };
+        let sub_rays = refine * refine;
         let mut rays = 2 * u64::from(n * n);
         let mut sets = [0.0f32; 2];
         let mut recent = RecentBlockers::default();
         let (mut jitter, mut candidates) = (Vec::new(), Vec::new());
-        let offset = point.normal * self.surface_offset;
-        let origins = [point.position + offset, point.position - offset];
+        let origins = self.origins(point);
         for (k, set) in sets.iter_mut().enumerate() {
             if refine == 1 {
                 *set = visible_fraction(&strata[k]);
@@ -699,52 +707,38 @@ impl GroundTruth {
                     sum += value;
                     continue;
                 }
-                rays += u64::from(refine * refine - 1);
+                let window = Window::LIGHT.stratum(index as u32, n);
+                let list = lists.get(stratum_list[index] as usize);
+                // The stratum exactly, from the area its few triangles cover; else M×M rays
+                // against the triangles its ray was tested against (those that can cross its own
+                // pyramid), or, without a list, through the BVH as its ray went.
+                let (exact_value, candidates) = match list {
+                    Some(list) => {
+                        // A stratum with a list lies on one side of the tangent plane.
+                        let origin = origins[usize::from(point.normal.dot(light.point(window.min.x, window.min.y) - point.position) < 0.0)];
+                        let candidates = self.stratum_candidates(light, origin, window, list, &mut candidates);
+                        let exact_value =
+                            (candidates.len() <= EXACT_CANDIDATES).then(|| self.exact_coverage(light, origin, window, candidates));
+                        (exact_value, Some((origin, candidates)))
+                    }
+                    None => (None, None),
+                };
+                if let Some(value) = exact_value {
+                    sum += value;
+                    continue;
+                }
+                rays += u64::from(sub_rays - 1);
                 let mut sub_rng = SplitMix64::for_pixel(refine_seeds[k], index as u64);
                 jitter.clear();
-                jitter.extend((0..refine * refine).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())));
-                let window = Window::LIGHT.stratum(index as u32, n);
-                let list = lists.get(stratum_list[index] as usize).map(Vec::as_slice);
-                let open = if shortcuts {
-                    // The stratum exactly, from the area its few triangles cover; else M×M rays
-                    // against the triangles its ray was tested against (those of its part of the
-                    // light that can cross its own pyramid), or without a list through the BVH,
-                    // as its ray went.
-                    match list {
-                        Some(list) => {
-                            // A stratum with a list lies on one side of the tangent plane.
-                            let origin =
-                                origins[usize::from(point.normal.dot(light.point(window.min.x, window.min.y) - point.position) < 0.0)];
-                            let candidates = self.stratum_candidates(light, origin, window, list, &mut candidates);
-                            if candidates.len() <= EXACT_CANDIDATES {
-                                rays -= u64::from(refine * refine - 1);
-                                self.exact_coverage(light, origin, window, candidates)
-                            } else {
-                                let visible = (0..refine * refine).filter(|cell| {
-                                    let at = window
-                                        .at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
-                                    !self.blocked_by(origin, light.point(at.x, at.y), candidates)
-                                });
-                                visible.count() as f32 / (refine * refine) as f32
-                            }
-                        }
-                        None => {
-                            let visible = (0..refine * refine).filter(|cell| {
-                                let at =
-                                    window.at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
-                                self.light_sample_visible(light, point, at, Some(&mut recent))
-                            });
-                            visible.count() as f32 / (refine * refine) as f32
-                        }
-                    }
-                } else {
-                    let visible = (0..refine * refine).filter(|cell| {
-                        let at = window.at(Vec2::new((cell % refine) as f32, (cell / refine) as f32) + jitter[*cell as usize], refine);
-                        self.light_sample_visible(light, point, at, None)
-                    });
-                    visible.count() as f32 / (refine * refine) as f32
-                };
-                sum += open;
+                jitter.extend((0..sub_rays).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())));
+                let visible = window
+                    .jittered(&jitter, refine)
+                    .filter(|at| match candidates {
+                        Some((origin, candidates)) => !self.blocked_by(origin, light.point(at.x, at.y), candidates),
+                        None => self.light_sample_visible(light, point, *at, shortcuts.then_some(&mut recent)),
+                    })
+                    .count();
+                sum += visible as f32 / sub_rays as f32;
             }
             *set = sum / (n * n) as f32;
         }
@@ -756,11 +750,11 @@ impl GroundTruth {
     /// footprint; with `recent`, the pixel's last blockers are tried first (the same answer).
     fn light_sample_visible(&self, light: &RectLight, point: &SurfacePoint, at: Vec2, recent: Option<&mut RecentBlockers>) -> bool {
         let sample = light.point(at.x, at.y);
-        let side = if point.normal.dot(sample - point.position) >= 0.0 { 1.0 } else { -1.0 };
-        if point.closed && side < 0.0 {
+        let front = point.normal.dot(sample - point.position) >= 0.0;
+        if point.closed && !front {
             return false;
         }
-        let origin = point.position + point.normal * (side * self.surface_offset);
+        let origin = self.origins(point)[usize::from(!front)];
         match recent {
             Some(recent) => !self.blocked_remembering(origin, sample, recent),
             None => self.unoccluded(origin, sample),
@@ -785,8 +779,20 @@ impl GroundTruth {
     /// per generator of `rngs`, each drawing its jitter as visibility_per_ray does; the sets share
     /// the gathers.
     fn pyramid_visibility<'a>(&self, light: &'a RectLight, point: &SurfacePoint, n: u32, rngs: &mut [SplitMix64]) -> PixelRays<'a> {
-        let mut rays = self.sub_rays(light, point, n, Window::LIGHT, Vec::new(), RecentBlockers::default());
-        rays.strata = vec![vec![0.0; (n * n) as usize]; rngs.len()];
+        let count = (n * n) as usize;
+        let mut rays = PixelRays {
+            light,
+            origins: self.origins(point),
+            plane: (point.position, point.normal),
+            closed: point.closed,
+            n,
+            jitter: Vec::new(),
+            recent: RecentBlockers::default(),
+            strata: vec![vec![0.0; count]; rngs.len()],
+            exact: vec![false; count],
+            stratum_list: vec![NO_LIST; count],
+            lists: Vec::new(),
+        };
         if light.is_point() {
             let front = rays.in_front(light.centre);
             let open = (front || !point.closed) && self.unoccluded(rays.origins[usize::from(!front)], light.centre);
@@ -797,6 +803,13 @@ impl GroundTruth {
         rays.jitter = rngs.iter_mut().map(|rng| (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()).collect();
         self.count_visible(&mut rays, [0, n, 0, n], None, 0, true);
         rays
+    }
+
+    /// The ray origins off `point`'s surface: for light samples in front of its tangent plane
+    /// (offset along the normal) and behind it (against it).
+    fn origins(&self, point: &SurfacePoint) -> [Vec3; 2] {
+        let offset = point.normal * self.surface_offset;
+        [point.position + offset, point.position - offset]
     }
 
     /// The triangles of `list` (every triangle a ray into an enclosing part of the light can
@@ -813,9 +826,7 @@ impl GroundTruth {
         if list.len() <= EXACT_CANDIDATES {
             return list;
         }
-        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
-        let corners = [light.point(min.x, min.y), light.point(max.x, min.y), light.point(max.x, max.y), light.point(min.x, max.y)];
-        match Pyramid::new(origin, corners, light) {
+        match Pyramid::new(origin, stratum.corners(light), light) {
             Some(pyramid) => {
                 found.clear();
                 found.extend(list.iter().copied().filter(|slot| self.may_cross(*slot, &pyramid)));
@@ -825,18 +836,18 @@ impl GroundTruth {
         }
     }
 
+    /// The corners of the triangle in BVH slot `slot`.
+    fn triangle_of_slot(&self, slot: u32) -> [Vec3; 3] {
+        let triangle = &self.triangles[self.bvh.primitive_indices[slot as usize] as usize];
+        [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
+    }
+
     /// The exact visible fraction of the part `stratum` of the light seen from `origin`, hidden
     /// only by `triangles` (at most [`EXACT_CANDIDATES`], BVH slots): 1 less the share of the
     /// stratum their central projection onto the light's plane covers ([`coverage::covered_share`]).
     fn exact_coverage(&self, light: &RectLight, origin: Vec3, stratum: Window, triangles: &[u32]) -> f32 {
         let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
-        let corners: Vec<[Vec3; 3]> = triangles
-            .iter()
-            .map(|slot| {
-                let triangle = &self.triangles[self.bvh.primitive_indices[*slot as usize] as usize];
-                [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
-            })
-            .collect();
+        let corners: Vec<[Vec3; 3]> = triangles.iter().map(|slot| self.triangle_of_slot(*slot)).collect();
         // Within rounding of all or nothing (two triangles sharing an edge, each clipped on its
         // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and
         // lit stay exact, at a cost of at most 1e-5 of a stratum.
@@ -847,35 +858,6 @@ impl GroundTruth {
             1.0
         } else {
             visible as f32
-        }
-    }
-
-    /// The rays of one set of N×N strata over `window` of the light from `point`, with `jitter`
-    /// (empty: drawn later), for [`GroundTruth::count_visible`].
-    fn sub_rays<'a>(
-        &self,
-        light: &'a RectLight,
-        point: &SurfacePoint,
-        n: u32,
-        window: Window,
-        jitter: Vec<Vec2>,
-        recent: RecentBlockers,
-    ) -> PixelRays<'a> {
-        let offset = point.normal * self.surface_offset;
-        let count = (n * n) as usize;
-        PixelRays {
-            light,
-            origins: [point.position + offset, point.position - offset],
-            plane: (point.position, point.normal),
-            closed: point.closed,
-            n,
-            window,
-            jitter: vec![jitter],
-            recent,
-            strata: vec![vec![0.0; count]],
-            exact: vec![false; count],
-            stratum_list: vec![NO_LIST; count],
-            lists: Vec::new(),
         }
     }
 
@@ -892,8 +874,8 @@ impl GroundTruth {
         if strata == 0 {
             return;
         }
-        let (scale, min) = (rays.window.size / rays.n as f32, rays.window.min);
-        let (s0, s1, t0, t1) = (i0 as f32 * scale + min.x, i1 as f32 * scale + min.x, j0 as f32 * scale + min.y, j1 as f32 * scale + min.y);
+        let scale = 2.0 / rays.n as f32;
+        let (s0, s1, t0, t1) = (i0 as f32 * scale - 1.0, i1 as f32 * scale - 1.0, j0 as f32 * scale - 1.0, j1 as f32 * scale - 1.0);
         let corners = [rays.light.point(s0, t0), rays.light.point(s1, t0), rays.light.point(s1, t1), rays.light.point(s0, t1)];
         // The side of the tangent plane is affine in the sample, so the corners decide a part's.
         let front = rays.in_front(corners[0]);
