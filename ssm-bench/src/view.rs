@@ -194,7 +194,7 @@ struct TruthLookup {
     cache: ReferenceCache,
     cache_dir: PathBuf,
     /// Per light, for the current camera: `None` when not cached.
-    images: Vec<Option<(Vec<f32>, Vec<f32>)>>,
+    images: Vec<Option<ssm_core::reference::ReferenceImage>>,
     covered: Vec<bool>,
 }
 
@@ -366,12 +366,7 @@ impl Live {
             .scene
             .light_frames
             .iter()
-            .map(|frame| {
-                self.truth
-                    .cache
-                    .cached(&frame.light, &points, sampling, seed, &self.truth.cache_dir)
-                    .map(|image| (image.visibility, image.noise))
-            })
+            .map(|frame| self.truth.cache.cached(&frame.light, &points, sampling, seed, &self.truth.cache_dir))
             .collect();
         Ok(())
     }
@@ -566,7 +561,7 @@ impl Live {
         let (width, height) = (self.renderer.width(), self.renderer.height());
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         let image = visibility.get(self.light).map_or(&[][..], Vec::as_slice);
-        let truth = self.truth.images.get(self.light).and_then(Option::as_ref).map(|(truth, _)| truth.as_slice());
+        let truth = self.truth.images.get(self.light).and_then(Option::as_ref).map(|truth| truth.visibility.as_slice());
         let (mode, rgba): (ViewMode, Vec<u8>) = match (self.mode, truth) {
             (ViewMode::Shaded, _) => {
                 match self.renderer.shade_on_gpu() {
@@ -613,9 +608,9 @@ impl Live {
             .iter()
             .zip(visibility)
             .filter_map(|(truth, image)| {
-                truth
-                    .as_ref()
-                    .map(|(truth, noise)| metrics::compare_with_noise(truth, Some(noise), image, &self.truth.covered, width, height))
+                truth.as_ref().map(|truth| {
+                    metrics::compare_with_noise(&truth.visibility, Some(&truth.noise), image, &self.truth.covered, width, height)
+                })
             })
             .collect();
         if !per_light.is_empty() {
