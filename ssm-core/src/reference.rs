@@ -847,11 +847,16 @@ impl GroundTruth {
     /// stratum their central projection onto the light's plane covers ([`coverage::covered_share`]).
     fn exact_coverage(&self, light: &RectLight, origin: Vec3, stratum: Window, triangles: &[u32]) -> f32 {
         let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
-        let corners: Vec<[Vec3; 3]> = triangles.iter().map(|slot| self.triangle_of_slot(*slot)).collect();
+        debug_assert!(triangles.len() <= EXACT_CANDIDATES);
+        let mut corners = [[Vec3::ZERO; 3]; EXACT_CANDIDATES];
+        for (corner, slot) in corners.iter_mut().zip(triangles) {
+            *corner = self.triangle_of_slot(*slot);
+        }
+        let corners = &corners[..triangles.len().min(EXACT_CANDIDATES)];
         // Within rounding of all or nothing (two triangles sharing an edge, each clipped on its
         // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and
         // lit stay exact, at a cost of at most 1e-5 of a stratum.
-        let visible = 1.0 - coverage::covered_share(light, origin, &corners, [min, max]);
+        let visible = 1.0 - coverage::covered_share(light, origin, corners, [min, max]);
         if visible < COVERAGE_SNAP {
             0.0
         } else if visible > 1.0 - COVERAGE_SNAP {

@@ -4,70 +4,149 @@
 //! light, where a segment from the point to the light can meet it), and the share is the area of
 //! their union inside the rectangle, by inclusion–exclusion over the triangles' subsets. In
 //! f64, so that a corner near the point's plane, which projects far away, keeps its precision.
+//!
+//! The ground truth calls this for most refined strata, so nothing here allocates once a
+//! thread's buffers have grown ([`Scratch`]), and inclusion–exclusion walks the subsets depth
+//! first: a subset's intersection is its parent's clipped once more, and a subset whose
+//! intersection is empty (or whose bounding boxes are apart) drops every superset with it.
+
+use std::cell::RefCell;
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use ssm_scene::RectLight;
 
+/// A corner of a triangle being cut to the slab, and its fraction t of the way from the origin
+/// to the light's plane.
+type SlabPoint = (DVec3, f64);
+
+/// Buffers reused by every call on a thread.
+#[derive(Default)]
+struct Scratch {
+    slab: [Vec<SlabPoint>; 2],
+    /// The triangles' clipped projections (the first `count` of them are this call's).
+    polygons: Vec<Vec<DVec2>>,
+    /// The intersection of a subset of `polygons` at each depth of the walk.
+    levels: Vec<Vec<DVec2>>,
+    /// Each polygon's bounding box.
+    boxes: Vec<[DVec2; 2]>,
+    spare: Vec<DVec2>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
 /// Share of `rect` (light coordinates: [-1, 1]² is the whole light, `[min, max]`) hidden from
-/// `origin` by the union of `triangles` (a few: inclusion–exclusion visits every subset), in [0, 1]. `origin` must be in front of
-/// the light (positive distance along its normal).
+/// `origin` by the union of `triangles` (a few: inclusion–exclusion visits every subset whose
+/// intersection is not empty), in [0, 1]. `origin` must be in front of the light (positive
+/// distance along its normal).
 pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
     let rect = [min.as_dvec2(), max.as_dvec2()];
     let area = (rect[1].x - rect[0].x) * (rect[1].y - rect[0].y);
     if area <= 0.0 {
         return 0.0;
     }
-    let clipped: Vec<Vec<DVec2>> =
-        triangles.iter().map(|t| clip_to_rect(&project(light, origin, t), rect)).filter(|polygon| polygon.len() >= 3).collect();
-    // Inclusion–exclusion over every non-empty subset: the area of its polygons' intersection,
-    // added for an odd count and taken away for an even one.
-    let mut covered = 0.0;
-    for subset in 1u32..(1 << clipped.len()) {
-        let mut members = (0..clipped.len()).filter(|k| subset & (1 << k) != 0);
-        let Some(first) = members.next() else { continue };
-        let mut common = clipped[first].clone();
-        for k in members {
-            common = clip_convex(&common, &clipped[k]);
+    SCRATCH.with_borrow_mut(|scratch| {
+        let Scratch { slab, polygons, levels, boxes, spare } = scratch;
+        if polygons.len() < triangles.len() {
+            polygons.resize_with(triangles.len(), Vec::new);
         }
-        let sign = if subset.count_ones() % 2 == 1 { 1.0 } else { -1.0 };
-        covered += sign * polygon_area(&common);
+        if levels.len() < triangles.len() {
+            levels.resize_with(triangles.len(), Vec::new);
+        }
+        let mut count = 0;
+        for triangle in triangles {
+            let polygon = &mut polygons[count];
+            project(light, origin, triangle, slab, polygon);
+            clip_to_rect(polygon, spare, rect);
+            if polygon.len() >= 3 {
+                count += 1;
+            }
+        }
+        let polygons = &polygons[..count];
+        boxes.clear();
+        boxes.extend(polygons.iter().map(|polygon| bounding_box(polygon)));
+        // Inclusion–exclusion: the area of each non-empty subset's intersection, added for an
+        // odd count and taken away for an even one.
+        let mut covered = 0.0;
+        for (first, polygon) in polygons.iter().enumerate() {
+            covered += polygon_area(polygon);
+            covered += intersections_from(polygons, boxes, first + 1, polygon, boxes[first], 2, levels, spare);
+        }
+        (covered / area).clamp(0.0, 1.0)
+    })
+}
+
+/// The signed sum, over the subsets made of `common`'s polygons (`size` − 1 of them) and one or
+/// more of `polygons[start..]`, of their intersections' areas: + for an odd size, − for even.
+#[allow(clippy::too_many_arguments)]
+fn intersections_from(
+    polygons: &[Vec<DVec2>],
+    boxes: &[[DVec2; 2]],
+    start: usize,
+    common: &[DVec2],
+    common_box: [DVec2; 2],
+    size: u32,
+    levels: &mut [Vec<DVec2>],
+    spare: &mut Vec<DVec2>,
+) -> f64 {
+    let Some((level, deeper)) = levels.split_first_mut() else { return 0.0 };
+    let sign = if size % 2 == 1 { 1.0 } else { -1.0 };
+    let mut sum = 0.0;
+    for next in start..polygons.len() {
+        let other = boxes[next];
+        if other[0].cmpgt(common_box[1]).any() || common_box[0].cmpgt(other[1]).any() {
+            continue;
+        }
+        clip_convex(common, &polygons[next], level, spare);
+        if level.len() < 3 {
+            continue;
+        }
+        sum += sign * polygon_area(level);
+        if next + 1 < polygons.len() {
+            sum += intersections_from(polygons, boxes, next + 1, level, bounding_box(level), size + 1, deeper, spare);
+        }
     }
-    (covered / area).clamp(0.0, 1.0)
+    sum
+}
+
+/// The smallest axis-aligned box around `polygon`: [min, max].
+fn bounding_box(polygon: &[DVec2]) -> [DVec2; 2] {
+    polygon.iter().fold([DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)], |[min, max], p| [min.min(*p), max.max(*p)])
 }
 
 /// The central projection from `origin` onto the light's plane, in light coordinates (u / half
 /// width, v / half height), of the part of `triangle` strictly between the plane through `origin`
-/// parallel to the light and the light's own plane; empty when none of it is.
-fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3]) -> Vec<DVec2> {
+/// parallel to the light and the light's own plane, into `out`; empty when none of it is.
+fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3], [slab, cut]: &mut [Vec<SlabPoint>; 2], out: &mut Vec<DVec2>) {
+    out.clear();
     let (centre, normal) = (light.centre.as_dvec3(), light.normal().as_dvec3());
     let origin = origin.as_dvec3();
     let height = (origin - centre).dot(normal);
     if height <= 0.0 {
-        return Vec::new();
+        return;
     }
     // t: the fraction of the way from the origin to the light's plane (0 at the origin's plane).
     let t_of = |p: DVec3| 1.0 - (p - centre).dot(normal) / height;
     // A corner at t → 0 projects to infinity: keep t above a bound that leaves the projection in
     // f64's range and far outside any light (the rectangle clip removes it).
     const T_MIN: f64 = 1e-9;
-    let mut polygon: Vec<(DVec3, f64)> = triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))).collect();
-    polygon = clip_by(&polygon, |(_, t)| t - T_MIN);
-    polygon = clip_by(&polygon, |(_, t)| 1.0 - t);
+    slab.clear();
+    slab.extend(triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))));
+    clip_by(slab, |(_, t)| t - T_MIN, cut);
+    clip_by(cut, |(_, t)| 1.0 - t, slab);
     let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
     let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
-    polygon
-        .iter()
-        .map(|(p, t)| {
-            let on_light = origin + (*p - origin) / *t;
-            DVec2::new((on_light - centre).dot(u_axis) / half.x, (on_light - centre).dot(v_axis) / half.y)
-        })
-        .collect()
+    out.extend(slab.iter().map(|(p, t)| {
+        let on_light = origin + (*p - origin) / *t;
+        DVec2::new((on_light - centre).dot(u_axis) / half.x, (on_light - centre).dot(v_axis) / half.y)
+    }));
 }
 
-/// Sutherland–Hodgman against one half-space: keeps the part of `polygon` where `inside` ≥ 0
-/// (`inside` affine along edges), interpolating position and t.
-fn clip_by(polygon: &[(DVec3, f64)], inside: impl Fn(&(DVec3, f64)) -> f64) -> Vec<(DVec3, f64)> {
-    let mut out = Vec::with_capacity(polygon.len() + 1);
+/// Sutherland–Hodgman against one half-space: the part of `polygon` where `inside` ≥ 0
+/// (`inside` affine along edges) into `out`, interpolating position and t.
+fn clip_by(polygon: &[SlabPoint], inside: impl Fn(&SlabPoint) -> f64, out: &mut Vec<SlabPoint>) {
+    out.clear();
     for (k, current) in polygon.iter().enumerate() {
         let next = &polygon[(k + 1) % polygon.len()];
         let (a, b) = (inside(current), inside(next));
@@ -79,21 +158,19 @@ fn clip_by(polygon: &[(DVec3, f64)], inside: impl Fn(&(DVec3, f64)) -> f64) -> V
             out.push((current.0 + (next.0 - current.0) * s, current.1 + (next.1 - current.1) * s));
         }
     }
-    out
 }
 
-/// The part of `polygon` inside the rectangle `[min, max]`.
-fn clip_to_rect(polygon: &[DVec2], [min, max]: [DVec2; 2]) -> Vec<DVec2> {
-    let mut out = polygon.to_vec();
+/// `polygon` cut to the rectangle `[min, max]` in place (`spare`: a buffer).
+fn clip_to_rect(polygon: &mut Vec<DVec2>, spare: &mut Vec<DVec2>, [min, max]: [DVec2; 2]) {
     for (axis, bound, keep_above) in [(0, min.x, true), (0, max.x, false), (1, min.y, true), (1, max.y, false)] {
-        out = clip_2d(&out, |p| if keep_above { p[axis] - bound } else { bound - p[axis] });
+        clip_2d(polygon, |p| if keep_above { p[axis] - bound } else { bound - p[axis] }, spare);
+        std::mem::swap(polygon, spare);
     }
-    out
 }
 
-/// Sutherland–Hodgman in the plane: the part of `polygon` where `inside` ≥ 0.
-fn clip_2d(polygon: &[DVec2], inside: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
-    let mut out = Vec::with_capacity(polygon.len() + 1);
+/// Sutherland–Hodgman in the plane: the part of `polygon` where `inside` ≥ 0, into `out`.
+fn clip_2d(polygon: &[DVec2], inside: impl Fn(DVec2) -> f64, out: &mut Vec<DVec2>) {
+    out.clear();
     for (k, &current) in polygon.iter().enumerate() {
         let next = polygon[(k + 1) % polygon.len()];
         let (a, b) = (inside(current), inside(next));
@@ -104,28 +181,29 @@ fn clip_2d(polygon: &[DVec2], inside: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
             out.push(current + (next - current) * (a / (a - b)));
         }
     }
-    out
 }
 
-/// The part of convex `subject` inside convex `clip` (either winding).
-fn clip_convex(subject: &[DVec2], clip: &[DVec2]) -> Vec<DVec2> {
+/// The part of convex `subject` inside convex `clip` (either winding), into `out` (`spare`: a
+/// buffer).
+fn clip_convex(subject: &[DVec2], clip: &[DVec2], out: &mut Vec<DVec2>, spare: &mut Vec<DVec2>) {
+    out.clear();
     if clip.len() < 3 || subject.len() < 3 {
-        return Vec::new();
+        return;
     }
     let orientation = signed_area(clip).signum();
     if orientation == 0.0 {
-        return Vec::new();
+        return;
     }
-    let mut out = subject.to_vec();
+    out.extend_from_slice(subject);
     for (k, &a) in clip.iter().enumerate() {
         let b = clip[(k + 1) % clip.len()];
         let edge = b - a;
-        out = clip_2d(&out, |p| orientation * edge.perp_dot(p - a));
+        clip_2d(out, |p| orientation * edge.perp_dot(p - a), spare);
+        std::mem::swap(out, spare);
         if out.is_empty() {
             break;
         }
     }
-    out
 }
 
 /// Signed area (positive counter-clockwise).
