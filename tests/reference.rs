@@ -67,9 +67,10 @@ fn ray_caster_matches_the_analytic_parallel_square_within_the_sampling_error() {
 }
 
 /// The ground truth as traced (`reference` at its defaults, through the renderer): where the
-/// visibility varies, the square's two triangles are few enough in a stratum's pyramid for the
-/// stratum to be decided from the area their projection covers, so the penumbra's error is far
-/// below what rays alone reach with more rays (N = 16 above: 0.0048), and within its reported noise.
+/// visibility varies, the square's two triangles are few enough in a part of the light's pyramid
+/// for the part to be decided from the area their projection covers, so the penumbra's error is
+/// far below what rays alone reach with more rays (N = 16 above: 0.0048), and within its reported
+/// noise.
 #[test]
 fn the_default_truth_of_parallel_square_is_within_its_noise_of_the_exact_answer() {
     let gpu = gpu();
@@ -92,10 +93,9 @@ fn the_default_truth_of_parallel_square_is_within_its_noise_of_the_exact_answer(
     println!("default truth: max error {max:.2e}, mean penumbra error {mean:.2e} over {penumbra} pixels, reported noise {noise:.2e}");
     assert!(penumbra > 500, "the penumbra covers too few pixels ({penumbra}) to measure");
     assert!(mean < 1e-3, "mean penumbra error {mean}");
-    assert!(
-        f64::from(mean) < 1.5 * noise && f64::from(mean) > noise / 1.5,
-        "mean penumbra error {mean} against a reported noise of {noise}"
-    );
+    // Where the square's triangles are few enough for whole parts of the light, the truth is exact
+    // and reports no noise: its error is then the f32 rounding of the answers (10⁻⁴ allowed).
+    assert!((f64::from(mean) - noise).abs() <= 0.5 * noise + 1e-4, "mean penumbra error {mean} against a reported noise of {noise}");
 }
 
 #[test]

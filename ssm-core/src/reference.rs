@@ -46,7 +46,7 @@ mod traversal;
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 4;
+pub const REFERENCE_VERSION: u32 = 5;
 
 /// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
 /// more, the part is cut further or its rays traverse the BVH one by one.
@@ -152,6 +152,10 @@ struct PixelRays<'a> {
     /// through the BVH or a shortcut decided them.
     stratum_list: Vec<u32>,
     lists: Vec<Vec<u32>>,
+    /// A part of the light with at most [`EXACT_CANDIDATES`] triangles gets the share they hide,
+    /// exactly, instead of its rays (the estimate's sets); off, every stratum keeps its ray's
+    /// answer, as [`GroundTruth::visibility`] defines it.
+    exact_parts: bool,
 }
 
 /// A square part of the light in its coordinates ([-1, 1]² is the whole light): the light, or one
@@ -462,21 +466,18 @@ fn visible_fraction(strata: &[f32]) -> f32 {
     strata.iter().sum::<f32>() / strata.len().max(1) as f32
 }
 
-/// The strata of an N×N set where the visibility varies: those whose result differs from one of
-/// their four neighbours'.
-fn varying_strata(strata: &[f32], n: u32) -> Vec<bool> {
-    let n = n as i64;
-    let visible = |i: i64, j: i64| strata[(j * n + i) as usize];
-    (0..n * n)
-        .map(|index| {
-            let (i, j) = (index % n, index / n);
-            let own = visible(i, j);
-            [(-1, 0), (1, 0), (0, -1), (0, 1)].iter().any(|(di, dj)| {
-                let (x, y) = (i + di, j + dj);
-                x >= 0 && y >= 0 && x < n && y < n && visible(x, y) != own
-            })
-        })
-        .collect()
+/// Whether the visibility of an N×N set (`strata`) varies at stratum `index`: its result differs
+/// from one of its four neighbours'. A neighbour given a part of the light's exact share (`exact`,
+/// strictly between 0 and 1) says nothing of where its edges run, and is not compared.
+fn varies(strata: &[f32], exact: &[bool], n: u32, index: usize) -> bool {
+    let n = n as usize;
+    let (i, j) = (index % n, index / n);
+    let own = strata[index];
+    let differs = |neighbour: usize| {
+        let value = strata[neighbour];
+        value != own && !(exact[neighbour] && value > 0.0 && value < 1.0)
+    };
+    (i > 0 && differs(index - 1)) || (i + 1 < n && differs(index + 1)) || (j > 0 && differs(index - n)) || (j + 1 < n && differs(index + n))
 }
 
 /// The result of tracing one image.
@@ -663,7 +664,10 @@ impl GroundTruth {
     /// it or passes near) is decided exactly when at most four triangles can block its rays (the
     /// area their projection covers, `reference/coverage.rs`), and otherwise gets `refine`² fresh jittered
     /// rays in sub-strata instead of its one.
-    /// Each set is unbiased, since which strata it refines depends only on the other set's rays;
+    /// A part of the light whose pyramid holds at most four triangles is decided exactly for both
+    /// sets at once, before any ray ([`GroundTruth::count_visible`]), and its strata are neither
+    /// refined nor compared as neighbours. Each set is unbiased, since which strata it refines
+    /// depends only on the other set's rays and on the triangles (not on its own jitter);
     /// the estimate is (A + B)/2 and its noise |A − B|/2, whose mean over pixels estimates the
     /// mean absolute error of the estimate (and its square the variance, pixel by pixel). Lit and
     /// umbra pixels that the BVH shortcuts decide exactly have no noise; a point light casts one
@@ -679,7 +683,7 @@ impl GroundTruth {
         let mut set_rngs = [rng.fork(), rng.fork()];
         let refine_seeds = [rng.next_u64(), rng.next_u64()];
         // The two sets share the pyramid shortcuts' gathers (the same triangles for any jitter).
-        let shared = (shortcuts && point.footprint.is_none()).then(|| self.pyramid_visibility(light, point, n, &mut set_rngs));
+        let shared = (shortcuts && point.footprint.is_none()).then(|| self.pyramid_visibility(light, point, n, &mut set_rngs, true));
         let (strata, exact, lists, stratum_list) = match shared {
             Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list),
             None => {
@@ -694,15 +698,18 @@ impl GroundTruth {
         let mut recent = RecentBlockers::default();
         let (mut jitter, mut candidates) = (Vec::new(), Vec::new());
         let origins = self.origins(point);
+        // A pixel every stratum of which a shortcut decided (lit, umbra, or the exact share of a
+        // few triangles) has nothing to refine.
+        let all_exact = exact.iter().all(|e| *e);
         for (k, set) in sets.iter_mut().enumerate() {
-            if refine == 1 {
+            if refine == 1 || all_exact {
                 *set = visible_fraction(&strata[k]);
                 continue;
             }
-            let mask = varying_strata(&strata[1 - k], n);
+            let other = &strata[1 - k];
             let mut sum = 0.0f32;
-            for (index, (&value, &varies)) in strata[k].iter().zip(&mask).enumerate() {
-                if !varies || exact[index] {
+            for (index, &value) in strata[k].iter().enumerate() {
+                if exact[index] || !varies(other, &exact, n, index) {
                     // Exact: a shortcut decided every ray of this part of the light.
                     sum += value;
                     continue;
@@ -767,7 +774,7 @@ impl GroundTruth {
     /// through the BVH.
     fn stratified(&self, light: &RectLight, point: &SurfacePoint, n: u32, rng: &mut SplitMix64, shortcuts: bool) -> Vec<f32> {
         if shortcuts && point.footprint.is_none() {
-            return self.pyramid_visibility(light, point, n, std::slice::from_mut(rng)).strata.swap_remove(0);
+            return self.pyramid_visibility(light, point, n, std::slice::from_mut(rng), false).strata.swap_remove(0);
         }
         self.visibility_of_rays(light, point, n, rng, shortcuts)
     }
@@ -778,7 +785,14 @@ impl GroundTruth {
     /// [`GroundTruth::count_visible`]). A point light casts one ray for all N². One set of rays
     /// per generator of `rngs`, each drawing its jitter as visibility_per_ray does; the sets share
     /// the gathers.
-    fn pyramid_visibility<'a>(&self, light: &'a RectLight, point: &SurfacePoint, n: u32, rngs: &mut [SplitMix64]) -> PixelRays<'a> {
+    fn pyramid_visibility<'a>(
+        &self,
+        light: &'a RectLight,
+        point: &SurfacePoint,
+        n: u32,
+        rngs: &mut [SplitMix64],
+        exact_parts: bool,
+    ) -> PixelRays<'a> {
         let count = (n * n) as usize;
         let mut rays = PixelRays {
             light,
@@ -792,6 +806,7 @@ impl GroundTruth {
             exact: vec![false; count],
             stratum_list: vec![NO_LIST; count],
             lists: Vec::new(),
+            exact_parts,
         };
         if light.is_point() {
             let front = rays.in_front(light.centre);
@@ -846,7 +861,12 @@ impl GroundTruth {
     /// only by `triangles` (at most [`EXACT_CANDIDATES`], BVH slots): 1 less the share of the
     /// stratum their central projection onto the light's plane covers ([`coverage::covered_share`]).
     fn exact_coverage(&self, light: &RectLight, origin: Vec3, stratum: Window, triangles: &[u32]) -> f32 {
-        let (min, max) = (stratum.min, stratum.min + Vec2::splat(stratum.size));
+        self.exact_coverage_of(light, origin, [stratum.min, stratum.min + Vec2::splat(stratum.size)], triangles)
+    }
+
+    /// [`GroundTruth::exact_coverage`] of the rectangle `[min, max]` of the light (light
+    /// coordinates).
+    fn exact_coverage_of(&self, light: &RectLight, origin: Vec3, [min, max]: [Vec2; 2], triangles: &[u32]) -> f32 {
         debug_assert!(triangles.len() <= EXACT_CANDIDATES);
         let mut corners = [[Vec3::ZERO; 3]; EXACT_CANDIDATES];
         for (corner, slot) in corners.iter_mut().zip(triangles) {
@@ -870,9 +890,11 @@ impl GroundTruth {
     /// triangles in the pyramid from the origin to that part of the light (`parent`: those of
     /// the enclosing part, or `None` to gather them from the BVH). None in it: every ray reaches
     /// the light. One triangle that the four corner rays all cross: it covers the pyramid (a
-    /// convex triangle, a convex cone), none does. A few: each ray is tested against them.
-    /// Otherwise the part is cut into quarters. Exact: a triangle a ray crosses is always among
-    /// the candidates, and each ray is decided by the same test as the BVH's.
+    /// convex triangle, a convex cone), none does. At most [`EXACT_CANDIDATES`], for the
+    /// estimate's sets ([`PixelRays::exact_parts`]): every stratum gets the share of the part
+    /// they hide, exactly. A few: each ray is tested against them. Otherwise the part is cut into
+    /// quarters. Exact: a triangle a ray crosses is always among the candidates, and each ray is
+    /// decided by the same test as the BVH's.
     fn count_visible(&self, rays: &mut PixelRays<'_>, region: [u32; 4], parent: Option<&[u32]>, depth: u32, may_gather: bool) {
         let [i0, i1, j0, j1] = region;
         let strata = (i1 - i0) * (j1 - j0);
@@ -924,6 +946,14 @@ impl GroundTruth {
             Some(candidates) if candidates.is_empty() => rays.mark(region, 1.0),
             Some(candidates) if candidates.iter().any(|slot| corners.iter().all(|c| self.blocked_by(origin, *c, &[*slot]))) => {
                 rays.mark(region, 0.0);
+            }
+            Some(candidates) if rays.exact_parts && strata > 1 && candidates.len() <= EXACT_CANDIDATES => {
+                // So few triangles that the area they hide of this whole part of the light is
+                // cheaper than its rays and their refinement: every stratum of it gets that share,
+                // exactly, in both sets (no noise), and none is refined.
+                let window = [Vec2::new(s0, t0), Vec2::new(s1, t1)];
+                let visible = self.exact_coverage_of(rays.light, origin, window, &candidates);
+                rays.mark(region, visible);
             }
             Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
                 for set in 0..rays.strata.len() {
@@ -1511,6 +1541,7 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     kind: crate::TechniqueKind::GroundTruth,
     // Rays to points all over the light, blocked behind a closed surface (SurfacePoint::closed).
     light_sampling: crate::LightSampling::PerSample,
+    light_view: crate::LightView::Hemisphere,
     params: PARAMS,
     requirements: |_| Ok(crate::Requirements { gbuffer: true, ..crate::Requirements::NONE }),
     create,

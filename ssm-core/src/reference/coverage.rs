@@ -131,10 +131,13 @@ fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3], [slab, cut]: &
     // A corner at t → 0 projects to infinity: keep t above a bound that leaves the projection in
     // f64's range and far outside any light (the rectangle clip removes it).
     const T_MIN: f64 = 1e-9;
+    const T_MAX: f64 = 1.0 - 1e-6;
     slab.clear();
     slab.extend(triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))));
     clip_by(slab, |(_, t)| t - T_MIN, cut);
-    clip_by(cut, |(_, t)| 1.0 - t, slab);
+    // Rays stop just short of the light (`segment_ray`: at 1 − 10⁻⁶ of the way), so that geometry
+    // lying in the light's plane hides none of it; the projection stops there too.
+    clip_by(cut, |(_, t)| T_MAX - t, slab);
     let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
     let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
     out.extend(slab.iter().map(|(p, t)| {
