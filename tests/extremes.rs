@@ -65,14 +65,23 @@ const PENUMBRA_SHARE: f32 = 0.01;
 /// yet. Each is reported when the test runs and must still fail: one that passes fails the test
 /// until its line is removed. They are bugs or missing features of the implementation, not limits
 /// of the papers (those are `KnownLimit`s, declared by the technique with the paper's reason).
+/// Why pcss is no better than hard shadows in the corridor, where either shadows: the walls rising
+/// from the floor lie in front of the floor's plane inside its filter, though not between the floor
+/// and the light, and darken the floor along its junctions with them (its error heatmap). On the
+/// truth's umbra and penumbra alone it beats hard beyond the noise (`ssm compare` on the corridor's
+/// manifest).
+const CORRIDOR_WALLS: &str = "false shadows along the floor-wall junctions: the walls lie in front of the floor's plane inside the filter";
+
 const OPEN_FAILURES: &[(&str, &str, &str)] = &[
-    // The light frame stops at 84 degrees off the light's normal: the floor past it reads lit.
-    ("atty", "light resting on the receiver", "no texel past the frame's widest angle"),
-    ("multi-sm", "light resting on the receiver", "no texel past the frame's widest angle"),
-    ("pcss", "light resting on the receiver", "no texel past the frame's widest angle"),
-    ("pvsm", "light resting on the receiver", "no texel past the frame's widest angle"),
-    ("sssm", "light resting on the receiver", "no texel past the frame's widest angle"),
-    ("vssm", "light resting on the receiver", "no texel past the frame's widest angle"),
+    // The light frame stops at 84 degrees off the light's normal: past it the framework answers
+    // with a hard shadow from the light's centre (LightView::Frame, ssm-core's beyond_frame.rs),
+    // the same error as hard's, where the truth's penumbra there is wide.
+    ("atty", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
+    ("multi-sm", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
+    ("pcss", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
+    ("pvsm", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
+    ("sssm", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
+    ("vssm", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
     // Under a near-point light the penumbra is a pixel or two wide: these blur or alias it more
     // than a hard shadow errs by (to investigate: minimum filter sizes, map resolution).
     ("multi-sm", "thin bars under a near-point light", "worse than a hard shadow"),
@@ -93,9 +102,14 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     ),
     ("atty", "room lit from a wall over a table", "no better than a hard shadow in a room lit from a wall"),
     ("atty", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
-    ("pcss", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
+    ("pcss", "corridor lit from its ceiling", CORRIDOR_WALLS),
     ("sssm", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
     // Each to investigate.
+    (
+        "wedges",
+        "light in an enclosure of open quads",
+        "light leaks along the corners where two separate open quads meet (coincident silhouette edges)",
+    ),
     ("sssm", "light far larger than the occluder", "error just above the bound where either shadows"),
     ("atty", "three lights", "error far above the other techniques' on three lights"),
     ("atty", "wall lit at grazing angles", "error above the bound where either shadows"),
@@ -122,6 +136,11 @@ enum Refusal {
     LimitTooLow(&'static str),
 }
 
+/// Ground points outside "light in an enclosure of open quads": one inside the frame, three past
+/// its widest angle.
+const OUTSIDE_THE_ENCLOSURE: [Vec3; 4] =
+    [Vec3::new(1.8, 0.0, 1.8), Vec3::new(5.0, 0.0, 0.0), Vec3::new(-4.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 5.0)];
+
 /// What must hold for every technique on a scene, beyond the error bound.
 #[derive(Clone, Copy, Debug)]
 enum Expect {
@@ -136,8 +155,8 @@ enum Expect {
     /// (Nearly) no penumbra: a point light casts none. A pixel strictly between 0 and 1 with both a
     /// lit and a dark pixel among its eight neighbours is an anti-aliased edge, not a penumbra.
     NoPenumbra,
-    /// The surface seen at this world point is (nearly) in umbra: the exact visibility there is 0.
-    ShadowedAt(Vec3),
+    /// The surfaces seen at these world points are (nearly) in umbra: the exact visibility there is 0.
+    ShadowedAt(&'static [Vec3]),
 }
 
 /// One scene of the matrix.
@@ -185,7 +204,7 @@ fn extreme_cases() -> Vec<Case> {
         case(
             "occluder almost touching the light",
             parallel_square_with(square_light(above, down, 1.0), 3.999),
-            Expect::ShadowedAt(Vec3::ZERO),
+            Expect::ShadowedAt(&[Vec3::ZERO]),
         ),
         case("occluder in the light's plane", parallel_square_with(square_light(above, down, 1.0), 4.0), Expect::Bound),
         case("point light", parallel_square_with(square_light(above, down, 0.0), 2.0), Expect::NoPenumbra),
@@ -266,7 +285,7 @@ fn extreme_cases() -> Vec<Case> {
         scene.camera.position *= scale;
         scene.camera.near *= scale;
         scene.camera.far *= scale;
-        cases.push(case(name, scene, Expect::ShadowedAt(Vec3::ZERO)));
+        cases.push(case(name, scene, Expect::ShadowedAt(&[Vec3::ZERO])));
     }
 
     // The coarsest closed mesh the sphere generator makes (3 segments, 2 rings: a triangular bipyramid), resting on the ground.
@@ -426,6 +445,24 @@ fn extreme_cases() -> Vec<Case> {
         ),
         Expect::Bound,
     ));
+    // A light inside five open quads (four walls down to the ground and a ceiling behind the
+    // light) on a ground that reaches 84 degrees off the light's normal 3 units out: no closed mesh,
+    // so no framework cull; outside, the ground is umbra, within the frame and past it.
+    cases.push(case(
+        "light in an enclosure of open quads",
+        from_manifest(
+            "open-enclosure",
+            "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[light]]\ncentre = [0.0, 0.3, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, 1.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n",
+        ),
+        Expect::ShadowedAt(&OUTSIDE_THE_ENCLOSURE),
+    ));
     // An occluder quad lying in the receiver's plane (it shadows nothing), and a block above.
     cases.push(case(
         "coplanar occluder and receiver",
@@ -478,9 +515,11 @@ fn check_expectation(technique: &str, (case_name, scene): (&str, &Scene), expect
             let share = penumbra as f32 / covered.len() as f32;
             assert!(share < 0.01, "{technique} / {case_name}: {:.1}% of pixels in a penumbra", share * 100.0);
         }
-        Expect::ShadowedAt(world) => {
-            let value = at(rendered, pixel_of(scene, WIDTH, HEIGHT, world));
-            assert!(value < 0.1, "{technique} / {case_name}: visibility {value} at {world}, where the exact value is 0");
+        Expect::ShadowedAt(points) => {
+            for world in points {
+                let value = at(rendered, pixel_of(scene, WIDTH, HEIGHT, *world));
+                assert!(value < 0.1, "{technique} / {case_name}: visibility {value} at {world}, where the exact value is 0");
+            }
         }
     }
 }

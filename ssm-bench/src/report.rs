@@ -980,11 +980,34 @@ pub fn markdown_report(context: &ReportContext<'_>, rows: &[Row]) -> String {
         context.scene, context.size.0, context.size.1, context.frames, context.adapter, context.reference_params, context.reference_cost
     );
     out += &markdown_table(rows);
+    if let Some(note) = beyond_frame_note(rows) {
+        let _ = writeln!(out, "\n{note}");
+    }
     for (name, why) in context.skipped {
         let _ = writeln!(out, "\nNot run: `{name}`: {why}");
     }
     out += &markdown_work(context, rows);
     out
+}
+
+/// The pixels the framework answered past the light frame's widest angle, per technique
+/// ([`ssm_core::BEYOND_FRAME_DIAGNOSTIC`]), as one sentence; `None` when it answered none.
+#[must_use]
+pub fn beyond_frame_note(rows: &[Row]) -> Option<String> {
+    let answered: Vec<String> = rows
+        .iter()
+        .filter(|r| r.light.is_none())
+        .filter_map(|r| {
+            let pixels = r.diagnostics.iter().find(|(key, _)| key == ssm_core::BEYOND_FRAME_DIAGNOSTIC).map(|(_, v)| *v)?;
+            (pixels > 0.0).then(|| format!("`{}` {pixels:.0}", r.technique))
+        })
+        .collect();
+    (!answered.is_empty()).then(|| {
+        format!(
+            "Past the light frame's widest angle (about 84° off the light's normal) these techniques' maps have no texel: the framework answered those pixels with a hard shadow from the light's centre (pixels, summed over lights: {}).",
+            answered.join(", ")
+        )
+    })
 }
 
 /// A number for JSON: `null` when not finite (JSON has no infinity; PSNR of identical images is one).
@@ -1151,6 +1174,9 @@ pub fn html_report(context: &ReportContext<'_>, rows: &[Row], reference_name: &s
         escape(context.reference_params),
         escape(context.reference_cost)
     );
+    if let Some(note) = beyond_frame_note(rows) {
+        let _ = writeln!(out, "<p>{}</p>", escape(&note));
+    }
     out += &viewer_section(context.size);
     out += "<h2>All images</h2>\n<table>\n<tr>";
     for header in TABLE_HEADER {

@@ -39,6 +39,8 @@
 // The derives name this crate `::ssm_core`, also when used inside it.
 extern crate self as ssm_core;
 
+mod after_technique;
+mod beyond_frame;
 mod composite;
 mod context;
 mod error;
@@ -63,6 +65,7 @@ mod technique;
 mod timing;
 pub mod work;
 
+pub use beyond_frame::{BEYOND_FRAME_DIAGNOSTIC, BEYOND_FRAME_PASS, SIDE_FACE_WIDTH, beyond_frame_label};
 pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
 pub use error::{BoxedError, Error, Reason, Result};
 pub use frame::{CountedComputePass, CountedRenderPass, Frame, SharedInputs};
@@ -80,8 +83,8 @@ pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
-    DebugOutput, ExtraImage, KnownLimit, LightSampling, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo, TechniqueKind,
-    TechniqueSetup, UniformCheck, UniformStruct,
+    DebugOutput, ExtraImage, KnownLimit, LightSampling, LightView, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo,
+    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
 };
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 pub use work::{FrameWork, PassWork, ShaderWork};

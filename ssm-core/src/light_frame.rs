@@ -191,6 +191,60 @@ impl LightFrame {
         uniform
     }
 
+    /// Whether the fit reached the widest angle ([`MAX_HALF_ANGLE_TANGENT`]) along an axis: then
+    /// part of the light's front hemisphere may hold receivers that the frame's maps have no
+    /// texel for, which the framework answers from the [side faces](LightFrame::side_face_uniform).
+    #[must_use]
+    pub fn reaches_widest_angle(&self) -> bool {
+        self.tan_half.max_element() >= MAX_HALF_ANGLE_TANGENT * (1.0 - 1e-6)
+    }
+
+    /// The axes of side face `face` (0: +u, 1: −u, 2: +v, 3: −v, the direction it looks along):
+    /// across (the map's x), down (its y: the light's normal) and forward, with across × down =
+    /// forward as u × v = normal. `shaders/core/beyond_frame.wgsl` picks the same.
+    #[must_use]
+    pub fn side_face_axes(&self, face: usize) -> [Vec3; 3] {
+        let (u, v, n) = (self.light.u_axis, self.light.v_axis, self.light.normal());
+        match face {
+            0 => [v, n, u],
+            1 => [-v, n, -u],
+            2 => [-u, n, v],
+            _ => [u, n, -v],
+        }
+    }
+
+    /// The uniform of side face `face` ([`LightFrame::side_face_axes`]): a frustum from the
+    /// light's centre looking along the light's plane, tangents [-1, 1] across and [0, 1]
+    /// towards the normal (the half of a hemicube's side in front of the light), for a map twice
+    /// as wide as high. Its `normal` is the face's forward axis, so that a
+    /// [`LightDepthMap`](crate::LightDepthMap) drawn through it stores depth along that axis;
+    /// the light's size, the scene and the sealed flag are the frame's.
+    #[must_use]
+    pub fn side_face_uniform(&self, face: usize) -> LightFrameUniform {
+        let [across, down, forward] = self.side_face_axes(face);
+        let view = glam::camera::rh::view::look_to_mat4(self.light.centre, forward, -down);
+        let near = self.scene_diagonal.max(1e-6) * 1e-6;
+        let far = 2.0 * self.scene_diagonal + self.far;
+        // A 90° square frustum, reversed depth as the frame's, whose lower half (view y from −w
+        // to 0: in front of the light) is stretched over the whole viewport: y' = 2y + w.
+        let square = glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, far, near);
+        let lower_half = Mat4::from_cols(
+            glam::Vec4::new(1.0, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 2.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+            glam::Vec4::new(0.0, 1.0, 0.0, 1.0),
+        );
+        let mut uniform = LightFrameUniform::from(self);
+        uniform.view_proj = (lower_half * square * view).to_cols_array_2d();
+        uniform.view = view.to_cols_array_2d();
+        uniform.u_axis = across.extend(self.light.half_size.x).to_array();
+        uniform.v_axis = down.extend(self.light.half_size.y).to_array();
+        uniform.normal = forward.extend(self.light.area()).to_array();
+        // Half-extent tangents: 1 across, 0.5 down (the [0, 1] range over the map's height).
+        uniform.projection = [1.0, 0.5, near, far];
+        uniform
+    }
+
     /// Shadow-map texture coordinates (u right, v down) and linear depth of a
     /// world point; the CPU twin of `light_uv_depth` in `light_frame.wgsl`.
     #[must_use]
@@ -449,5 +503,40 @@ mod tests {
         assert!(frame.uv_depth(Vec3::X).x > 0.5 && frame.uv_depth(Vec3::Z).y > 0.5);
         // Square light: square frustum.
         assert_eq!(frame.tan_half.x, frame.tan_half.y);
+    }
+
+    /// Each side face's clip space puts a point in front of the light where
+    /// `shaders/core/beyond_frame.wgsl` looks it up: x at 0.5 + 0.5 tan across, y (down) at the
+    /// tangent towards the light's normal, depth inside [0, 1]; and the four faces, with the
+    /// frame, cover the front hemisphere.
+    #[test]
+    fn side_faces_map_the_front_hemisphere_as_the_lookup_reads_it() {
+        let light = RectLight::try_facing(Vec3::new(0.3, 2.0, -0.4), Vec3::new(0.2, -1.0, 0.1), Vec3::X, Vec2::new(0.5, 0.2), 1.0).unwrap();
+        let frame = LightFrame::fit(&light, &Aabb { min: Vec3::splat(-5.0), max: Vec3::splat(5.0) });
+        let (u, v, n) = (light.u_axis, light.v_axis, light.normal());
+        let mut state = 11u64;
+        let mut random = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        for _ in 0..500 {
+            // In a side face's region: at most 45 degrees from the light's plane.
+            let (x, y) = (random() * 4.0, random() * 4.0);
+            let local = Vec3::new(x, y, (random().abs() * 0.999 + 1e-4) * x.abs().max(y.abs()));
+            let world = light.centre + u * local.x + v * local.y + n * local.z;
+            // The face the lookup picks: the larger of |u| and |v|, its sign.
+            let face = if local.x.abs() >= local.y.abs() { usize::from(local.x < 0.0) } else { 2 + usize::from(local.y < 0.0) };
+            let [across, down, forward] = frame.side_face_axes(face);
+            assert!((across.cross(down) - forward).length() < 1e-5, "face {face} is not (u, v, normal)-handed");
+            let offset = world - light.centre;
+            let expected = Vec2::new(0.5 + 0.5 * offset.dot(across) / offset.dot(forward), offset.dot(down) / offset.dot(forward));
+            let uniform = frame.side_face_uniform(face);
+            let clip = Mat4::from_cols_array_2d(&uniform.view_proj) * world.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            let uv = Vec2::new(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+            assert!((uv - expected).length() < 1e-4, "face {face}: {uv} where the lookup reads {expected}");
+            assert!(uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all(), "face {face}: {uv} outside its map");
+            assert!(ndc.z > 0.0 && ndc.z < 1.0, "face {face}: depth {} outside the range", ndc.z);
+        }
     }
 }

@@ -19,7 +19,7 @@ use crate::frame::Frame;
 use crate::passes::{bind_group, bind_group_layout, compute_pipeline, visibility_storage_entry};
 use crate::read_counts::ReadCounts;
 use crate::shader::create_shader;
-use crate::technique::{ShadowTechnique, TechniqueSetup};
+use crate::technique::TechniqueSetup;
 use crate::work::ShaderWork;
 
 /// The pass's name after the technique's: `<technique>_own_surface_share`.
@@ -38,7 +38,7 @@ pub fn own_surface_share_label(technique: &str) -> String {
 const COUNTERS: &[(&str, &str)] = &[(OWN_SURFACE_SHARE_PASS, "reads"), (OWN_SURFACE_SHARE_PASS, "storage_bytes")];
 
 /// The pass, built for one technique's visibility targets.
-struct OwnSurfaceShare {
+pub(crate) struct OwnSurfaceShare {
     /// `<technique>_own_surface_share`.
     label: String,
     pipeline: wgpu::ComputePipeline,
@@ -51,7 +51,7 @@ struct OwnSurfaceShare {
 }
 
 impl OwnSurfaceShare {
-    fn new(setup: &TechniqueSetup<'_>, technique: &str) -> Result<Self> {
+    pub(crate) fn new(setup: &TechniqueSetup<'_>, technique: &str) -> Result<Self> {
         let gpu = setup.gpu;
         let gbuffer = setup.shared.gbuffer(technique)?;
         let read_counts = ReadCounts::with_units(&gpu.device, "own_surface_share_read_counts", COUNTERS, setup.count_work);
@@ -97,7 +97,7 @@ impl OwnSurfaceShare {
     }
 
     /// Records the pass for `light`, after the technique's.
-    fn encode(&self, frame: &mut Frame<'_>, light: usize) -> Result<()> {
+    pub(crate) fn encode(&self, frame: &mut Frame<'_>, light: usize) -> Result<()> {
         let no_light = || Error::Technique { technique: self.label.clone(), message: format!("no light {light}") };
         let group = self.groups.get(light).ok_or_else(no_light)?;
         let light_frame = frame.scene.light_bind_groups.get(light).ok_or_else(no_light)?;
@@ -112,54 +112,11 @@ impl OwnSurfaceShare {
     }
 
     /// What the pass counted in the last frame, under its label; `None` when not counting.
-    fn work(&self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
+    pub(crate) fn work(&self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
         let mut work = self.read_counts.work(gpu)?;
         for pass in work.iter_mut().flatten() {
             pass.pass.clone_from(&self.label);
         }
         Ok(work)
     }
-}
-
-/// A technique that samples the light from its centre, followed by the own-surface share.
-struct WithOwnSurfaceShare {
-    technique: Box<dyn ShadowTechnique>,
-    share: OwnSurfaceShare,
-}
-
-impl ShadowTechnique for WithOwnSurfaceShare {
-    fn render(&mut self, frame: &mut Frame<'_>, light: usize, output: &wgpu::TextureView) -> Result<()> {
-        self.technique.render(frame, light, output)?;
-        self.share.encode(frame, light)
-    }
-
-    fn diagnostics(&mut self, gpu: &GpuContext) -> Vec<(String, f64)> {
-        self.technique.diagnostics(gpu)
-    }
-
-    /// The technique's counts and the share pass's. A technique that does not count keeps its
-    /// reads unknown (`None`): the frame's total would be wrong with the share's alone.
-    fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
-        let Some(mut work) = self.technique.counted_work(gpu)? else {
-            return Ok(None);
-        };
-        work.extend(self.share.work(gpu)?.unwrap_or_default());
-        Ok(Some(work))
-    }
-
-    fn debug_outputs(&mut self, gpu: &GpuContext, requested: &[&str]) -> Result<Vec<crate::ExtraImage>> {
-        self.technique.debug_outputs(gpu, requested)
-    }
-}
-
-/// `technique` followed, for every light, by the own-surface share pass.
-///
-/// # Errors
-/// [`Error::UndeclaredRequirement`] without a G-buffer, or a shader error.
-pub(crate) fn with_own_surface_share(
-    technique: Box<dyn ShadowTechnique>,
-    setup: &TechniqueSetup<'_>,
-    name: &str,
-) -> Result<Box<dyn ShadowTechnique>> {
-    Ok(Box::new(WithOwnSurfaceShare { technique, share: OwnSurfaceShare::new(setup, name)? }))
 }

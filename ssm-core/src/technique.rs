@@ -212,6 +212,26 @@ pub enum LightSampling {
     PerSample,
 }
 
+/// How far from the light's normal a technique's maps see, which decides whether the framework
+/// answers the receivers past them (`ssm-core/src/beyond_frame.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightView {
+    /// Through one perspective frustum from the light: the shared light frame, a tile of it, or
+    /// one per light sample (hard, pcss, vssm, sssm, atty, pvsm, multi-sm, and a new technique
+    /// by default). Such a frustum stops at the frame's widest angle
+    /// ([`MAX_HALF_ANGLE_TANGENT`](crate::MAX_HALF_ANGLE_TANGENT), about 84° off the light's
+    /// normal). Where a light's frame reaches it, the framework renders the rest of the light's
+    /// front hemisphere as a hemicube's four side faces and answers every receiver past the
+    /// frame with a hard shadow from the light's centre (one pass per light,
+    /// `<technique>_beyond_frame`, timed and counted with the technique's), and reports how many
+    /// pixels it answered (the diagnostic `pixels_beyond_frame`): the technique's own method does
+    /// not reach them. The technique needs the G-buffer for it ([`TechniqueInfo::needs`]).
+    Frame,
+    /// Over the light's whole front hemisphere: shadow volumes (wedges) and the ground truth's
+    /// rays. The framework adds nothing.
+    Hemisphere,
+}
+
 /// A named sweep a technique declares beside its parameters (the studies of
 /// its paper), discovered by `ssm sweep --list-presets` and the preset benches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -294,6 +314,9 @@ pub struct TechniqueInfo {
     /// Where on the light it takes its visibility from: [`LightSampling::Centre`] gets the
     /// framework's own-surface share after its passes, [`LightSampling::PerSample`] does not.
     pub light_sampling: LightSampling,
+    /// How far from the light's normal it sees: [`LightView::Frame`] gets the framework's
+    /// answer past the frame's widest angle, [`LightView::Hemisphere`] does not.
+    pub light_view: LightView,
     /// Its parameters.
     pub params: &'static [ParamSpec],
     /// Its requirements, which may depend on the parameter values.
@@ -340,15 +363,24 @@ impl TechniqueInfo {
         self.light_sampling == LightSampling::Centre && self.kind != TechniqueKind::GroundTruth
     }
 
+    /// Whether the framework answers, after the technique's passes, the receivers past the light
+    /// frame's widest angle where a light's frame reaches it: it sees the light through one
+    /// frustum ([`LightView::Frame`]) and is not the ground truth.
+    #[must_use]
+    pub fn gets_beyond_frame(&self) -> bool {
+        self.light_view == LightView::Frame && self.kind != TechniqueKind::GroundTruth
+    }
+
     /// What a renderer must build for the technique with `params`: its
     /// [`requirements`](TechniqueInfo::requirements), and the G-buffer that the framework's
-    /// own-surface share reads when it [gets one](TechniqueInfo::gets_own_surface_share).
+    /// passes after it read when it gets one ([`TechniqueInfo::gets_own_surface_share`],
+    /// [`TechniqueInfo::gets_beyond_frame`]).
     ///
     /// # Errors
     /// Whatever its requirements reject.
     pub fn needs(&self, params: &ParamValues) -> Result<Requirements> {
         let requirements = (self.requirements)(params)?;
-        Ok(if self.gets_own_surface_share() {
+        Ok(if self.gets_own_surface_share() || self.gets_beyond_frame() {
             requirements.union(Requirements { gbuffer: true, ..Requirements::NONE })
         } else {
             requirements
@@ -432,10 +464,8 @@ pub(crate) fn create_checked(
         });
     }
     let setup = TechniqueSetup { gpu, scene, cpu_scene, shared, outputs, params, count_work };
-    let mut technique = (info.create)(&setup)?;
-    if info.gets_own_surface_share() {
-        technique = crate::own_surface::with_own_surface_share(technique, &setup, info.name)?;
-    }
+    let technique = (info.create)(&setup)?;
+    let technique = crate::after_technique::with_framework_passes(technique, &setup, info)?;
     let messages = gpu.take_errors();
     if messages.is_empty() { Ok(technique) } else { Err(Error::Gpu { during: format!("creating technique `{}`", info.name), messages }) }
 }

@@ -277,6 +277,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     // A map per light sample, each with the shared rules for that point light (multi_sm.wgsl):
     // the own surface's share is in its answer, not charged twice.
     light_sampling: ssm_core::LightSampling::PerSample,
+    light_view: ssm_core::LightView::Frame,
     params: MultiSmSettings::PARAMS,
     requirements,
     create,

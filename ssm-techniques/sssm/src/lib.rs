@@ -805,6 +805,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     kind: TechniqueKind::Realtime,
     // One view of the light from its centre: the framework adds the own surface's share.
     light_sampling: ssm_core::LightSampling::Centre,
+    light_view: ssm_core::LightView::Frame,
     params: SssmSettings::PARAMS,
     requirements,
     create,
@@ -828,10 +829,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: SssmSettingsUniform::LAYOUT,
     }],
-    limits: &[
-        ssm_core::KnownLimit { case: "tube light along the occluder's side", mean_error: 0.15, reason: TUBE_LIMIT },
-        ssm_core::KnownLimit { case: "tube light across the scene at 30 degrees", mean_error: 0.15, reason: TUBE_LIMIT },
-    ],
+    limits: &[ssm_core::KnownLimit { case: "tube light across the scene at 30 degrees", mean_error: 0.15, reason: TUBE_LIMIT }],
 };
 
 register_technique!(INFO);

@@ -1160,6 +1160,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     kind: TechniqueKind::Realtime,
     // One view of the light from its centre: the framework adds the own surface's share.
     light_sampling: ssm_core::LightSampling::Centre,
+    light_view: ssm_core::LightView::Hemisphere,
     params: WedgesSettings::PARAMS,
     requirements,
     create,

@@ -142,6 +142,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     kind: TechniqueKind::Realtime,
     // One view of the light from its centre: the framework adds the own surface's share.
     light_sampling: ssm_core::LightSampling::Centre,
+    light_view: ssm_core::LightView::Frame,
     params: PARAMS,
     requirements: |params| Ok(Requirements { gbuffer: true, max_texture_size: map_size(params)?, ..Requirements::NONE }),
     create,

@@ -1,0 +1,119 @@
+// The receivers past the light frame's widest angle (ssm-core's beyond_frame.rs), run by the
+// framework after a technique whose maps see the light through that one frame
+// (LightView::Frame) when the frame reached its widest angle (MAX_HALF_ANGLE_TANGENT, about 84
+// degrees off the light's normal). There its maps hold no texel, and its value is whatever its
+// sampler's clamp finds. The framework answers those pixels instead, from four side faces around
+// the light's centre that cover the rest of its front hemisphere (a hemicube's sides, as the
+// radiosity engines render one for an area light): a hard shadow from the centre, the same for
+// every such technique, and it counts them so that the report says how many it answered.
+
+// #import common/screen_pass.wgsl
+// #import common/read_counts.wgsl
+
+@group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
+// The side faces' linear depth maps (core/light_depth.wgsl, through LightFrame::side_face_uniform):
+// +u, -u, +v, -v. Each covers tangents [-1, 1] across and [0, 1] towards the light's normal.
+@group(2) @binding(1) var face_plus_u: texture_2d<f32>;
+@group(2) @binding(2) var face_minus_u: texture_2d<f32>;
+@group(2) @binding(3) var face_plus_v: texture_2d<f32>;
+@group(2) @binding(4) var face_minus_v: texture_2d<f32>;
+// Word `light` counts the pixels answered here for that light (cleared every frame).
+@group(2) @binding(5) var<storage, read_write> answered: array<atomic<u32>>;
+// Counters 0 (texel reads) and 1 (storage bytes) of a counting frame (common/read_counts.wgsl).
+@group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+struct BeyondFrameSettings {
+    // x: this light's index (its word of `answered`); y: the faces' width in texels, z: their
+    // height; w: the texels of the receiver's own depth change its bias allows.
+    values: vec4<f32>,
+};
+@group(2) @binding(7) var<uniform> settings: BeyondFrameSettings;
+
+// The point lies past the frame: in front of the light, outside its frustum's tangents.
+fn beyond_frame(offset: vec3<f32>) -> bool {
+    let depth = dot(offset, frame.normal.xyz);
+    let across = vec2<f32>(abs(dot(offset, frame.u_axis.xyz)), abs(dot(offset, frame.v_axis.xyz)));
+    return depth > 0.0 && any(across > depth * frame.projection.xy);
+}
+
+// Hard visibility from the light's centre through the side face that `offset` (from the centre)
+// falls in: 1 when no surface of the face's map is nearer along the face's axis.
+fn side_face_visibility(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
+    let u = frame.u_axis.xyz;
+    let v = frame.v_axis.xyz;
+    let n = frame.normal.xyz;
+    let size = settings.values.yz;
+    // The face of the largest of |offset.u| and |offset.v|, and its axes across and forward as
+    // LightFrame::side_face_axes builds them (down is the light's normal on every face).
+    var across = v;
+    var forward = u;
+    var face = 0;
+    let along_u = dot(offset, u);
+    let along_v = dot(offset, v);
+    if (abs(along_u) >= abs(along_v)) {
+        if (along_u < 0.0) {
+            across = -v;
+            forward = -u;
+            face = 1;
+        }
+    } else if (along_v >= 0.0) {
+        across = -u;
+        forward = v;
+        face = 2;
+    } else {
+        across = u;
+        forward = -v;
+        face = 3;
+    }
+    // The point's depth along the face's axis, and the depth its own surface (the tangent plane,
+    // normal `normal`) may have at the centre of the texel it falls in: the map holds the surface
+    // rasterized at texel centres. Seen from the light's centre at a grazing angle a surface's
+    // depth changes by far more than a texel's width across one texel (D² δ (|N·a| + |N·n|) /
+    // |N·o| for a texel of tangent δ, D the depth, o the point's offset from the centre), and a
+    // fixed or clamped bias would let it shadow itself, as a floor a hair below a light does
+    // everywhere. The bias is that change over settings.w texels, at most the depth itself.
+    let depth = max(dot(offset, forward), 1e-30);
+    let tangents = vec2<f32>(dot(offset, across), dot(offset, n)) / depth;
+    let uv = vec2<f32>(0.5 + 0.5 * tangents.x, tangents.y);
+    let texel_tangent = 1.0 / size.y;
+    let facing = max(abs(dot(normal, offset)), 1e-30);
+    let slope = (abs(dot(normal, across)) + abs(dot(normal, n))) * depth * depth / facing;
+    let bias = min(settings.values.w * texel_tangent * slope, depth);
+    let texel = vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), size - 1.0));
+    var stored = 0.0;
+    switch face {
+        case 0: { stored = textureLoad(face_plus_u, texel, 0).x; }
+        case 1: { stored = textureLoad(face_minus_u, texel, 0).x; }
+        case 2: { stored = textureLoad(face_plus_v, texel, 0).x; }
+        default: { stored = textureLoad(face_minus_v, texel, 0).x; }
+    }
+    return select(0.0, 1.0, depth - bias <= stored);
+}
+
+@compute @workgroup_size(8, 8)
+fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(visibility);
+    if (id.x >= size.x || id.y >= size.y) {
+        return;
+    }
+    let texel = vec2<i32>(id.xy);
+    let point = screen_point_at(texel);
+    var reads = 2u;
+    var stored = 0u;
+    let offset = point.position - frame.centre.xyz;
+    if (point.covered && !unlit_by_rule(point) && beyond_frame(offset)) {
+        let answer = side_face_visibility(offset, point.normal);
+        textureStore(visibility, texel, vec4<f32>(answer, 0.0, 0.0, 0.0));
+        atomicAdd(&answered[u32(settings.values.x)], 1u);
+        reads += 1u;
+        stored = 4u;
+    }
+    if (COUNT_READS) {
+        let reads_word = read_count_word(0u, texel);
+        atomicAdd(&read_counts[reads_word], 1u);
+        atomicAdd(&read_counts[reads_word + 1u], reads);
+        let bytes_word = read_count_word(1u, texel);
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], stored);
+    }
+}
