@@ -207,7 +207,7 @@ def main():
     def write_results():
         if not body:
             return
-        sections = body_sections()
+        sections = part_sections("\n".join(body_sections()))
         if only and target.exists():
             sections = merged_sections(target.read_text(), sections)
         target.write_text(header("Results" + ("" if lavapipe else f" on {adapter}")) + "\n".join(sections))
@@ -295,18 +295,22 @@ def lowest_error(rows):
     return text + (f", tied within the truth's noise with {', '.join(tied)}" if tied else "")
 
 
-def merged_sections(previous, fresh):
-    """The `## ` sections of `previous` (a results file) in their order, each replaced by the section
-    of `fresh` with the same heading, and `fresh`'s new headings after them: what a partial run
-    writes, keeping the parts it did not run."""
-    # Only the parts' own headings open a section (a report's own `## ` headings stay inside).
+def part_sections(text):
+    """`text` cut into the parts' sections, each from its `## <part>` heading to the next: only the
+    parts' own headings open one (a report's own `## ` headings, and each part's `### `
+    subsections, stay inside)."""
     names = "|".join(re.escape(n) for n in ["summary", "defaults", "trade", "lights", "kinds", *TECHNIQUES])
-    def split(text):
-        parts = re.split(rf"(?m)^(?=## (?:{names})\n)", text)
-        return [p for p in parts if p.startswith("## ")]
+    parts = re.split(rf"(?m)^(?=## (?:{names})\n)", text)
+    return [p.rstrip("\n") + "\n" for p in parts if p.startswith("## ")]
+
+
+def merged_sections(previous, fresh):
+    """The part sections of `previous` (a results file) in their order, each replaced by the section
+    of `fresh` (part sections) with the same heading, and `fresh`'s new parts after them: what a
+    partial run writes, keeping the parts it did not run."""
     heading = lambda section: section.split("\n", 1)[0]
     replacement = {heading(section): section for section in fresh}
-    merged = [replacement.pop(heading(section), section) for section in split(previous)]
+    merged = [replacement.pop(heading(section), section) for section in part_sections(previous)]
     return merged + [section for section in fresh if heading(section) in replacement]
 
 
