@@ -201,13 +201,15 @@ impl BeyondFrame {
             .light_bind_groups
             .get(light)
             .ok_or_else(|| Error::Technique { technique: self.label.clone(), message: format!("no light {light}") })?;
-        if light == 0 || self.lights[..light].iter().all(Option::is_none) {
+        // The counters sum over the frame's lights: cleared at the first light that has faces
+        // (the renderer renders the lights in order).
+        if self.lights[..light].iter().all(Option::is_none) {
             frame.clear_buffer(&format!("{}_answered_clear", self.label), &self.answered, 0, None);
+            self.read_counts.clear(frame, 0);
         }
         for (map, face_frame) in faces.maps.iter().zip(&faces.face_frames) {
             map.encode_with(frame, face_frame);
         }
-        self.read_counts.clear(frame, light);
         let mut pass = frame.compute_pass(&self.label);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);

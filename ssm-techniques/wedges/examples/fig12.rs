@@ -134,7 +134,12 @@ fn main() -> Result<()> {
             let diagnostics = technique.diagnostics(&gpu);
             let ms = ssm_bench::median(&frame_times[k]).unwrap_or(f64::NAN);
             let diagnostic = |name: &str| diagnostics.iter().find(|(n, _)| n == name).map_or(String::new(), |(_, v)| v.to_string());
-            let (signed, mae) = truth.as_ref().map_or((f64::NAN, f64::NAN), |t| errors(t, &visibility, &covered, options.size));
+            // Without `--error` the errors are not measured: empty in the CSV, said so when printed.
+            let measured = truth.as_ref().map(|t| errors(t, &visibility, &covered, options.size));
+            let (signed_field, mae_field, error_text) = match measured {
+                Some((signed, mae)) => (format!("{signed:.5}"), format!("{mae:.5}"), format!("MAE {mae:.4}  signed {signed:+.4}")),
+                None => (String::new(), String::new(), "error not measured (--error)".to_owned()),
+            };
             let mut passes: Vec<(String, f64)> = Vec::new();
             for (name, ms) in &pass_times[k] {
                 match passes.iter_mut().find(|(n, _)| n == name) {
@@ -146,16 +151,14 @@ fn main() -> Result<()> {
             let passes = passes.iter().map(|(n, t)| format!("{n}={:.1}", t / frames)).collect::<Vec<_>>().join(";");
             let _ = writeln!(
                 csv,
-                "{spheres},{triangles},{label},{},{},{ms:.3},{},{},{mae:.5},{signed:.5},{passes},\"{}\"",
+                "{spheres},{triangles},{label},{},{},{ms:.3},{},{},{mae_field},{signed_field},{passes},\"{}\"",
                 options.size.0,
                 options.size.1,
                 diagnostic("silhouette_edges"),
                 diagnostic("wedge_fragments"),
                 gpu.describe()
             );
-            println!(
-                "{spheres:4} spheres, {triangles:7} triangles, {label:22}: {ms:9.1} ms  MAE {mae:.4}  signed {signed:+.4}  ({passes})"
-            );
+            println!("{spheres:4} spheres, {triangles:7} triangles, {label:22}: {ms:9.1} ms  {error_text}  ({passes})");
             time_points.push(PlotPoint { series: (*label).to_owned(), x: triangles as f64, y: ms, label: String::new() });
             times.push(ms);
         }
