@@ -8,7 +8,7 @@
 // every such technique, and it counts them so that the report says how many it answered.
 
 // #import common/screen_pass.wgsl
-// #import common/read_counts.wgsl
+// #import common/pixel_work.wgsl
 
 @group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
 // The side faces' linear depth maps (core/light_depth.wgsl, through LightFrame::side_face_uniform):
@@ -108,12 +108,5 @@ fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
         reads += 1u;
         stored = 4u;
     }
-    if (COUNT_READS) {
-        let reads_word = read_count_word(0u, texel);
-        atomicAdd(&read_counts[reads_word], 1u);
-        atomicAdd(&read_counts[reads_word + 1u], reads);
-        let bytes_word = read_count_word(1u, texel);
-        atomicAdd(&read_counts[bytes_word], 1u);
-        atomicAdd(&read_counts[bytes_word + 1u], stored);
-    }
+    record_pixel_work(0u, 1u, texel, reads, stored);
 }

@@ -16,7 +16,7 @@
 // Elsewhere the technique's value is kept.
 
 // #import common/screen_pass.wgsl
-// #import common/read_counts.wgsl
+// #import common/pixel_work.wgsl
 
 @group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
 // Counters 0 (texel reads) and 1 (storage bytes), (invocations, count) per bucket
@@ -51,12 +51,5 @@ fn own_surface_share(@builtin(global_invocation_id) id: vec3<u32>) {
             stored = 4u;
         }
     }
-    if (COUNT_READS) {
-        let reads_word = read_count_word(0u, texel);
-        atomicAdd(&read_counts[reads_word], 1u);
-        atomicAdd(&read_counts[reads_word + 1u], reads);
-        let bytes_word = read_count_word(1u, texel);
-        atomicAdd(&read_counts[bytes_word], 1u);
-        atomicAdd(&read_counts[bytes_word + 1u], stored);
-    }
+    record_pixel_work(0u, 1u, texel, reads, stored);
 }

@@ -665,7 +665,7 @@ impl GroundTruth {
     /// area their projection covers, `reference/coverage.rs`), and otherwise gets `refine`² fresh jittered
     /// rays in sub-strata instead of its one.
     /// A part of the light whose pyramid holds at most four triangles is decided exactly for both
-    /// sets at once, before any ray ([`GroundTruth::count_visible`]), and its strata are neither
+    /// sets at once, before any ray (in the pyramid shortcuts), and its strata are neither
     /// refined nor compared as neighbours. Each set is unbiased, since which strata it refines
     /// depends only on the other set's rays and on the triangles (not on its own jitter);
     /// the estimate is (A + B)/2 and its noise |A − B|/2, whose mean over pixels estimates the
