@@ -1294,9 +1294,9 @@ mod tests {
         assert_eq!(number(None, 2), "");
     }
 
-    #[test]
-    fn rows_read_back_from_their_csv_give_the_same_csv() {
-        let row = |technique: &str, light: Option<usize>, gpu: Option<f64>| Row {
+    /// A row of every column, for the tests: `gpu` None is a row timed on the CPU alone.
+    fn sample_row(technique: &str, light: Option<usize>, gpu: Option<f64>) -> Row {
+        Row {
             scene: "parallel-square[light_scale=0.5]".into(),
             technique: technique.into(),
             light,
@@ -1331,7 +1331,28 @@ mod tests {
             extra_images: Vec::new(),
             overlays: Vec::new(),
             work: None,
+        }
+    }
+
+    #[test]
+    fn the_beyond_frame_note_names_each_technique_the_framework_answered_for() {
+        let with = |technique: &str, light: Option<usize>, pixels: f64| {
+            let mut row = sample_row(technique, light, Some(1.0));
+            row.diagnostics.push((ssm_core::BEYOND_FRAME_DIAGNOSTIC.to_owned(), pixels));
+            row
         };
+        let rows =
+            vec![with("hard", None, 1234.0), with("pcss", Some(0), 99.0), with("vssm", None, 0.0), sample_row("wedges", None, Some(1.0))];
+        let note = beyond_frame_note(&rows).unwrap();
+        assert!(note.contains("`hard` 1234"), "{note}");
+        // Per-light rows repeat the frame's; a technique that answered none, or has no such pass, is not named.
+        assert!(!note.contains("pcss") && !note.contains("vssm") && !note.contains("wedges"), "{note}");
+        assert_eq!(beyond_frame_note(&rows[2..]), None);
+    }
+
+    #[test]
+    fn rows_read_back_from_their_csv_give_the_same_csv() {
+        let row = sample_row;
         let mut rows = vec![row("hard", None, Some(3.25)), row("pcss", Some(1), None), row("pcss", None, None)];
         // Counted with pipeline statistics but not in the shaders: its reads are unknown, not 0.
         rows[0].work = Some(FrameWork {
