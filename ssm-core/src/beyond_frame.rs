@@ -75,6 +75,8 @@ pub(crate) struct BeyondFrame {
     lights: Vec<Option<LightFaces>>,
     /// One counter per light: the pixels answered in the last frame.
     answered: wgpu::Buffer,
+    /// The label of the counters' clearing, made once.
+    answered_clear_label: String,
     read_counts: ReadCounts,
     width: u32,
     height: u32,
@@ -179,6 +181,7 @@ impl BeyondFrame {
             lights.push(Some(LightFaces { maps, face_frames, group }));
         }
         Ok(Some(Self {
+            answered_clear_label: format!("{label}_answered_clear"),
             label,
             pipeline,
             gbuffer_bind_group: gbuffer.bind_group.clone(),
@@ -204,7 +207,7 @@ impl BeyondFrame {
         // The counters sum over the frame's lights: cleared at the first light that has faces
         // (the renderer renders the lights in order).
         if self.lights[..light].iter().all(Option::is_none) {
-            frame.clear_buffer(&format!("{}_answered_clear", self.label), &self.answered, 0, None);
+            frame.clear_buffer(&self.answered_clear_label, &self.answered, 0, None);
             self.read_counts.clear(frame, 0);
         }
         for (map, face_frame) in faces.maps.iter().zip(&faces.face_frames) {
