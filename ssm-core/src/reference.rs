@@ -46,7 +46,7 @@ mod traversal;
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 5;
+pub const REFERENCE_VERSION: u32 = 6;
 
 /// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
 /// more, the part is cut further or its rays traverse the BVH one by one.
@@ -433,7 +433,8 @@ impl PixelFootprint {
 pub struct Sampling {
     /// N: each of the two independent sets has N×N strata, one jittered ray each.
     pub samples_per_axis: u32,
-    /// M: a stratum where the visibility varies gets M×M jittered rays instead of its one (1: no refinement).
+    /// M: a stratum where the visibility varies is cut into M×M sub-strata with one jittered ray each,
+    /// its own ray standing for the sub-stratum it fell in (1: no refinement).
     pub refine: u32,
 }
 
@@ -662,8 +663,9 @@ impl GroundTruth {
     /// then refined where the visibility varies across the light: a stratum whose result in the
     /// other set differs from one of its four neighbours' (an edge of the visible region crosses
     /// it or passes near) is decided exactly when at most four triangles can block its rays (the
-    /// area their projection covers, `reference/coverage.rs`), and otherwise gets `refine`² fresh jittered
-    /// rays in sub-strata instead of its one.
+    /// area their projection covers, `reference/coverage.rs`), and otherwise is cut into `refine`²
+    /// sub-strata: its own ray, uniform over the stratum and so over the sub-stratum it fell in,
+    /// stands for that one, and each of the others gets a fresh jittered ray.
     /// A part of the light whose pyramid holds at most four triangles is decided exactly for both
     /// sets at once, before any ray (in the pyramid shortcuts), and its strata are neither
     /// refined nor compared as neighbours. Each set is unbiased, since which strata it refines
@@ -684,11 +686,20 @@ impl GroundTruth {
         let refine_seeds = [rng.next_u64(), rng.next_u64()];
         // The two sets share the pyramid shortcuts' gathers (the same triangles for any jitter).
         let shared = (shortcuts && point.footprint.is_none()).then(|| self.pyramid_visibility(light, point, n, &mut set_rngs, true));
-        let (strata, exact, lists, stratum_list) = match shared {
-            Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list),
+        let (strata, exact, lists, stratum_list, base_jitter) = match shared {
+            Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list, rays.jitter),
             None => {
+                // Without a footprint, visibility_of_rays draws each stratum's jitter and nothing
+                // else, in this order: the same draws from a copy give where each ray went.
+                let base_jitter = set_rngs
+                    .iter()
+                    .map(|rng| {
+                        let mut rng = rng.clone();
+                        (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()
+                    })
+                    .collect();
                 let strata = set_rngs.iter_mut().map(|rng| self.visibility_of_rays(light, point, n, rng, shortcuts)).collect();
-                (strata, vec![false; (n * n) as usize], Vec::new(), vec![NO_LIST; (n * n) as usize])
+                (strata, vec![false; (n * n) as usize], Vec::new(), vec![NO_LIST; (n * n) as usize], base_jitter)
             }
         };
         let refine = if point.footprint.is_some() { 1 } else { sampling.refine.max(1) };
@@ -738,9 +749,18 @@ impl GroundTruth {
                 let mut sub_rng = SplitMix64::for_pixel(refine_seeds[k], index as u64);
                 jitter.clear();
                 jitter.extend((0..sub_rays).map(|_| Vec2::new(sub_rng.next_f32(), sub_rng.next_f32())));
-                let visible = window
+                // The stratum's own ray, uniform over the stratum, is uniform over the sub-stratum
+                // it fell in: it stands for that one, and the others get fresh rays.
+                let kept_cell = {
+                    let cell = (base_jitter[k][index] * refine as f32).floor().clamp(Vec2::ZERO, Vec2::splat((refine - 1) as f32));
+                    cell.y as usize * refine as usize + cell.x as usize
+                };
+                let visible = value as usize
+                    + window
                     .jittered(&jitter, refine)
-                    .filter(|at| match candidates {
+                    .enumerate()
+                    .filter(|(cell, _)| *cell != kept_cell)
+                    .filter(|(_, at)| match candidates {
                         Some((origin, candidates)) => !self.blocked_by(origin, light.point(at.x, at.y), candidates),
                         None => self.light_sample_visible(light, point, *at, shortcuts.then_some(&mut recent)),
                     })
