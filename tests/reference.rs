@@ -397,7 +397,8 @@ fn the_default_estimate_is_unbiased_in_a_penumbra_of_many_triangles() {
     };
     let mut tested = 0;
     for step in 0..60 {
-        let point = SurfacePoint { position: Vec3::new(-1.2 + step as f32 * 0.04, 0.0, 0.13), normal: Vec3::Y, closed: false, footprint: None };
+        let point =
+            SurfacePoint { position: Vec3::new(-1.2 + step as f32 * 0.04, 0.0, 0.13), normal: Vec3::Y, closed: false, footprint: None };
         let rough = truth.visibility(&light, &point, 16, &mut ssm_core::reference::SplitMix64::for_pixel(5, step));
         if !(0.1..0.9).contains(&rough) {
             continue;
@@ -412,7 +413,10 @@ fn the_default_estimate_is_unbiased_in_a_penumbra_of_many_triangles() {
             .unzip();
         let ((estimate, estimate_error), (exact, exact_error)) = (mean_and_error(&estimates), mean_and_error(&definition));
         let z = (estimate - exact) / estimate_error.hypot(exact_error);
-        println!("x = {:.2}: estimate {estimate:.5} ± {estimate_error:.5}, 32² rays {exact:.5} ± {exact_error:.5}: z = {z:.2}", point.position.x);
+        println!(
+            "x = {:.2}: estimate {estimate:.5} ± {estimate_error:.5}, 32² rays {exact:.5} ± {exact_error:.5}: z = {z:.2}",
+            point.position.x
+        );
         assert!(z.abs() < 5.0, "x = {}: the estimate's mean {estimate} is {z:.1} standard errors from {exact}", point.position.x);
         tested += 1;
     }

@@ -20,7 +20,7 @@ struct LightFrame {
     projection: vec4<f32>,
     // x: the diagonal of the scene's bounding box, the scale of scene-relative settings; y: 1 when
     // a closed mesh separates the whole light from the camera (ssm-core's LightFrame::sealed);
-    // z, w: unused.
+    // z: 1 when a closed mesh holds the light (LightFrame::enclosed); w: unused.
     scene: vec4<f32>,
     // xyz: the light's linear RGB colour (the composite shading's; visibility ignores it); w: unused.
     colour: vec4<f32>,
@@ -66,6 +66,11 @@ fn in_front_of_light(frame: LightFrame, world: vec3<f32>) -> bool {
 // it (LightFrame::sealed in ssm-core).
 fn light_sealed(frame: LightFrame) -> bool {
     return frame.scene.y > 0.5;
+}
+
+// True when a closed mesh holds the light: an interior (LightFrame::enclosed in ssm-core).
+fn light_enclosed(frame: LightFrame) -> bool {
+    return frame.scene.z > 0.5;
 }
 
 // True when the whole light lies strictly behind the plane through `world` with normal `normal`

@@ -191,6 +191,7 @@ impl GpuScene {
             .iter()
             .map(|light| LightFrame {
                 sealed: scene.separates_light_from(&closed, light, scene.camera.position),
+                enclosed: scene.encloses_light(&closed, light),
                 ..LightFrame::fit_to_geometry(light, &bounds, &receivers, &casting_points, &triangle_corners)
             })
             .collect();

@@ -49,6 +49,12 @@ pub struct LightFrame {
     /// depth and a filter's taps find it lit. Set by [`GpuScene`](crate::GpuScene), which knows
     /// the camera; false from the `fit` functions.
     pub sealed: bool,
+    /// A closed mesh holds the light ([`ssm_scene::Scene::encloses_light`]): an interior, whose
+    /// walls, floor and ceiling beside the light lie close to its plane in every map, inside the
+    /// search regions of techniques that search through the nearest depth (pvsm's blocker search
+    /// keeps only texels in each receiver's light cone there). Set by
+    /// [`GpuScene`](crate::GpuScene); false from the `fit` functions.
+    pub enclosed: bool,
 }
 
 impl LightFrame {
@@ -141,7 +147,17 @@ impl LightFrame {
         // nearly constant relative to depth, so a near plane a million times closer than the far
         // one still orders surfaces at the far end correctly. Depth tests use `Greater` for nearest.
         let projection = glam::camera::rh::proj::directx::perspective(fov_y, tan_half.x / tan_half.y, far, near);
-        Self { light: *light, view, projection, tan_half, near, far, scene_diagonal: bounds.size().length(), sealed: false }
+        Self {
+            light: *light,
+            view,
+            projection,
+            tan_half,
+            near,
+            far,
+            scene_diagonal: bounds.size().length(),
+            sealed: false,
+            enclosed: false,
+        }
     }
 
     /// Size in texels, along the map's two axes, of the part of a `map_size`²
@@ -343,7 +359,8 @@ pub struct LightFrameUniform {
     /// tan half u, tan half v, near, far.
     pub projection: [f32; 4],
     /// The scene's bounding-box diagonal; y: 1 when the light is sealed from the camera
-    /// ([`LightFrame::sealed`]), else 0; z, w unused.
+    /// ([`LightFrame::sealed`]), else 0; z: 1 when a closed mesh holds the light
+    /// ([`LightFrame::enclosed`]), else 0; w unused.
     pub scene: [f32; 4],
     /// The light's linear RGB colour; w unused.
     pub colour: [f32; 4],
@@ -360,7 +377,7 @@ impl From<&LightFrame> for LightFrameUniform {
             v_axis: light.v_axis.extend(light.half_size.y).to_array(),
             normal: light.normal().extend(light.area()).to_array(),
             projection: [frame.tan_half.x, frame.tan_half.y, frame.near, frame.far],
-            scene: [frame.scene_diagonal, if frame.sealed { 1.0 } else { 0.0 }, 0.0, 0.0],
+            scene: [frame.scene_diagonal, if frame.sealed { 1.0 } else { 0.0 }, if frame.enclosed { 1.0 } else { 0.0 }, 0.0],
             colour: light.colour.extend(0.0).to_array(),
         }
     }

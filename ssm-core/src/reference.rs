@@ -757,14 +757,14 @@ impl GroundTruth {
                 };
                 let visible = value as usize
                     + window
-                    .jittered(&jitter, refine)
-                    .enumerate()
-                    .filter(|(cell, _)| *cell != kept_cell)
-                    .filter(|(_, at)| match candidates {
-                        Some((origin, candidates)) => !self.blocked_by(origin, light.point(at.x, at.y), candidates),
-                        None => self.light_sample_visible(light, point, *at, shortcuts.then_some(&mut recent)),
-                    })
-                    .count();
+                        .jittered(&jitter, refine)
+                        .enumerate()
+                        .filter(|(cell, _)| *cell != kept_cell)
+                        .filter(|(_, at)| match candidates {
+                            Some((origin, candidates)) => !self.blocked_by(origin, light.point(at.x, at.y), candidates),
+                            None => self.light_sample_visible(light, point, *at, shortcuts.then_some(&mut recent)),
+                        })
+                        .count();
                 sum += visible as f32 / sub_rays as f32;
             }
             *set = sum / (n * n) as f32;

@@ -220,6 +220,44 @@ impl Scene {
         self.meshes.iter().map(|mesh| Adjacency::of(mesh).is_closed()).collect()
     }
 
+    /// Each placed instance of a closed mesh (`closed`: [`Scene::closed_meshes`]): its triangles in
+    /// world space and their bounds.
+    fn closed_instances<'a>(&'a self, closed: &'a [bool]) -> impl Iterator<Item = (Vec<[Vec3; 3]>, Aabb)> + 'a {
+        self.instances.iter().filter(|i| closed.get(i.mesh).copied().unwrap_or(false)).filter_map(|instance| {
+            let mesh = self.meshes.get(instance.mesh)?;
+            let triangles: Vec<[Vec3; 3]> =
+                mesh.triangles().map(|t| t.map(|k| instance.transform.transform_point3(mesh.positions[k as usize]))).collect();
+            let mut bounds = Aabb::EMPTY;
+            for corner in triangles.iter().flatten() {
+                bounds.extend(*corner);
+            }
+            Some((triangles, bounds))
+        })
+    }
+
+    /// True when a placed closed mesh (`closed`: [`Scene::closed_meshes`]) holds the light's
+    /// centre, taken a ten-thousandth of the mesh's size off the light along its normal (the side
+    /// it emits to): an interior, such as a closed room lit from its wall or ceiling. Surfaces
+    /// then surround the light on every side of its hemisphere, and those beside it, which can
+    /// hide nothing from a receiver, lie close to its plane in every map it renders. Decided by
+    /// the parity of three segments' crossings to points outside the mesh (two must agree).
+    #[must_use]
+    pub fn encloses_light(&self, closed: &[bool], light: &RectLight) -> bool {
+        self.closed_instances(closed).any(|(triangles, bounds)| {
+            let size = bounds.size().length().max(f32::MIN_POSITIVE);
+            let nudge = size * 1e-4;
+            let emitting = light.centre + light.normal() * nudge;
+            if !(emitting.cmpge(bounds.min).all() && emitting.cmple(bounds.max).all()) {
+                return false;
+            }
+            // Segments to three points well outside the bounds, in directions no box edge or
+            // axis-aligned face runs along: two of three must cross an odd number of times.
+            let outside = [Vec3::new(0.63, 0.51, 0.59), Vec3::new(-0.71, 0.37, -0.6), Vec3::new(0.21, -0.86, 0.46)]
+                .map(|direction| emitting + direction.normalize() * size * 2.0);
+            outside.iter().filter(|&&far| segment_crossings(&triangles, emitting, far).is_some_and(|count| count % 2 == 1)).count() >= 2
+        })
+    }
+
     /// True when one placed closed mesh (`closed`: [`Scene::closed_meshes`]) separates the
     /// whole of `light` from `eye`: the light sealed in a box seen from outside, or a camera
     /// inside a closed room whose light is outside it. An opaque closed surface then stands
@@ -241,14 +279,7 @@ impl Scene {
     pub fn separates_light_from(&self, closed: &[bool], light: &RectLight, eye: Vec3) -> bool {
         let corners = [light.point(-1.0, -1.0), light.point(1.0, -1.0), light.point(1.0, 1.0), light.point(-1.0, 1.0)];
         let light_points: Vec<Vec3> = if light.is_point() { vec![light.centre] } else { [&[light.centre][..], &corners[..]].concat() };
-        self.instances.iter().filter(|i| closed.get(i.mesh).copied().unwrap_or(false)).any(|instance| {
-            let Some(mesh) = self.meshes.get(instance.mesh) else { return false };
-            let triangles: Vec<[Vec3; 3]> =
-                mesh.triangles().map(|t| t.map(|k| instance.transform.transform_point3(mesh.positions[k as usize]))).collect();
-            let mut bounds = Aabb::EMPTY;
-            for corner in triangles.iter().flatten() {
-                bounds.extend(*corner);
-            }
+        self.closed_instances(closed).any(|(triangles, bounds)| {
             let nudge = bounds.size().length().max(f32::MIN_POSITIVE) * 1e-4;
             let inside = |p: Vec3| p.cmpge(bounds.min - nudge).all() && p.cmple(bounds.max + nudge).all();
             // An odd count needs one end inside the mesh, so inside its bounds.
@@ -406,6 +437,25 @@ mod tests {
             .unwrap_or_else(|| panic!("light"));
         assert!(!scene.separates_light_from(&closed, &on_top, outside_eye), "lying on the top");
         assert!(scene.separates_light_from(&closed, &on_top, Vec3::new(-0.5, -0.5, 0.5)), "lying on the top, eye inside");
+    }
+
+    /// A light inside a closed box is enclosed whatever the eye (flush on its ceiling and facing
+    /// in, too); one outside it, lying on its top facing out, or under an open quad is not.
+    #[test]
+    fn a_closed_mesh_encloses_a_light_inside_it() {
+        let light = |centre: Vec3, normal: Vec3| {
+            let along = if normal.x == 0.0 { Vec3::X } else { Vec3::Z };
+            RectLight::try_facing(centre, normal, along, glam::Vec2::splat(0.5), 1.0).unwrap_or_else(|| panic!("light"))
+        };
+        let inside = light(Vec3::new(0.1, 0.5, -0.2), -Vec3::Y);
+        let scene = boxed(Vec3::ZERO, inside);
+        let closed = scene.closed_meshes();
+        assert!(scene.encloses_light(&closed, &inside), "inside");
+        assert!(scene.encloses_light(&closed, &light(Vec3::new(0.3, 1.0, 0.2), -Vec3::Y)), "flush on the ceiling, facing in");
+        assert!(scene.encloses_light(&closed, &light(Vec3::new(-1.0, 0.2, 0.0), Vec3::X)), "on a wall, facing in");
+        assert!(!scene.encloses_light(&closed, &light(Vec3::new(0.3, 1.0, 0.2), Vec3::Y)), "on the top, facing out");
+        assert!(!scene.encloses_light(&closed, &light(Vec3::new(0.0, 4.0, 0.0), -Vec3::Y)), "above the box, under the open quad");
+        assert!(!scene.encloses_light(&[false, false], &inside), "the box not closed");
     }
 
     /// Three closed boxes in a row, one mesh: a light whose centre and corners all lie inside

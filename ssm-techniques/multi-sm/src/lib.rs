@@ -198,7 +198,7 @@ fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<SampleFra
                 .map(|(k, s)| {
                     let light = frame.light;
                     let point_light = RectLight { centre: light.point(s.x, s.y), half_size: Vec2::ZERO, ..light };
-                    let sample = LightFrame { sealed: frame.sealed, ..LightFrame::fit(&point_light, &bounds) };
+                    let sample = LightFrame { sealed: frame.sealed, enclosed: frame.enclosed, ..LightFrame::fit(&point_light, &bounds) };
                     let buffer = wgpu::util::DeviceExt::create_buffer_init(
                         device,
                         &wgpu::util::BufferInitDescriptor {
