@@ -285,7 +285,8 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     // or the region is too small for a texel's area to count (a point light).
     if (cone_search && count == 0.0 && coarse_count > 0.0 && !whole) {
         // 1. The same samples over regions a quarter as wide each time, centred on the point: the
-        //    occluders straight above it, which a region spanning the whole map samples too sparsely.
+        //    occluders straight above it, whose cones the region's n×n grid (the region reaching to
+        //    the walls beside the light) samples too sparsely.
         var shrink = 0.25;
         for (var attempt = 0u; attempt < RETRY_REGIONS && count == 0.0; attempt++) {
             let found = cone_samples(uvd, search * shrink, n, receiver, fine_tolerance, 0.5 / base_size);
@@ -341,9 +342,9 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     if (cone_search && count > 0.0 && !whole && !coarse_stands_in) {
         // 4. Every texel that can occlude the point lies in the light's cone at its depth, no
         //    nearer than the nearest blocker found, so inside the region through that depth: where
-        //    it is less than half as wide as the region sampled (a region through a wall beside the
-        //    light spans the whole map), the same samples over it, up to twice, estimate the same
-        //    average more densely.
+        //    it is less than half as wide as the region sampled (the region through a wall beside the
+        //    light is many times wider than the occluders' cones), the same samples over it, up to
+        //    twice, estimate the same average more densely.
         for (var refinement = 0u; refinement < 2u; refinement++) {
             let implied = light_half_extent_uv(frame, 0.98 * nearest_found, d);
             if (any(implied >= 0.5 * sampled_extent)) {
