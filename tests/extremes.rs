@@ -61,21 +61,21 @@ const HARD_MUST_FAIL: &[&str] =
 /// pixels is in a visible penumbra (between 0.02 and 0.98) in the ground truth.
 const PENUMBRA_SHARE: f32 = 0.01;
 
-/// (technique, scene, what is wrong): failures this matrix finds that the workspace has not fixed
-/// yet. Each is reported when the test runs and must still fail: one that passes fails the test
-/// until its line is removed. They are bugs or missing features of the implementation, not limits
-/// of the papers (those are `KnownLimit`s, declared by the technique with the paper's reason).
+/// The interiors of the matrix (a closed mesh holds the light), where pvsm must do no worse than
+/// pcss.
+const INTERIORS: &[&str] = &["room lit from a wall over a table", "corridor lit from its ceiling", "light inside a closed room"];
+
 /// Why pcss is no better than hard shadows in the corridor, where either shadows: the walls rising
 /// from the floor lie in front of the floor's plane inside its filter, though not between the floor
 /// and the light, and darken the floor along its junctions with them (its error heatmap). On the
 /// truth's umbra and penumbra alone it beats hard beyond the noise (`ssm compare` on the corridor's
 /// manifest).
-/// The interiors of the matrix (a closed mesh holds the light), where pvsm must do no worse than
-/// pcss.
-const INTERIORS: &[&str] = &["room lit from a wall over a table", "corridor lit from its ceiling", "light inside a closed room"];
-
 const CORRIDOR_WALLS: &str = "false shadows along the floor-wall junctions: the walls lie in front of the floor's plane inside the filter";
 
+/// (technique, scene, what is wrong): failures this matrix finds that the workspace has not fixed
+/// yet. Each is reported when the test runs and must still fail: one that passes fails the test
+/// until its line is removed. They are bugs or missing features of the implementation, not limits
+/// of the papers (those are `KnownLimit`s, declared by the technique with the paper's reason).
 const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     // The light frame stops at 84 degrees off the light's normal: past it the framework answers
     // with a hard shadow from the light's centre (LightView::Frame, ssm-core's beyond_frame.rs),

@@ -66,8 +66,6 @@ const MIN_TILE_SIZE: f32 = 8.0;
 // pixel pays for it, lit or not: a coarser level only makes the test more conservative).
 const DETECTION_TEXELS: f32 = 4.0;
 
-// Shadow-map coordinates where the camera ray through `pixel` meets the pixel's tangent plane;
-// w = 0 where it does not.
 // Whether a texel or block centred on `uv`, `slack` from its centre to its edges, at light depth
 // `depth` (a block's nearest) can hold a point between the receiver at `uvd` and the light: the
 // light seen from the receiver crosses the plane at that depth in the rectangle uvd.xy ± the
@@ -110,6 +108,13 @@ fn cone_samples(uvd: vec3<f32>, extent: vec2<f32>, n: u32, receiver: TapPlane, t
     return found;
 }
 
+// The size in texels of level `level` of the low-resolution map's mip chain, from the base's:
+// textureDimensions with a level argument reads the base level's size on lavapipe (Mesa 22.3), and
+// loads past a level's edge return 0.
+fn low_res_level_size(level: u32) -> vec2<f32> {
+    return vec2<f32>(max(textureDimensions(low_res_map, 0) >> vec2<u32>(level), vec2<u32>(1u)));
+}
+
 // Most blocks the descent follows per level of the min-depth chain.
 const DESCENT_BLOCKS: u32 = 16u;
 // Regions the retry samples when the region's samples found no blocker: each a quarter of the last.
@@ -117,7 +122,7 @@ const RETRY_REGIONS: u32 = 6u;
 
 // Adds `block` (texel x, y and its nearest depth) to the first `count` of `blocks`, or, when they
 // are DESCENT_BLOCKS, in place of the farthest if it is nearer; whether a block was left out.
-fn keep_nearest(blocks: ptr<function, array<vec3<f32>, 16>>, count: ptr<function, u32>, block: vec3<f32>) -> bool {
+fn keep_nearest(blocks: ptr<function, array<vec3<f32>, DESCENT_BLOCKS>>, count: ptr<function, u32>, block: vec3<f32>) -> bool {
     if (*count < DESCENT_BLOCKS) {
         (*blocks)[*count] = block;
         *count += 1u;
@@ -135,6 +140,8 @@ fn keep_nearest(blocks: ptr<function, array<vec3<f32>, 16>>, count: ptr<function
     return true;
 }
 
+// Shadow-map coordinates where the camera ray through `pixel` meets the pixel's tangent plane;
+// w = 0 where it does not.
 fn plane_uv(point: ScreenPoint, pixel: vec2<f32>) -> vec3<f32> {
     let hit = tangent_point(point.position, point.normal, pixel);
     if (hit.w == 0.0 || !in_front_of_light(frame, hit.xyz)) {
@@ -191,9 +198,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = max(settings.blocker_kernel, 1u);
     let span = max(2.0 * search * base_size, vec2<f32>(1.0));
     let level = min(u32(max(ceil(log2(max(span.x, span.y) / DETECTION_TEXELS)), 0.0)), levels - 1u);
-    // The level's size from the base's: textureDimensions with a level argument reads the base
-    // level's size on lavapipe (Mesa 22.3), and loads past a level's edge return 0.
-    let level_size = vec2<f32>(max(textureDimensions(low_res_map, 0) >> vec2<u32>(level), vec2<u32>(1u)));
+    let level_size = low_res_level_size(level);
     let texel = shadow_texel_size(frame, low_res_map, d);
     // A texel's nearest depth of the receiver itself is its tangent plane's at the texel's nearest
     // corner (and a conservative map adds up to a texel): the plane's change across half a texel,
@@ -223,7 +228,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     var coarse_count = 0.0;
     // The detection's blocks (the nearest DESCENT_BLOCKS), where the descent starts, and whether
     // any was left out.
-    var blocks: array<vec3<f32>, 16>;
+    var blocks: array<vec3<f32>, DESCENT_BLOCKS>;
     var block_count = 0u;
     var blocks_left_out = false;
     // Area-weighted sums over the full-resolution level: at level 0 the detection reads those very
@@ -309,9 +314,9 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         var left_out = blocks_left_out;
         while (descent_level > 0u && block_count > 0u) {
             descent_level -= 1u;
-            let size = vec2<f32>(max(textureDimensions(low_res_map, 0) >> vec2<u32>(descent_level), vec2<u32>(1u)));
+            let size = low_res_level_size(descent_level);
             let level_tolerance = bias + min(plane_change(point, uvd.xy, d, 0.5 / size), f32(1u << descent_level) * texel);
-            var children: array<vec3<f32>, 16>;
+            var children: array<vec3<f32>, DESCENT_BLOCKS>;
             var child_count = 0u;
             for (var b = 0u; b < block_count; b++) {
                 for (var c = 0u; c < 4u; c++) {
@@ -339,6 +344,12 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         coarse_stands_in = count == 0.0 && left_out;
     }
+    if (coarse_stands_in) {
+        // 3. No blocker found but the detection saw blocks (the paper's search), or the descent
+        //    left out blocks that may have held them: the detection's nearest depths stand in.
+        sum = coarse_sum;
+        count = coarse_count;
+    }
     if (cone_search && count > 0.0 && !whole && !coarse_stands_in) {
         // 4. Every texel that can occlude the point lies in the light's cone at its depth, no
         //    nearer than the nearest blocker found, so inside the region through that depth: where
@@ -361,11 +372,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             sampled_extent = implied;
         }
     }
-    if (coarse_stands_in) {
-        // 3. Blocks left out may have held the blockers: the detection's nearest depths stand in.
-        sum = coarse_sum;
-        count = coarse_count;
-    }
+
     if (count == 0.0 && settings.prediction != 3u) {
         // The conservative map guarantees no occluder was missed: fully lit (Sec. 5.2).
         kernel.flags = KERNEL_LIT;

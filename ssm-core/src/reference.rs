@@ -690,12 +690,14 @@ impl GroundTruth {
             Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list, rays.jitter),
             None => {
                 // Without a footprint, visibility_of_rays draws each stratum's jitter and nothing
-                // else, in this order: the same draws from a copy give where each ray went.
+                // else, in this order: the same draws from a copy give where each ray went, which
+                // refinement needs. A footprint is not refined.
                 let base_jitter = set_rngs
                     .iter()
                     .map(|rng| {
                         let mut rng = rng.clone();
-                        (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()
+                        let count = if point.footprint.is_none() { n * n } else { 0 };
+                        (0..count).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()
                     })
                     .collect();
                 let strata = set_rngs.iter_mut().map(|rng| self.visibility_of_rays(light, point, n, rng, shortcuts)).collect();
