@@ -29,24 +29,32 @@
 //! node's eight children against the pyramid at once, a ray its eight boxes.
 //! `GroundTruth::visibility_per_ray` is the plain definition, which a test
 //! compares it with.
+//!
+//! The estimate goes further where the occluders are convex pieces (a
+//! connected part of a mesh that is a convex solid or a flat convex polygon:
+//! a box, a sphere, a leaf card; `pieces`): from a ray origin, each hides one
+//! convex polygon of the light, so the share of a part of the light that a
+//! few of them hide is computed exactly, in the light's plane, for the whole
+//! light or its quarters, with no ray and no noise (`coverage`).
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use glam::{UVec2, Vec2, Vec3, Vec3A};
+use glam::{DVec2, UVec2, Vec2, Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::cwbvh::builder::{build_cwbvh, build_cwbvh_from_tris};
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 use ssm_scene::{RectLight, Scene};
 
 mod coverage;
+mod pieces;
 mod traversal;
 
 /// Version of the reference algorithm, part of every cache key: bump it when
 /// the results of the same inputs change.
-pub const REFERENCE_VERSION: u32 = 6;
+pub const REFERENCE_VERSION: u32 = 7;
 
 /// Most triangles gathered from the BVH for the pyramid from a point to (part of) the light; with
 /// more, the part is cut further or its rays traverse the BVH one by one.
@@ -139,8 +147,11 @@ struct PixelRays<'a> {
     closed: bool,
     n: u32,
     /// Per set of rays, the jitter of stratum (i, j) at j·n + i. The sets share the pyramids and
-    /// their triangles, which do not depend on the jitter.
+    /// their triangles, which do not depend on the jitter. Empty until a ray needs it
+    /// ([`PixelRays::draw_jitter`]: a pixel decided exactly casts none).
     jitter: Vec<Vec<Vec2>>,
+    /// The generators the jitter is drawn from, one per set, until it is drawn.
+    jitter_rngs: Vec<SplitMix64>,
     recent: RecentBlockers,
     /// Per set, each stratum's visible fraction at j·n + i: its ray's answer (0 or 1), or the
     /// exact fraction where a shortcut decided the stratum's whole part of the light.
@@ -156,6 +167,37 @@ struct PixelRays<'a> {
     /// exactly, instead of its rays (the estimate's sets); off, every stratum keeps its ray's
     /// answer, as [`GroundTruth::visibility`] defines it.
     exact_parts: bool,
+    /// Per ray origin (`origins`), what the occluders in its pyramid to the whole light hide
+    /// ([`GroundTruth::project_occluders`]): `None` until a part of the light needs it.
+    projected: [Option<Option<ProjectedOccluders>>; 2],
+    /// The polygons of `projected` that may meet the part being decided (scratch).
+    picked: Vec<usize>,
+}
+
+/// What the occluders in the pyramid from one ray origin to the whole light hide: per occluder
+/// (a convex piece or a triangle), its central projection onto the light's plane, a convex
+/// polygon in light coordinates, and its bounding box.
+#[derive(Default)]
+struct ProjectedOccluders {
+    polygons: Vec<Vec<DVec2>>,
+    boxes: Vec<[DVec2; 2]>,
+}
+
+/// With at most this many occluder polygons meeting a part of the light, its visible share is
+/// computed exactly (inclusion–exclusion over them: `coverage`).
+const EXACT_POLYGONS: usize = 6;
+/// Most triangles outside the convex pieces, and most pieces, in the pyramid from a point to the
+/// whole light for its occluders to be projected once ([`GroundTruth::project_occluders`]); with
+/// more, the shortcuts go on with triangles.
+const LOOSE_LIMIT: usize = 16;
+const PIECE_LIMIT: usize = 64;
+
+/// What the projected occluders say of a part of the light.
+enum PolygonAnswer {
+    /// Its exact visible fraction.
+    Exact(f32),
+    /// More than [`EXACT_POLYGONS`] occluders meet it.
+    TooMany,
 }
 
 /// A square part of the light in its coordinates ([-1, 1]² is the whole light): the light, or one
@@ -201,7 +243,75 @@ const COVERAGE_SNAP: f64 = 1e-5;
 /// No candidate list: [`PixelRays::stratum_list`] of a stratum whose rays go through the BVH.
 const NO_LIST: u32 = u32::MAX;
 
+/// The visible fraction of the part `window` of the light ([min, max], light coordinates), from
+/// the occluders `projected` from the part's ray origin: lit when none meets it, dark when one
+/// holds it, else the share that their union leaves, when at most [`EXACT_POLYGONS`] meet it.
+/// `extra`: one more polygon hiding part of it (the part behind a solid's tangent plane).
+/// `picked`: scratch.
+fn decide_by_polygons(
+    projected: &ProjectedOccluders,
+    window: [DVec2; 2],
+    picked: &mut Vec<usize>,
+    extra: Option<&[DVec2]>,
+) -> PolygonAnswer {
+    picked.clear();
+    for (index, bounds) in projected.boxes.iter().enumerate() {
+        if bounds[0].cmpge(window[1]).any() || window[0].cmpge(bounds[1]).any() {
+            continue;
+        }
+        if coverage::holds_rectangle(&projected.polygons[index], window) {
+            return PolygonAnswer::Exact(0.0);
+        }
+        picked.push(index);
+    }
+    let count = picked.len() + usize::from(extra.is_some());
+    if count > EXACT_POLYGONS {
+        return PolygonAnswer::TooMany;
+    }
+    let mut polygons: [&[DVec2]; EXACT_POLYGONS] = [&[]; EXACT_POLYGONS];
+    for (slot, index) in polygons.iter_mut().zip(picked.iter()) {
+        *slot = &projected.polygons[*index];
+    }
+    if let Some(extra) = extra {
+        polygons[picked.len()] = extra;
+    }
+    let covered = coverage::covered_share_of_projected(&polygons[..count], window);
+    PolygonAnswer::Exact(snap_visible(1.0 - covered))
+}
+
+/// An exactly computed visible fraction, snapped to 0 or 1 within [`COVERAGE_SNAP`]: within
+/// rounding of all or nothing (two triangles sharing an edge, each clipped on its own, sum to the
+/// whole rectangle within about 1e-6 when seen at grazing angles), umbra and lit stay exact, at a
+/// cost of at most 1e-5 of a stratum.
+fn snap_visible(visible: f64) -> f32 {
+    if visible < COVERAGE_SNAP {
+        0.0
+    } else if visible > 1.0 - COVERAGE_SNAP {
+        1.0
+    } else {
+        visible as f32
+    }
+}
+
+/// Whether the box `[min, max]` lies wholly beyond the plane `normal · p = offset` (on the side
+/// the normal points to).
+fn box_beyond([min, max]: [Vec3; 2], normal: Vec3, offset: f32) -> bool {
+    // The box's corner least far along the normal.
+    let nearest = Vec3::select(normal.cmpge(Vec3::ZERO), min, max);
+    normal.dot(nearest) > offset
+}
+
 impl PixelRays<'_> {
+    /// Draws every stratum's jitter, per set in the order visibility_per_ray draws it, if not yet
+    /// drawn.
+    fn draw_jitter(&mut self) {
+        if self.jitter.is_empty() {
+            let count = self.n * self.n;
+            self.jitter =
+                self.jitter_rngs.iter_mut().map(|rng| (0..count).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()).collect();
+        }
+    }
+
     /// Whether `sample` lies on the front side of the tangent plane (rays to it leave from `origins[0]`).
     fn in_front(&self, sample: Vec3) -> bool {
         self.plane.1.dot(sample - self.plane.0) >= 0.0
@@ -282,6 +392,63 @@ pub struct GroundTruth {
     cache: ReferenceCache,
     /// How [`GroundTruth::trace`] traces each pixel.
     traversal: Traversal,
+    /// The scene's convex pieces and its other triangles, each in a BVH of its own, for the exact
+    /// share of the light a few occluders hide; `None` when no placed mesh is a convex piece.
+    occluders: Option<OccluderLayer>,
+}
+
+/// The scene's occluders as the estimate's exact parts read them: every connected part of a placed
+/// mesh that is a convex piece (`pieces`), one polygon from a point, and every other triangle.
+struct OccluderLayer {
+    pieces: Vec<pieces::ConvexPiece>,
+    /// The pieces' bounds (slot k holds piece `piece_bvh.primitive_indices[k]`).
+    piece_bvh: CwBvh,
+    piece_nodes: traversal::DecodedBvh,
+    /// The triangles not in a piece (indices into `GroundTruth::triangles`), and their BVH
+    /// (slot k holds `loose[loose_bvh.primitive_indices[k]]`); `None` when there are none.
+    loose: Vec<u32>,
+    loose_bvh: Option<(CwBvh, traversal::DecodedBvh)>,
+}
+
+impl OccluderLayer {
+    /// The layer of `scene`'s triangles (`keys`: each traced triangle's instance and its index in
+    /// the instance's mesh), or `None` when no part of a placed mesh is a convex piece.
+    fn of(scene: &Scene, triangles: &[Triangle], keys: &[(u32, u32)]) -> Option<Self> {
+        let mut parts: Vec<Option<pieces::MeshParts>> = (0..scene.meshes.len()).map(|_| None).collect();
+        // Each convex part of each instance with a triangle traced becomes a piece (a transform
+        // that flattens every triangle of a part leaves none, and nothing to hide the light).
+        let mut pieces = Vec::new();
+        let mut piece_of_part: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        let mut loose = Vec::new();
+        for (slot, (instance, triangle)) in keys.iter().enumerate() {
+            let placed = &scene.instances[*instance as usize];
+            let mesh_parts = parts[placed.mesh].get_or_insert_with(|| pieces::MeshParts::of(&scene.meshes[placed.mesh]));
+            let part = mesh_parts.part_of_triangle[*triangle as usize];
+            match &mesh_parts.shapes[part as usize] {
+                Some(shape) => {
+                    piece_of_part.entry((*instance, part)).or_insert_with(|| {
+                        pieces.push(pieces::ConvexPiece::placed(shape, placed.transform));
+                        pieces.len() as u32 - 1
+                    });
+                }
+                None => loose.push(slot as u32),
+            }
+        }
+        if pieces.is_empty() {
+            return None;
+        }
+        let loose_bvh = (!loose.is_empty()).then(|| {
+            let loose_triangles: Vec<Triangle> = loose.iter().map(|t| triangles[*t as usize]).collect();
+            let bvh = build_cwbvh_from_tris(&loose_triangles, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
+            let nodes = traversal::DecodedBvh::new(&bvh);
+            (bvh, nodes)
+        });
+        let boxes: Vec<obvhs::aabb::Aabb> =
+            pieces.iter().map(|piece| obvhs::aabb::Aabb::new(Vec3A::from(piece.bounds[0]), Vec3A::from(piece.bounds[1]))).collect();
+        let piece_bvh = build_cwbvh(&boxes, obvhs::BvhBuildParams::medium_build(), &mut Duration::default());
+        let piece_nodes = traversal::DecodedBvh::new(&piece_bvh);
+        Some(Self { pieces, piece_bvh, piece_nodes, loose, loose_bvh })
+    }
 }
 
 /// How [`GroundTruth::trace`] traces a pixel's rays. Both give the same visibility, ray for ray
@@ -307,10 +474,23 @@ pub struct ReferenceCache {
 
 /// The triangles the ground truth traces: every world triangle with a non-zero area.
 fn traced_triangles(scene: &Scene) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    traced_triangles_by_instance(scene).map(|(_, corners)| corners)
+}
+
+/// [`traced_triangles`], each with the index of the instance it belongs to and its own index in
+/// that instance's mesh (the same corners as [`Scene::world_triangles`], in its order).
+fn traced_triangles_by_instance(scene: &Scene) -> impl Iterator<Item = ((u32, u32), [Vec3; 3])> + '_ {
     scene
-        .world_triangles()
-        .filter(|t| (t.corners[1] - t.corners[0]).cross(t.corners[2] - t.corners[0]).length_squared() > 0.0)
-        .map(|t| t.corners)
+        .instances
+        .iter()
+        .enumerate()
+        .filter_map(|(index, instance)| scene.meshes.get(instance.mesh).map(|mesh| (index as u32, instance, mesh)))
+        .flat_map(|(index, instance, mesh)| {
+            mesh.triangles()
+                .enumerate()
+                .map(move |(k, t)| ((index, k as u32), t.map(|i| instance.transform.transform_point3(mesh.positions[i as usize]))))
+        })
+        .filter(|(_, t)| (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0)
 }
 
 impl ReferenceCache {
@@ -511,9 +691,10 @@ impl GroundTruth {
     /// Builds the BVH over every triangle of `scene` (degenerate ones skipped).
     #[must_use]
     pub fn new(scene: &Scene) -> Self {
-        let triangles: Vec<Triangle> = traced_triangles(scene)
-            .map(|[v0, v1, v2]| Triangle { v0: Vec3A::from(v0), v1: Vec3A::from(v1), v2: Vec3A::from(v2) })
-            .collect();
+        let (keys, triangles): (Vec<(u32, u32)>, Vec<Triangle>) = traced_triangles_by_instance(scene)
+            .map(|(key, [v0, v1, v2])| (key, Triangle { v0: Vec3A::from(v0), v1: Vec3A::from(v1), v2: Vec3A::from(v2) }))
+            .unzip();
+        let occluders = OccluderLayer::of(scene, &triangles, &keys);
         let normals = triangles
             .iter()
             .map(|t| {
@@ -533,6 +714,7 @@ impl GroundTruth {
             surface_offset: extent * 1e-5,
             cache: ReferenceCache::of(scene),
             traversal: Traversal::Shortcuts,
+            occluders,
         }
     }
 
@@ -540,6 +722,23 @@ impl GroundTruth {
     #[must_use]
     pub fn with_traversal(self, traversal: Traversal) -> Self {
         Self { traversal, ..self }
+    }
+
+    /// This tracer with (`true`, the default) or without the convex pieces: placed meshes whose
+    /// triangles are a convex solid or a flat convex polygon, each one polygon when the estimate
+    /// computes the share of a part of the light that a few occluders hide exactly. Without, those
+    /// parts are sampled by rays, as any other triangles: the same expected visibility, with the
+    /// rays' noise (tests of the rays use it).
+    #[must_use]
+    pub fn with_convex_pieces(self, pieces: bool) -> Self {
+        if pieces { self } else { Self { occluders: None, ..self } }
+    }
+
+    /// How many placed meshes the estimate treats as convex pieces
+    /// ([`GroundTruth::with_convex_pieces`]).
+    #[must_use]
+    pub fn convex_piece_count(&self) -> usize {
+        self.occluders.as_ref().map_or(0, |layer| layer.pieces.len())
     }
 
     /// True when the segment from `origin` to `target` crosses no triangle.
@@ -572,7 +771,11 @@ impl GroundTruth {
     /// offset (no segment then crosses it: this drops the surface a point lies on, which its
     /// rays leave by the surface offset, and faces turned away from the light).
     fn may_cross(&self, slot: u32, pyramid: &Pyramid) -> bool {
-        let index = self.bvh.primitive_indices[slot as usize] as usize;
+        self.may_cross_triangle(self.bvh.primitive_indices[slot as usize] as usize, pyramid)
+    }
+
+    /// [`GroundTruth::may_cross`] of the triangle at `index` in `triangles`.
+    fn may_cross_triangle(&self, index: usize, pyramid: &Pyramid) -> bool {
         let triangle = &self.triangles[index];
         let corners = [Vec3::from(triangle.v0), Vec3::from(triangle.v1), Vec3::from(triangle.v2)];
         let margin = self.pyramid_margin();
@@ -666,9 +869,10 @@ impl GroundTruth {
     /// area their projection covers, `reference/coverage.rs`), and otherwise is cut into `refine`²
     /// sub-strata: its own ray, uniform over the stratum and so over the sub-stratum it fell in,
     /// stands for that one, and each of the others gets a fresh jittered ray.
-    /// A part of the light whose pyramid holds at most four triangles is decided exactly for both
-    /// sets at once, before any ray (in the pyramid shortcuts), and its strata are neither
-    /// refined nor compared as neighbours. Each set is unbiased, since which strata it refines
+    /// A part of the light whose pyramid holds at most four triangles, or that at most six convex
+    /// pieces' and other triangles' projections meet ([`GroundTruth::with_convex_pieces`]), is
+    /// decided exactly for both sets at once, before any ray (in the pyramid shortcuts), and its
+    /// strata are neither refined nor compared as neighbours. Each set is unbiased, since which strata it refines
     /// depends only on the other set's rays and on the triangles (not on its own jitter);
     /// the estimate is (A + B)/2 and its noise |A − B|/2, whose mean over pixels estimates the
     /// mean absolute error of the estimate (and its square the variance, pixel by pixel). Lit and
@@ -687,7 +891,14 @@ impl GroundTruth {
         // The two sets share the pyramid shortcuts' gathers (the same triangles for any jitter).
         let shared = (shortcuts && point.footprint.is_none()).then(|| self.pyramid_visibility(light, point, n, &mut set_rngs, true));
         let (strata, exact, lists, stratum_list, base_jitter) = match shared {
-            Some(rays) => (rays.strata, rays.exact, rays.lists, rays.stratum_list, rays.jitter),
+            Some(mut rays) => {
+                // Refinement reads where each stratum's own ray went (drawn already where a ray
+                // was cast; the shortcuts decided every other stratum, which is not refined).
+                if !rays.exact.iter().all(|e| *e) {
+                    rays.draw_jitter();
+                }
+                (rays.strata, rays.exact, rays.lists, rays.stratum_list, rays.jitter)
+            }
             None => {
                 // Without a footprint, visibility_of_rays draws each stratum's jitter and nothing
                 // else, in this order: the same draws from a copy give where each ray went, which
@@ -823,12 +1034,15 @@ impl GroundTruth {
             closed: point.closed,
             n,
             jitter: Vec::new(),
+            jitter_rngs: Vec::new(),
             recent: RecentBlockers::default(),
             strata: vec![vec![0.0; count]; rngs.len()],
             exact: vec![false; count],
             stratum_list: vec![NO_LIST; count],
             lists: Vec::new(),
             exact_parts,
+            projected: [None, None],
+            picked: Vec::new(),
         };
         if light.is_point() {
             let front = rays.in_front(light.centre);
@@ -836,8 +1050,14 @@ impl GroundTruth {
             rays.mark([0, n, 0, n], if open { 1.0 } else { 0.0 });
             return rays;
         }
-        // The jitter of every stratum, drawn in the order visibility_per_ray draws it.
-        rays.jitter = rngs.iter_mut().map(|rng| (0..n * n).map(|_| Vec2::new(rng.next_f32(), rng.next_f32())).collect()).collect();
+        // The jitter of every stratum, drawn in the order visibility_per_ray draws it: with exact
+        // parts (the estimate's own generators) only once a ray needs it; otherwise now, so that
+        // `rngs` moves on as visibility_per_ray moves it.
+        rays.jitter_rngs = rngs.to_vec();
+        if !exact_parts {
+            rays.draw_jitter();
+            rngs.clone_from_slice(&rays.jitter_rngs);
+        }
         self.count_visible(&mut rays, [0, n, 0, n], None, 0, true);
         rays
     }
@@ -895,17 +1115,7 @@ impl GroundTruth {
             *corner = self.triangle_of_slot(*slot);
         }
         let corners = &corners[..triangles.len().min(EXACT_CANDIDATES)];
-        // Within rounding of all or nothing (two triangles sharing an edge, each clipped on its
-        // own, sum to the whole rectangle within about 1e-6 when seen at grazing angles): umbra and
-        // lit stay exact, at a cost of at most 1e-5 of a stratum.
-        let visible = 1.0 - coverage::covered_share(light, origin, corners, [min, max]);
-        if visible < COVERAGE_SNAP {
-            0.0
-        } else if visible > 1.0 - COVERAGE_SNAP {
-            1.0
-        } else {
-            visible as f32
-        }
+        snap_visible(1.0 - coverage::covered_share(light, origin, corners, [min, max]))
     }
 
     /// Which of the rays of every set to the strata [i0, i1) × [j0, j1) reach the light, from the
@@ -928,12 +1138,29 @@ impl GroundTruth {
         let corners = [rays.light.point(s0, t0), rays.light.point(s1, t0), rays.light.point(s1, t1), rays.light.point(s0, t1)];
         // The side of the tangent plane is affine in the sample, so the corners decide a part's.
         let front = rays.in_front(corners[0]);
+        let window = [DVec2::new(f64::from(s0), f64::from(t0)), DVec2::new(f64::from(s1), f64::from(t1))];
         if corners.iter().any(|c| rays.in_front(*c) != front) {
+            // On a solid, the part behind the tangent plane is dark and the rest is seen from
+            // the front origin: the part of the light behind the plane is one more polygon
+            // hiding it, with the occluders projected from there.
+            if rays.closed && rays.exact_parts && self.occluders.is_some() {
+                if rays.projected[0].is_none() {
+                    rays.projected[0] = Some(self.project_occluders(rays.light, rays.origins[0]));
+                }
+                if let Some(Some(projected)) = &rays.projected[0] {
+                    let behind = coverage::behind_line(window, rays.light, rays.plane);
+                    if let PolygonAnswer::Exact(visible) = decide_by_polygons(projected, window, &mut rays.picked, Some(&behind)) {
+                        rays.mark(region, visible);
+                        return;
+                    }
+                }
+            }
             if strata > 1 {
                 // The plane cuts this part: each quarter has a side of its own, or is cut further.
                 self.count_quarters(rays, region, None, depth, may_gather);
                 return;
             }
+            rays.draw_jitter();
             for set in 0..rays.strata.len() {
                 for (i, j, index) in PixelRays::indices(region, rays.n) {
                     let sample = rays.sample(set, i, j);
@@ -949,7 +1176,27 @@ impl GroundTruth {
             rays.mark(region, 0.0);
             return;
         }
-        let origin = rays.origins[usize::from(!front)];
+        let side = usize::from(!front);
+        let origin = rays.origins[side];
+        if rays.exact_parts && self.occluders.is_some() {
+            if rays.projected[side].is_none() {
+                rays.projected[side] = Some(self.project_occluders(rays.light, origin));
+            }
+            if let Some(Some(projected)) = &rays.projected[side] {
+                match decide_by_polygons(projected, window, &mut rays.picked, None) {
+                    PolygonAnswer::Exact(visible) => {
+                        rays.mark(region, visible);
+                        return;
+                    }
+                    PolygonAnswer::TooMany if strata > 1 => {
+                        self.count_quarters(rays, region, None, depth, may_gather && depth == 0);
+                        return;
+                    }
+                    // One stratum that more occluders meet: its rays, as below.
+                    PolygonAnswer::TooMany => {}
+                }
+            }
+        }
         let gathered = Pyramid::new(origin, corners, rays.light).and_then(|pyramid| {
             let mut found = Vec::new();
             let complete = match parent {
@@ -978,6 +1225,7 @@ impl GroundTruth {
                 rays.mark(region, visible);
             }
             Some(candidates) if strata == 1 || candidates.len() <= DIRECT_CANDIDATES => {
+                rays.draw_jitter();
                 for set in 0..rays.strata.len() {
                     for (i, j, index) in PixelRays::indices(region, rays.n) {
                         let open = !self.blocked_by(origin, rays.sample(set, i, j), &candidates);
@@ -994,6 +1242,7 @@ impl GroundTruth {
             None if strata > 1 && depth == 0 => self.count_quarters(rays, region, None, depth, true),
             None => {
                 // Too many triangles even here: each ray through the BVH.
+                rays.draw_jitter();
                 for set in 0..rays.strata.len() {
                     for (i, j, index) in PixelRays::indices(region, rays.n) {
                         let open = !self.blocked_remembering(origin, rays.sample(set, i, j), &mut rays.recent);
@@ -1002,6 +1251,100 @@ impl GroundTruth {
                 }
             }
         }
+    }
+
+    /// What the occluders in the pyramid from `origin` to the whole light hide, projected onto the
+    /// light's plane: each convex piece as one polygon ([`pieces::ConvexPiece::project`]), each
+    /// other triangle as its own. `None` where no piece can hide any of it (the triangles'
+    /// shortcuts do as well), or where they cannot all be projected: more than [`LOOSE_LIMIT`]
+    /// triangles or [`PIECE_LIMIT`] pieces, or a solid piece that may hold the origin (its
+    /// projection has no bound; a point on the piece, its origin off the surface, is outside).
+    fn project_occluders(&self, light: &RectLight, origin: Vec3) -> Option<ProjectedOccluders> {
+        let layer = self.occluders.as_ref()?;
+        let pyramid = Pyramid::new(origin, Window::LIGHT.corners(light), light)?;
+        let margin = self.pyramid_margin();
+        // The pieces first (a small BVH): a pyramid that none can cross, such as one over the
+        // ground alone, is left to the triangles, as if there were no pieces.
+        let mut found = Vec::new();
+        let complete = layer.piece_nodes.gather(&pyramid.planes, margin, |first, count| {
+            found.extend((first..first + count).map(|slot| layer.piece_bvh.primitive_indices[slot as usize] as usize));
+            found.len() <= PIECE_LIMIT
+        });
+        if !complete {
+            return None;
+        }
+        let clearance = 0.5 * self.surface_offset;
+        let mut relevant = Vec::with_capacity(found.len());
+        for index in found {
+            let piece = &layer.pieces[index];
+            if pyramid.planes.iter().any(|(normal, offset)| box_beyond(piece.bounds, *normal, *offset + margin)) {
+                continue;
+            }
+            if let Some((normal, offset)) = piece.plane {
+                // A flat piece with the origin and the whole light on one side of it, clear of
+                // it, hides nothing (as `may_cross` drops a triangle): such as the surface the
+                // point lies on.
+                let first = normal.dot(pyramid.apex) - offset;
+                let clear = |distance: f32| distance.abs() > clearance && (distance > 0.0) == (first > 0.0);
+                if clear(first) && pyramid.base.iter().all(|corner| clear(normal.dot(*corner) - offset)) {
+                    continue;
+                }
+                if !clear(first) {
+                    return None;
+                }
+            } else if piece.may_hold(origin, 0.5 * clearance) {
+                // Inside a convex solid that also holds the whole light (a room lit from
+                // within), its surface hides nothing; else the projection has no bound.
+                if piece.holds_inside(&pyramid.base, margin) && piece.holds_inside(&[origin], 0.0) {
+                    continue;
+                }
+                return None;
+            }
+            relevant.push(index);
+        }
+        if relevant.is_empty() {
+            return None;
+        }
+        let mut loose = Vec::new();
+        if let Some((bvh, nodes)) = &layer.loose_bvh {
+            let complete = nodes.gather(&pyramid.planes, margin, |first, count| {
+                for slot in first..first + count {
+                    let index = layer.loose[bvh.primitive_indices[slot as usize] as usize] as usize;
+                    if self.may_cross_triangle(index, &pyramid) {
+                        loose.push(index);
+                    }
+                }
+                loose.len() <= LOOSE_LIMIT
+            });
+            if !complete {
+                return None;
+            }
+        }
+        let mut projected = ProjectedOccluders::default();
+        let mut scratch = pieces::ProjectScratch::default();
+        for index in relevant {
+            let mut polygon = Vec::new();
+            layer.pieces[index].project(light, origin, &mut scratch, &mut polygon);
+            if polygon.len() >= 3 {
+                projected.boxes.push(coverage::bounding_box(&polygon));
+                projected.polygons.push(polygon);
+            }
+        }
+        for index in loose {
+            let mut polygon = Vec::new();
+            coverage::project_triangle(light, origin, &self.triangle_corners(index), &mut polygon);
+            if polygon.len() >= 3 {
+                projected.boxes.push(coverage::bounding_box(&polygon));
+                projected.polygons.push(polygon);
+            }
+        }
+        Some(projected)
+    }
+
+    /// The corners of the triangle at `index` in `triangles`.
+    fn triangle_corners(&self, index: usize) -> [Vec3; 3] {
+        let triangle = &self.triangles[index];
+        [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
     }
 
     /// [`GroundTruth::count_visible`] of the four quarters of `region`.

@@ -42,27 +42,59 @@ thread_local! {
 /// distance along its normal).
 pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
     let rect = [min.as_dvec2(), max.as_dvec2()];
-    let area = (rect[1].x - rect[0].x) * (rect[1].y - rect[0].y);
-    if area <= 0.0 {
-        return 0.0;
-    }
     SCRATCH.with_borrow_mut(|scratch| {
-        let Scratch { slab, polygons, levels, boxes, spare } = scratch;
-        if polygons.len() < triangles.len() {
-            polygons.resize_with(triangles.len(), Vec::new);
-        }
-        if levels.len() < triangles.len() {
-            levels.resize_with(triangles.len(), Vec::new);
-        }
+        scratch.reserve(triangles.len());
         let mut count = 0;
         for triangle in triangles {
-            let polygon = &mut polygons[count];
-            project(light, origin, triangle, slab, polygon);
-            clip_to_rect(polygon, spare, rect);
+            let polygon = &mut scratch.polygons[count];
+            project(light, origin, triangle, &mut scratch.slab, polygon);
+            clip_to_rect(polygon, &mut scratch.spare, rect);
             if polygon.len() >= 3 {
                 count += 1;
             }
         }
+        scratch.union_share(count, rect)
+    })
+}
+
+/// [`covered_share`] of convex polygons already projected onto the light's plane (light
+/// coordinates, either winding): a convex piece's hull, a triangle's projection.
+pub(super) fn covered_share_of_projected(projected: &[&[DVec2]], rect: [DVec2; 2]) -> f64 {
+    SCRATCH.with_borrow_mut(|scratch| {
+        scratch.reserve(projected.len());
+        let mut count = 0;
+        for hull in projected {
+            let polygon = &mut scratch.polygons[count];
+            polygon.clear();
+            polygon.extend_from_slice(hull);
+            clip_to_rect(polygon, &mut scratch.spare, rect);
+            if polygon.len() >= 3 {
+                count += 1;
+            }
+        }
+        scratch.union_share(count, rect)
+    })
+}
+
+impl Scratch {
+    /// Room for `count` polygons.
+    fn reserve(&mut self, count: usize) {
+        if self.polygons.len() < count {
+            self.polygons.resize_with(count, Vec::new);
+        }
+        if self.levels.len() < count {
+            self.levels.resize_with(count, Vec::new);
+        }
+    }
+
+    /// The share of `rect` that the union of the first `count` polygons (already cut to it)
+    /// covers, in [0, 1].
+    fn union_share(&mut self, count: usize, rect: [DVec2; 2]) -> f64 {
+        let area = (rect[1].x - rect[0].x) * (rect[1].y - rect[0].y);
+        if area <= 0.0 {
+            return 0.0;
+        }
+        let Self { polygons, levels, boxes, spare, .. } = self;
         let polygons = &polygons[..count];
         boxes.clear();
         boxes.extend(polygons.iter().map(|polygon| bounding_box(polygon)));
@@ -74,7 +106,71 @@ pub(super) fn covered_share(light: &RectLight, origin: Vec3, triangles: &[[Vec3;
             covered += intersections_from(polygons, boxes, first + 1, polygon, boxes[first], 2, levels, spare);
         }
         (covered / area).clamp(0.0, 1.0)
+    }
+}
+
+/// The central projection of `triangle` from `origin` onto the light's plane, cut to the slab
+/// as [`covered_share`] cuts it, into `out` (fewer than three corners when none of it is there).
+pub(super) fn project_triangle(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3], out: &mut Vec<DVec2>) {
+    SCRATCH.with_borrow_mut(|scratch| project(light, origin, triangle, &mut scratch.slab, out));
+}
+
+/// The part of the rectangle `[min, max]` of the light (light coordinates) behind the plane
+/// through `plane.0` with normal `plane.1` (where a sample's offset from the point has a
+/// negative dot product with the normal: the side a solid's surface at the point hides).
+pub(super) fn behind_line(rect: [DVec2; 2], light: &RectLight, (point, normal): (Vec3, Vec3)) -> Vec<DVec2> {
+    let normal = normal.as_dvec3();
+    let half = light.half_size.as_dvec2();
+    // light.point(s, t) = centre + u_axis·half.x·s + v_axis·half.y·t: the offset's dot product
+    // with the normal is affine in (s, t).
+    let (a, b) = (half.x * normal.dot(light.u_axis.as_dvec3()), half.y * normal.dot(light.v_axis.as_dvec3()));
+    let c = normal.dot(light.centre.as_dvec3() - point.as_dvec3());
+    let [min, max] = rect;
+    let corners = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)];
+    let mut out = Vec::with_capacity(5);
+    clip_2d(&corners, |p| -(a * p.x + b * p.y + c), &mut out);
+    out
+}
+
+/// Whether convex `polygon` (either winding) holds the whole rectangle `[min, max]`.
+pub(super) fn holds_rectangle(polygon: &[DVec2], [min, max]: [DVec2; 2]) -> bool {
+    let orientation = signed_area(polygon).signum();
+    if polygon.len() < 3 || orientation == 0.0 {
+        return false;
+    }
+    let corners = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)];
+    polygon.iter().enumerate().all(|(k, &a)| {
+        let edge = polygon[(k + 1) % polygon.len()] - a;
+        corners.iter().all(|c| orientation * edge.perp_dot(*c - a) >= 0.0)
     })
+}
+
+/// The convex hull of `points` (sorted in place), counter-clockwise, without collinear corners,
+/// into `out` (Andrew's monotone chain); fewer than three corners when the points are collinear.
+pub(super) fn convex_hull(points: &mut [DVec2], out: &mut Vec<DVec2>) {
+    out.clear();
+    points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    if points.len() < 3 {
+        out.extend_from_slice(points);
+        return;
+    }
+    let turns_left = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o) > 0.0;
+    // The lower chain left to right, then the upper right to left, each popping corners that do
+    // not turn left.
+    for &p in points.iter() {
+        while out.len() >= 2 && !turns_left(out[out.len() - 2], out[out.len() - 1], p) {
+            out.pop();
+        }
+        out.push(p);
+    }
+    let lower = out.len() + 1;
+    for &p in points.iter().rev().skip(1) {
+        while out.len() >= lower && !turns_left(out[out.len() - 2], out[out.len() - 1], p) {
+            out.pop();
+        }
+        out.push(p);
+    }
+    out.pop();
 }
 
 /// The signed sum, over the subsets made of `common`'s polygons (`size` − 1 of them) and one or
@@ -111,9 +207,17 @@ fn intersections_from(
 }
 
 /// The smallest axis-aligned box around `polygon`: [min, max].
-fn bounding_box(polygon: &[DVec2]) -> [DVec2; 2] {
+pub(super) fn bounding_box(polygon: &[DVec2]) -> [DVec2; 2] {
     polygon.iter().fold([DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)], |[min, max], p| [min.min(*p), max.max(*p)])
 }
+
+/// The least fraction of the way from a point to the light's plane kept of an occluder: a corner
+/// at t → 0 projects to infinity, so t stays above a bound that leaves the projection in f64's
+/// range and far outside any light (the rectangle clip removes it).
+pub(super) const T_MIN: f64 = 1e-9;
+/// The greatest: rays stop just short of the light (`segment_ray`: at 1 − 10⁻⁶ of the way), so
+/// that geometry lying in the light's plane hides none of it; the projection stops there too.
+pub(super) const T_MAX: f64 = 1.0 - 1e-6;
 
 /// The central projection from `origin` onto the light's plane, in light coordinates (u / half
 /// width, v / half height), of the part of `triangle` strictly between the plane through `origin`
@@ -128,15 +232,9 @@ fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3], [slab, cut]: &
     }
     // t: the fraction of the way from the origin to the light's plane (0 at the origin's plane).
     let t_of = |p: DVec3| 1.0 - (p - centre).dot(normal) / height;
-    // A corner at t → 0 projects to infinity: keep t above a bound that leaves the projection in
-    // f64's range and far outside any light (the rectangle clip removes it).
-    const T_MIN: f64 = 1e-9;
-    const T_MAX: f64 = 1.0 - 1e-6;
     slab.clear();
     slab.extend(triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))));
     clip_by(slab, |(_, t)| t - T_MIN, cut);
-    // Rays stop just short of the light (`segment_ray`: at 1 − 10⁻⁶ of the way), so that geometry
-    // lying in the light's plane hides none of it; the projection stops there too.
     clip_by(cut, |(_, t)| T_MAX - t, slab);
     let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
     let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
@@ -214,12 +312,12 @@ fn signed_area(polygon: &[DVec2]) -> f64 {
     0.5 * polygon.iter().enumerate().map(|(k, p)| p.perp_dot(polygon[(k + 1) % polygon.len()])).sum::<f64>()
 }
 
-fn polygon_area(polygon: &[DVec2]) -> f64 {
+pub(super) fn polygon_area(polygon: &[DVec2]) -> f64 {
     if polygon.len() < 3 { 0.0 } else { signed_area(polygon).abs() }
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     fn light() -> RectLight {
@@ -227,7 +325,7 @@ mod tests {
     }
 
     /// The share of `rect` hidden, by rays through a fine grid of the rectangle (the definition).
-    fn counted(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
+    pub(crate) fn counted(light: &RectLight, origin: Vec3, triangles: &[[Vec3; 3]], [min, max]: [Vec2; 2]) -> f64 {
         const N: usize = 400;
         let mut hidden = 0usize;
         for j in 0..N {
