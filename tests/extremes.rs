@@ -65,12 +65,24 @@ const PENUMBRA_SHARE: f32 = 0.01;
 /// pcss.
 const INTERIORS: &[&str] = &["room lit from a wall over a table", "corridor lit from its ceiling", "light inside a closed room"];
 
+/// The techniques that must beat hard shadows over the truth's umbra and penumbra in every interior
+/// (issue #47), whatever their false shadows beside it.
+const INTERIOR_SOFT: &[&str] = &["pcss", "sssm", "pvsm"];
+
 /// Why pcss is no better than hard shadows in the corridor, where either shadows: the walls rising
 /// from the floor lie in front of the floor's plane inside its filter, though not between the floor
-/// and the light, and darken the floor along its junctions with them (its error heatmap). On the
-/// truth's umbra and penumbra alone it beats hard beyond the noise (`ssm compare` on the corridor's
-/// manifest).
+/// and the light, and darken the floor along its junctions with them, a line a pixel wide (its
+/// error heatmap at 480×360: 0.0315 against hard's 0.0299 where either shadows). On the truth's
+/// umbra and penumbra alone it beats hard beyond the noise (0.0265 against 0.0284 here, asserted
+/// with INTERIOR_SOFT). Counting only taps in the receiver's light cone, in the search and the
+/// filter, did not remove the line (0.0323 with half a texel's slack, 0.0408 with none).
 const CORRIDOR_WALLS: &str = "false shadows along the floor-wall junctions: the walls lie in front of the floor's plane inside the filter";
+
+/// Why sssm is no better than hard shadows in the corridor, where either shadows: a tie at this
+/// matrix's 160×120 (0.0285 each), ahead at 480×360 (0.0261 against 0.0299); over the truth's
+/// umbra and penumbra it beats hard beyond the noise (0.0275 against 0.0284, asserted with
+/// INTERIOR_SOFT).
+const CORRIDOR_SSSM: &str = "a tie with a hard shadow at 160x120 where either shadows; ahead over the truth's umbra and penumbra";
 
 /// (technique, scene, what is wrong): failures this matrix finds that the workspace has not fixed
 /// yet. Each is reported when the test runs and must still fail: one that passes fails the test
@@ -97,7 +109,7 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     ("atty", "room lit from a wall over a table", "no better than a hard shadow in a room lit from a wall"),
     ("atty", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
     ("pcss", "corridor lit from its ceiling", CORRIDOR_WALLS),
-    ("sssm", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
+    ("sssm", "corridor lit from its ceiling", CORRIDOR_SSSM),
     // Each to investigate.
     (
         "wedges",
@@ -607,6 +619,7 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
         let truth = Truth::of(&gpu, &case.scene);
         let penumbra = truth.penumbra_share();
         let mut errors: Vec<(&'static TechniqueInfo, f64, Option<f64>)> = Vec::new();
+        let mut shadowed_errors: Vec<(&'static str, f64, Option<f64>)> = Vec::new();
         for info in registry.iter() {
             if info.kind == TechniqueKind::GroundTruth {
                 // The ground truth is what the others are measured against.
@@ -629,8 +642,10 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
             if EXPECTED_REFUSALS.iter().any(|(name, scene, _)| *name == info.name && *scene == case.name) {
                 failures.push(format!("{} / {}: renders, but this test expects a refusal: update EXPECTED_REFUSALS", info.name, case.name));
             }
-            // The largest headline error over the scene's lights, with the truth's noise there.
+            // The largest headline error over the scene's lights, with the truth's noise there; and
+            // the largest over the truth's umbra and penumbra alone.
             let (mut worst, mut worst_noise) = (0.0f64, None);
+            let (mut worst_shadowed, mut worst_shadowed_noise) = (0.0f64, None);
             for (light, (truth_image, noise)) in truth.images.iter().enumerate() {
                 match rendered.renderer.read_visibility(light, info.name) {
                     Ok(image) => {
@@ -638,11 +653,15 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
                         if metrics.mae >= worst {
                             (worst, worst_noise) = (metrics.mae, metrics.truth_noise);
                         }
+                        if metrics.mae_penumbra >= worst_shadowed {
+                            (worst_shadowed, worst_shadowed_noise) = (metrics.mae_penumbra, metrics.truth_noise_penumbra);
+                        }
                     }
                     Err(e) => failures.push(format!("{} / {} / light {light}: {e}", info.name, case.name)),
                 }
             }
             errors.push((info, worst, worst_noise));
+            shadowed_errors.push((info.name, worst_shadowed, worst_shadowed_noise));
             let (bound, reason) = bound_of(info, case.name);
             let (bound, common) = (f64::from(bound), f64::from(COMMON_BOUND));
             report.push(format!(
@@ -728,6 +747,22 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
                     }
                 }
                 _ => failures.push(format!("{}: pvsm and pcss must both run on an interior", case.name)),
+            }
+            // And pcss and sssm beat hard shadows over the truth's umbra and penumbra (their false
+            // shadows beside it are the matrix's headline error, above).
+            let shadowed_of = |name: &str| shadowed_errors.iter().find(|(n, _, _)| *n == name).map(|(_, e, n)| (*e, *n));
+            let Some((hard, hard_noise)) = shadowed_of(HARD_SHADOW_TECHNIQUES[0]) else { continue };
+            for name in INTERIOR_SOFT {
+                match shadowed_of(name) {
+                    Some((error, noise)) if error < hard && !is_tie(error, noise, hard, hard_noise) => {
+                        report.push(format!("{name:>12} {error:>7.4} over the truth's umbra and penumbra (hard {hard:.4}) {}", case.name));
+                    }
+                    Some((error, _)) => failures.push(format!(
+                        "{name} / {} (umbra and penumbra): error {error:.4} does not beat hard shadows' {hard:.4} beyond the truth's noise",
+                        case.name
+                    )),
+                    None => failures.push(format!("{}: {name} must run on an interior", case.name)),
+                }
             }
         }
     }

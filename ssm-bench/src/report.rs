@@ -1275,7 +1275,12 @@ pub fn reference_cost(diagnostics: &[(String, f64)]) -> String {
     let get = |key: &str| diagnostics.iter().find(|(k, _)| k == key).map(|(_, v)| *v);
     match (get("reference_rays"), get("reference_trace_ms"), get("reference_rays_per_second")) {
         (Some(rays), Some(ms), Some(rate)) if rays > 0.0 => {
-            format!("{:.1} M light samples traced on the CPU in {:.0} ms ({:.1} M samples/s)", rays / 1e6, ms, rate / 1e6)
+            format!(
+                "{:.1} M light samples evaluated on the CPU in {:.0} ms ({:.1} M samples/s, exact shares of the light included)",
+                rays / 1e6,
+                ms,
+                rate / 1e6
+            )
         }
         _ => "read from the cache".into(),
     }
