@@ -119,7 +119,6 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     ("sssm", "light far larger than the occluder", "error just above the bound where either shadows"),
     ("atty", "three lights", "error far above the other techniques' on three lights"),
     ("atty", "wall lit at grazing angles", "error above the bound where either shadows"),
-    ("multi-sm", "light inside a closed room", "worse than a hard shadow in a closed room"),
 ];
 
 /// (technique, scene, what its refusal must say): the refusals this matrix expects, each asserted

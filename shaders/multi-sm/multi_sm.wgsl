@@ -12,8 +12,8 @@ struct MultiSmSettings {
     weight: f32,
     // Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
-    _pad0: f32,
-    _pad1: f32,
+    // Half the sides of one stratum of the light, world units, along the light's two axes.
+    stratum_half_size: vec2<f32>,
 };
 
 // Group 0 (`frame`) holds this sample's frame: a point light at the sample, with the light's axes.
@@ -28,6 +28,18 @@ struct MultiSmSettings {
 // bytes.
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
+// The share of this sample's stratum (a rectangle of the light centred on the sample, the frame's
+// centre) in front of a closed surface's tangent plane at `point`; 1 on an open surface, which the
+// ground truth lights from either side.
+fn stratum_share_in_front(point: ScreenPoint) -> f32 {
+    if (!point.closed) {
+        return 1.0;
+    }
+    let reach_u = abs(settings.stratum_half_size.x * dot(frame.u_axis.xyz, point.normal));
+    let reach_v = abs(settings.stratum_half_size.y * dot(frame.v_axis.xyz, point.normal));
+    return sum_of_uniforms_cdf(light_centre_height(frame, point.position, point.normal), reach_u, reach_v);
+}
+
 @compute @workgroup_size(8, 8)
 fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(visibility);
@@ -39,15 +51,24 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     var lit = 1.0;
     var reads = 3u;
     if (point.covered) {
-        // This sample's frame is a point light: behind a closed surface's tangent plane, the
-        // surface itself hides it (and the other shared rules, screen_pass.wgsl).
-        if (unlit_by_rule(point)) {
+        // This sample stands for its stratum of the light. On a closed surface, the part of the
+        // stratum behind the tangent plane is hidden by the surface itself: the stratum's share in
+        // front, exact for a rectangle (light_frame.wgsl), weighs the sample's shadow test, rather
+        // than the sample alone deciding (with 16 samples, a face whose plane passes through a
+        // column of strata got 4/16 of the light where it sees 1/8). A sample behind the plane
+        // sees the surface's back, which its map holds in front of the point: its test says
+        // nothing of the stratum's part in front, which is taken as lit. Elsewhere the other
+        // shared rules (screen_pass.wgsl).
+        let share = stratum_share_in_front(point);
+        if (light_sealed(frame) || !in_front_of_light(frame, point.position) || share <= 0.0) {
             lit = 0.0;
+        } else if (point.closed && light_centre_height(frame, point.position, point.normal) < 0.0) {
+            lit = share;
         } else {
             let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
             let uvd = light_uv_depth(frame, lookup);
             reads += 1u;
-            lit = select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
+            lit = share * select(0.0, 1.0, uvd.z <= shadow_map_depth(shadow_map, uvd.xy));
         }
     }
     let sum = textureLoad(visibility, texel).x + settings.weight * lit;

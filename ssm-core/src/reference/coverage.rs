@@ -219,29 +219,57 @@ pub(super) const T_MIN: f64 = 1e-9;
 /// that geometry lying in the light's plane hides none of it; the projection stops there too.
 pub(super) const T_MAX: f64 = 1.0 - 1e-6;
 
-/// The central projection from `origin` onto the light's plane, in light coordinates (u / half
-/// width, v / half height), of the part of `triangle` strictly between the plane through `origin`
-/// parallel to the light and the light's own plane, into `out`; empty when none of it is.
+/// The central projection from a point onto the light's plane, in light coordinates (u / half
+/// width, v / half height), and each point's fraction t of the way from the point's plane
+/// (parallel to the light) to the light's.
+pub(super) struct CentralProjection {
+    origin: DVec3,
+    centre: DVec3,
+    normal: DVec3,
+    /// The origin's distance from the light's plane (positive: in front of it).
+    height: f64,
+    axes: [DVec3; 2],
+    half: DVec2,
+}
+
+impl CentralProjection {
+    /// The projection from `origin`; `None` when it is not in front of the light.
+    pub(super) fn new(light: &RectLight, origin: Vec3) -> Option<Self> {
+        let (centre, normal, origin) = (light.centre.as_dvec3(), light.normal().as_dvec3(), origin.as_dvec3());
+        let height = (origin - centre).dot(normal);
+        (height > 0.0).then(|| Self {
+            origin,
+            centre,
+            normal,
+            height,
+            axes: [light.u_axis.as_dvec3(), light.v_axis.as_dvec3()],
+            half: light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE)),
+        })
+    }
+
+    /// The fraction t of the way from the origin's plane to the light's (0 at the origin's).
+    pub(super) fn t_of(&self, p: DVec3) -> f64 {
+        1.0 - (p - self.centre).dot(self.normal) / self.height
+    }
+
+    /// Where the ray from the origin through `p` (at fraction `t`) meets the light's plane.
+    pub(super) fn onto_light(&self, p: DVec3, t: f64) -> DVec2 {
+        let on_light = self.origin + (p - self.origin) / t;
+        DVec2::new((on_light - self.centre).dot(self.axes[0]) / self.half.x, (on_light - self.centre).dot(self.axes[1]) / self.half.y)
+    }
+}
+
+/// The central projection from `origin` onto the light's plane, in light coordinates, of the part
+/// of `triangle` strictly between the plane through `origin` parallel to the light and the light's
+/// own plane, into `out`; empty when none of it is.
 fn project(light: &RectLight, origin: Vec3, triangle: &[Vec3; 3], [slab, cut]: &mut [Vec<SlabPoint>; 2], out: &mut Vec<DVec2>) {
     out.clear();
-    let (centre, normal) = (light.centre.as_dvec3(), light.normal().as_dvec3());
-    let origin = origin.as_dvec3();
-    let height = (origin - centre).dot(normal);
-    if height <= 0.0 {
-        return;
-    }
-    // t: the fraction of the way from the origin to the light's plane (0 at the origin's plane).
-    let t_of = |p: DVec3| 1.0 - (p - centre).dot(normal) / height;
+    let Some(projection) = CentralProjection::new(light, origin) else { return };
     slab.clear();
-    slab.extend(triangle.iter().map(|p| (p.as_dvec3(), t_of(p.as_dvec3()))));
+    slab.extend(triangle.iter().map(|p| (p.as_dvec3(), projection.t_of(p.as_dvec3()))));
     clip_by(slab, |(_, t)| t - T_MIN, cut);
     clip_by(cut, |(_, t)| T_MAX - t, slab);
-    let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
-    let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
-    out.extend(slab.iter().map(|(p, t)| {
-        let on_light = origin + (*p - origin) / *t;
-        DVec2::new((on_light - centre).dot(u_axis) / half.x, (on_light - centre).dot(v_axis) / half.y)
-    }));
+    out.extend(slab.iter().map(|(p, t)| projection.onto_light(*p, *t)));
 }
 
 /// Sutherland–Hodgman against one half-space: the part of `polygon` where `inside` ≥ 0

@@ -323,19 +323,11 @@ impl ConvexPiece {
         out.clear();
         let ProjectScratch { points, facing, ts, marked } = scratch;
         points.clear();
-        let (centre, normal) = (light.centre.as_dvec3(), light.normal().as_dvec3());
+        let Some(projection) = coverage::CentralProjection::new(light, origin) else { return };
+        let normal = light.normal().as_dvec3();
         let origin = origin.as_dvec3();
-        let height = (origin - centre).dot(normal);
-        if height <= 0.0 {
-            return;
-        }
-        let t_of = |p: DVec3| 1.0 - (p - centre).dot(normal) / height;
-        let (u_axis, v_axis) = (light.u_axis.as_dvec3(), light.v_axis.as_dvec3());
-        let half = light.half_size.as_dvec2().max(DVec2::splat(f64::MIN_POSITIVE));
-        let onto_light = |p: DVec3, t: f64| {
-            let on_light = origin + (p - origin) / t;
-            DVec2::new((on_light - centre).dot(u_axis) / half.x, (on_light - centre).dot(v_axis) / half.y)
-        };
+        let t_of = |p: DVec3| projection.t_of(p);
+        let onto_light = |p: DVec3, t: f64| projection.onto_light(p, t);
         // The range of t over the piece's bounds: t is affine, so its extremes are at corners of
         // the box.
         let [min, max] = self.bounds.map(Vec3::as_dvec3);

@@ -78,13 +78,18 @@ pub struct MultiSmSettings {
 pub struct MultiSmSettingsUniform {
     weight: f32,
     normal_offset: f32,
-    _pad0: f32,
-    _pad1: f32,
+    /// Half the sides of one stratum of the light, world units (along its first and second axes).
+    stratum_half_size: [f32; 2],
 }
 
-impl From<&MultiSmSettings> for MultiSmSettingsUniform {
-    fn from(settings: &MultiSmSettings) -> Self {
-        Self { weight: 1.0 / settings.samples.max(1) as f32, normal_offset: settings.bias.normal_offset, _pad0: 0.0, _pad1: 0.0 }
+impl MultiSmSettingsUniform {
+    /// The settings for a light of half sides `half_size` cut into `per_axis` × `per_axis` strata.
+    fn new(settings: &MultiSmSettings, half_size: Vec2, per_axis: u32) -> Self {
+        Self {
+            weight: 1.0 / settings.samples.max(1) as f32,
+            normal_offset: settings.bias.normal_offset,
+            stratum_half_size: (half_size / per_axis.max(1) as f32).to_array(),
+        }
     }
 }
 
@@ -127,7 +132,6 @@ impl MultiShadowMaps {
         let device = &setup.gpu.device;
         let gbuffer = setup.shared.gbuffer(NAME)?;
         let depth_map = settings.bias.depth_map(setup, "multi_sm_shadow_map", settings.shadow_map_size)?;
-        let settings_buffer = uniform_buffer(device, "multi_sm_settings_uniform", &MultiSmSettingsUniform::from(&settings));
         let read_counts = ReadCounts::with_units(device, "multi_sm_read_counts", COUNTERS, setup.count_work);
         let own_layout = bind_group_layout(
             device,
@@ -139,6 +143,12 @@ impl MultiShadowMaps {
             .iter()
             .enumerate()
             .map(|(light, output)| {
+                let half_size = setup.scene.light_frames.get(light).map_or(Vec2::ZERO, |frame| frame.light.half_size);
+                let settings_buffer = uniform_buffer(
+                    device,
+                    &format!("multi_sm_settings_uniform_{light}"),
+                    &MultiSmSettingsUniform::new(&settings, half_size, per_axis),
+                );
                 bind_group(
                     device,
                     &format!("multi_sm_own_bind_group_{light}"),
