@@ -93,8 +93,14 @@ fn light_centre_height(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) -
 // [-1, 1]), so the fraction is sum_of_uniforms_cdf(h, A, B). CPU twin:
 // ssm_scene::RectLight::share_in_front_of_plane.
 fn light_share_in_front(frame: LightFrame, world: vec3<f32>, normal: vec3<f32>) -> f32 {
-    let reach_u = abs(frame.u_axis.w * dot(frame.u_axis.xyz, normal));
-    let reach_v = abs(frame.v_axis.w * dot(frame.v_axis.xyz, normal));
+    return rect_share_in_front(frame, vec2<f32>(frame.u_axis.w, frame.v_axis.w), world, normal);
+}
+
+// The same for a rectangle centred on the light's centre, along its axes, of half sides
+// `half_size` (a stratum of a light, whose frame is a point light at its centre).
+fn rect_share_in_front(frame: LightFrame, half_size: vec2<f32>, world: vec3<f32>, normal: vec3<f32>) -> f32 {
+    let reach_u = abs(half_size.x * dot(frame.u_axis.xyz, normal));
+    let reach_v = abs(half_size.y * dot(frame.v_axis.xyz, normal));
     return sum_of_uniforms_cdf(light_centre_height(frame, world, normal), reach_u, reach_v);
 }
 

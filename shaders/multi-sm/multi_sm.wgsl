@@ -35,9 +35,7 @@ fn stratum_share_in_front(point: ScreenPoint) -> f32 {
     if (!point.closed) {
         return 1.0;
     }
-    let reach_u = abs(settings.stratum_half_size.x * dot(frame.u_axis.xyz, point.normal));
-    let reach_v = abs(settings.stratum_half_size.y * dot(frame.v_axis.xyz, point.normal));
-    return sum_of_uniforms_cdf(light_centre_height(frame, point.position, point.normal), reach_u, reach_v);
+    return rect_share_in_front(frame, settings.stratum_half_size, point.position, point.normal);
 }
 
 @compute @workgroup_size(8, 8)

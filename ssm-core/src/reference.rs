@@ -75,6 +75,21 @@ struct Pyramid {
 }
 
 impl Pyramid {
+    /// Where the pyramid lies against a plane (`height`: a point's signed distance from it): `None`
+    /// when the apex is within `clearance` of it; `Some(true)` when the apex and every corner of
+    /// the base lie on one side, clear of it by more than `clearance` (no segment from the apex to
+    /// the base crosses it); `Some(false)` otherwise.
+    fn beside_plane(&self, height: impl Fn(Vec3) -> f32, clearance: f32) -> Option<bool> {
+        let first = height(self.apex);
+        if first.abs() <= clearance {
+            return None;
+        }
+        Some(self.base.iter().all(|corner| {
+            let distance = height(*corner);
+            distance.abs() > clearance && (distance > 0.0) == (first > 0.0)
+        }))
+    }
+
     /// `None` when it is degenerate (a side of no area: the apex in the light's plane).
     fn new(apex: Vec3, base: [Vec3; 4], light: &RectLight) -> Option<Self> {
         let inside = (apex + (base[0] + base[2]) * 0.5) * 0.5;
@@ -786,16 +801,7 @@ impl GroundTruth {
         if normal == Vec3::ZERO {
             return true;
         }
-        let clearance = 0.5 * self.surface_offset;
-        let side = |p: Vec3| normal.dot(p - corners[0]);
-        let first = side(pyramid.apex);
-        if first.abs() <= clearance {
-            return true;
-        }
-        !pyramid.base.iter().all(|corner| {
-            let distance = side(*corner);
-            distance.abs() > clearance && (distance > 0.0) == (first > 0.0)
-        })
+        pyramid.beside_plane(|p| normal.dot(p - corners[0]), 0.5 * self.surface_offset) != Some(true)
     }
 
     /// The BVH slot of the triangle the BVH finds first on `ray` (a [`segment_ray`], with the
@@ -1095,8 +1101,7 @@ impl GroundTruth {
 
     /// The corners of the triangle in BVH slot `slot`.
     fn triangle_of_slot(&self, slot: u32) -> [Vec3; 3] {
-        let triangle = &self.triangles[self.bvh.primitive_indices[slot as usize] as usize];
-        [triangle.v0, triangle.v1, triangle.v2].map(Vec3::from)
+        self.triangle_corners(self.bvh.primitive_indices[slot as usize] as usize)
     }
 
     /// The exact visible fraction of the part `stratum` of the light seen from `origin`, hidden
@@ -1144,9 +1149,7 @@ impl GroundTruth {
             // the front origin: the part of the light behind the plane is one more polygon
             // hiding it, with the occluders projected from there.
             if rays.closed && rays.exact_parts && self.occluders.is_some() {
-                if rays.projected[0].is_none() {
-                    rays.projected[0] = Some(self.project_occluders(rays.light, rays.origins[0]));
-                }
+                self.ensure_projected(rays, 0);
                 if let Some(Some(projected)) = &rays.projected[0] {
                     let behind = coverage::behind_line(window, rays.light, rays.plane);
                     if let PolygonAnswer::Exact(visible) = decide_by_polygons(projected, window, &mut rays.picked, Some(&behind)) {
@@ -1179,9 +1182,7 @@ impl GroundTruth {
         let side = usize::from(!front);
         let origin = rays.origins[side];
         if rays.exact_parts && self.occluders.is_some() {
-            if rays.projected[side].is_none() {
-                rays.projected[side] = Some(self.project_occluders(rays.light, origin));
-            }
+            self.ensure_projected(rays, side);
             if let Some(Some(projected)) = &rays.projected[side] {
                 match decide_by_polygons(projected, window, &mut rays.picked, None) {
                     PolygonAnswer::Exact(visible) => {
@@ -1253,6 +1254,14 @@ impl GroundTruth {
         }
     }
 
+    /// Projects the occluders from ray origin `side` of `rays` ([`GroundTruth::project_occluders`]),
+    /// once per pixel.
+    fn ensure_projected(&self, rays: &mut PixelRays<'_>, side: usize) {
+        if rays.projected[side].is_none() {
+            rays.projected[side] = Some(self.project_occluders(rays.light, rays.origins[side]));
+        }
+    }
+
     /// What the occluders in the pyramid from `origin` to the whole light hide, projected onto the
     /// light's plane: each convex piece as one polygon ([`pieces::ConvexPiece::project`]), each
     /// other triangle as its own. `None` where no piece can hide any of it (the triangles'
@@ -1283,14 +1292,11 @@ impl GroundTruth {
             if let Some((normal, offset)) = piece.plane {
                 // A flat piece with the origin and the whole light on one side of it, clear of
                 // it, hides nothing (as `may_cross` drops a triangle): such as the surface the
-                // point lies on.
-                let first = normal.dot(pyramid.apex) - offset;
-                let clear = |distance: f32| distance.abs() > clearance && (distance > 0.0) == (first > 0.0);
-                if clear(first) && pyramid.base.iter().all(|corner| clear(normal.dot(*corner) - offset)) {
-                    continue;
-                }
-                if !clear(first) {
-                    return None;
+                // point lies on. One through the origin has no bounded projection.
+                match pyramid.beside_plane(|p| normal.dot(p) - offset, clearance) {
+                    Some(true) => continue,
+                    None => return None,
+                    Some(false) => {}
                 }
             } else if piece.may_hold(origin, 0.5 * clearance) {
                 // Inside a convex solid that also holds the whole light (a room lit from

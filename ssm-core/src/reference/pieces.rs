@@ -14,7 +14,7 @@
 use std::collections::HashSet;
 
 use glam::{DVec2, DVec3, Mat4, Vec3};
-use ssm_scene::{Adjacency, Mesh, RectLight};
+use ssm_scene::{Adjacency, Mesh, RectLight, normal_matrix};
 
 use super::coverage;
 
@@ -246,18 +246,10 @@ impl ConvexPiece {
     pub fn placed(shape: &ConvexShape, transform: Mat4) -> Self {
         let corners: Vec<Vec3> = shape.corners.iter().map(|c| transform.transform_point3(*c)).collect();
         let bounds = corners.iter().fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], c| [lo.min(*c), hi.max(*c)]);
-        let plane = shape.flat_normal.and_then(|_| {
-            // The placed plane from three corners far apart (a transform may shear the normal).
-            let [a, b] = [
-                corners[0],
-                corners.iter().copied().max_by(|p, q| p.distance_squared(corners[0]).total_cmp(&q.distance_squared(corners[0])))?,
-            ];
-            let c = corners
-                .iter()
-                .copied()
-                .max_by(|p, q| (*p - a).cross(b - a).length_squared().total_cmp(&(*q - a).cross(b - a).length_squared()))?;
-            let normal = (b - a).cross(c - a).try_normalize()?;
-            Some((normal, normal.dot(a)))
+        // Normals go through the inverse transpose (a transform may shear them).
+        let plane = shape.flat_normal.and_then(|normal| {
+            let normal = (normal_matrix(transform) * normal).try_normalize()?;
+            Some((normal, normal.dot(*corners.first()?)))
         });
         // Each face's normal turned away from the corners' centroid, which is inside the solid:
         // outwards whichever way the mesh winds and whether the transform mirrors it.
