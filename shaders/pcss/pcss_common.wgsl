@@ -91,7 +91,12 @@ fn soft_visibility(pixel: PcssPixel) -> f32 {
 
     // 2. Penumbra extent, 3. PCF over it.
     let filter_extent = light_half_extent_uv(frame, blocker_depth, uvd.z);
-    let m = max(settings.pcf_kernel, 1u);
+    // A penumbra narrower than a texel is not in the map: the m×m taps of a filter narrower than a
+    // texel read the one or two texels at the lookup, and their share only moves the map's own
+    // quantised edge (under a near-point light it made PCSS worse than a hard shadow from the same
+    // map). One tap at the lookup is that hard shadow, the most the map holds.
+    let narrower_than_a_texel = all(filter_extent * vec2<f32>(textureDimensions(shadow_map)) < vec2<f32>(0.5));
+    let m = select(max(settings.pcf_kernel, 1u), 1u, narrower_than_a_texel);
     var lit = 0.0;
     for (var j = 0u; j < m; j++) {
         for (var i = 0u; i < m; i++) {
