@@ -11,7 +11,9 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use ssm_core::metrics::compare_with_noise;
+use ssm_core::reference::{GroundTruth, Sampling, surface_points};
 use ssm_core::{BEYOND_FRAME_DIAGNOSTIC, BEYOND_FRAME_PASS, LightView, Renderer, Requirements, TechniqueInfo, TechniqueKind};
 use ssm_integration_tests::{missing_must_run, registry};
 use ssm_scene::{Scene, builtin};
@@ -29,6 +31,13 @@ const ENCLOSURE: &str = "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.
     [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\n\
     [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\n\
     [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\n";
+
+/// A light a thousandth of the floor's size above it, facing it, with a block beside it: the floor
+/// sees the light at grazing angles everywhere but under it (the extremes matrix's case).
+const RESTING: &str = "[camera]\nposition = [0.0, 4.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+    [[light]]\ncentre = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.0, 1.0]\n\
+    [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n\
+    [[object]]\nprimitive = \"box\"\nsize = [0.4, 0.4, 0.4]\ntranslate = [1.5, 0.2, 0.0]\nrole = \"both\"\n";
 
 /// Ground points outside the enclosure and past the frame's widest angle (tangent > 10 at 0.3
 /// below the light).
@@ -87,9 +96,9 @@ fn the_framework_answers_receivers_past_the_frame_and_counts_them() {
                     ));
                 }
             }
-            LightView::Hemisphere => {
+            LightView::SideFaces | LightView::Hemisphere => {
                 if answered.is_some() || has_pass {
-                    failures.push(format!("{}: sees the whole hemisphere but got the framework's pass", info.name));
+                    failures.push(format!("{}: answers the whole hemisphere itself but got the framework's pass", info.name));
                 }
             }
         }
@@ -109,9 +118,59 @@ fn the_framework_answers_receivers_past_the_frame_and_counts_them() {
 #[test]
 fn scenes_inside_the_widest_angle_get_no_faces_and_no_pass() {
     let scene = builtin("contact").unwrap().build();
-    for info in registry().iter().filter(|info| info.kind == TechniqueKind::Realtime && info.light_view == LightView::Frame) {
+    let mut side_face_techniques = 0;
+    for info in registry().iter().filter(|info| info.kind == TechniqueKind::Realtime && info.light_view != LightView::Hemisphere) {
         let Frame { diagnostics, passes, .. } = render(&scene, info).unwrap();
         assert!(!diagnostics.iter().any(|(key, _)| key == BEYOND_FRAME_DIAGNOSTIC), "{}: reports pixels past the frame", info.name);
         assert!(!passes.iter().any(|p| p.contains(BEYOND_FRAME_PASS)), "{}: runs the pass past the frame: {passes:?}", info.name);
+        // A technique with side faces of its own draws and reads them only where a frame reaches
+        // the widest angle (pcss: `pcss_side_faces`, its faces `pcss_light<i>_face<k>`).
+        if info.light_view == LightView::SideFaces {
+            side_face_techniques += 1;
+            assert!(!passes.iter().any(|p| p.contains("side_faces") || p.contains("_face")), "{}: draws side faces: {passes:?}", info.name);
+        }
     }
+    assert!(side_face_techniques > 0, "no registered technique answers past the frame with side faces of its own");
+}
+
+/// A technique with side faces of its own (pcss) answers the receivers past the frame with its own
+/// method, not a hard shadow: beside a light resting on a floor, a block's shadow past 84° is a
+/// penumbra as wide as the block's distance, which it must draw within 0.05 of the truth on
+/// average where either shadows (hard shadows from the centre: 0.19).
+#[test]
+fn side_faces_draw_the_penumbra_past_the_frame() {
+    let origin = PathBuf::from("beyond-frame:resting");
+    let scene = ssm_scene::Manifest::parse(RESTING, &origin).unwrap().build(&origin, Path::new(".")).unwrap();
+    let gpu = gpu();
+    let needs = Requirements { gbuffer: true, ..Requirements::NONE };
+    let renderer = Renderer::new(&gpu, &scene, SIZE.0, SIZE.1, &needs).unwrap();
+    let positions = renderer.read_positions().unwrap();
+    let points = surface_points(&positions, &renderer.read_normals().unwrap(), &renderer.scene.camera, false);
+    let truth = GroundTruth::new(&scene).trace(&scene.lights[0], &points, Sampling::DEFAULT, 1);
+    let covered: Vec<bool> = positions.iter().map(|p| p[3] > 0.5).collect();
+    let frame = &renderer.scene.light_frames[0];
+    assert!(frame.reaches_widest_angle(), "the case must reach past the frame");
+    let past: Vec<bool> = positions
+        .iter()
+        .map(|p| {
+            let offset = Vec3::new(p[0], p[1], p[2]) - frame.light.centre;
+            let depth = offset.dot(frame.light.normal());
+            let across = Vec2::new(offset.dot(frame.light.u_axis).abs(), offset.dot(frame.light.v_axis).abs());
+            p[3] > 0.5 && depth > 0.0 && (across.x > depth * frame.tan_half.x || across.y > depth * frame.tan_half.y)
+        })
+        .collect();
+    let mut checked = 0;
+    for info in registry().iter().filter(|info| info.light_view == LightView::SideFaces) {
+        let Frame { visibility, .. } = render(&scene, info).unwrap();
+        let mut only_past = covered.clone();
+        for (keep, past) in only_past.iter_mut().zip(&past) {
+            *keep &= *past;
+        }
+        let metrics = compare_with_noise(&truth.visibility, Some(&truth.noise), &visibility, &only_past, SIZE.0 as usize, SIZE.1 as usize);
+        println!("{}: {:.4} where either shadows past the frame, over {} pixels", info.name, metrics.mae, metrics.pixels);
+        assert!(metrics.pixels > 20, "{}: too few shadowed pixels past the frame ({})", info.name, metrics.pixels);
+        assert!(metrics.mae < 0.05, "{}: mean |error| {:.4} past the frame where either shadows", info.name, metrics.mae);
+        checked += 1;
+    }
+    assert!(checked > 0, "no registered technique answers past the frame with side faces of its own");
 }

@@ -9,10 +9,10 @@
 
 // #import common/screen_pass.wgsl
 // #import common/pixel_work.wgsl
+// #import common/side_faces.wgsl
 
 @group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
-// The side faces' linear depth maps (core/light_depth.wgsl, through LightFrame::side_face_uniform):
-// +u, -u, +v, -v. Each covers tangents [-1, 1] across and [0, 1] towards the light's normal.
+// The side faces' linear depth maps (common/side_faces.wgsl): +u, -u, +v, -v.
 @group(2) @binding(1) var face_plus_u: texture_2d<f32>;
 @group(2) @binding(2) var face_minus_u: texture_2d<f32>;
 @group(2) @binding(3) var face_plus_v: texture_2d<f32>;
@@ -29,42 +29,14 @@ struct BeyondFrameSettings {
 };
 @group(2) @binding(7) var<uniform> settings: BeyondFrameSettings;
 
-// The point lies past the frame: in front of the light, outside its frustum's tangents.
-fn beyond_frame(offset: vec3<f32>) -> bool {
-    let depth = dot(offset, frame.normal.xyz);
-    let across = vec2<f32>(abs(dot(offset, frame.u_axis.xyz)), abs(dot(offset, frame.v_axis.xyz)));
-    return depth > 0.0 && any(across > depth * frame.projection.xy);
-}
-
 // Hard visibility from the light's centre through the side face that `offset` (from the centre)
 // falls in: 1 when no surface of the face's map is nearer along the face's axis.
 fn side_face_visibility(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
-    let u = frame.u_axis.xyz;
-    let v = frame.v_axis.xyz;
     let n = frame.normal.xyz;
     let size = settings.values.yz;
-    // The face of the largest of |offset.u| and |offset.v|, and its axes across and forward as
-    // LightFrame::side_face_axes builds them (down is the light's normal on every face).
-    var across = v;
-    var forward = u;
-    var face = 0;
-    let along_u = dot(offset, u);
-    let along_v = dot(offset, v);
-    if (abs(along_u) >= abs(along_v)) {
-        if (along_u < 0.0) {
-            across = -v;
-            forward = -u;
-            face = 1;
-        }
-    } else if (along_v >= 0.0) {
-        across = -u;
-        forward = v;
-        face = 2;
-    } else {
-        across = u;
-        forward = -v;
-        face = 3;
-    }
+    let side = side_face_of(frame, offset);
+    let across = side.across;
+    let forward = side.forward;
     // The point's depth along the face's axis, and the depth its own surface (the tangent plane,
     // normal `normal`) may have at the centre of the texel it falls in: the map holds the surface
     // rasterized at texel centres. Seen from the light's centre at a grazing angle a surface's
@@ -81,10 +53,10 @@ fn side_face_visibility(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
     let bias = min(settings.values.w * texel_tangent * slope, depth);
     let texel = vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), size - 1.0));
     var stored = 0.0;
-    switch face {
-        case 0: { stored = textureLoad(face_plus_u, texel, 0).x; }
-        case 1: { stored = textureLoad(face_minus_u, texel, 0).x; }
-        case 2: { stored = textureLoad(face_plus_v, texel, 0).x; }
+    switch side.index {
+        case 0u: { stored = textureLoad(face_plus_u, texel, 0).x; }
+        case 1u: { stored = textureLoad(face_minus_u, texel, 0).x; }
+        case 2u: { stored = textureLoad(face_plus_v, texel, 0).x; }
         default: { stored = textureLoad(face_minus_v, texel, 0).x; }
     }
     return select(0.0, 1.0, depth - bias <= stored);
@@ -101,7 +73,7 @@ fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     var reads = 2u;
     var stored = 0u;
     let offset = point.position - frame.centre.xyz;
-    if (point.covered && !unlit_by_rule(point) && beyond_frame(offset)) {
+    if (point.covered && !unlit_by_rule(point) && past_the_frame(frame, offset)) {
         let answer = side_face_visibility(offset, point.normal);
         textureStore(visibility, texel, vec4<f32>(answer, 0.0, 0.0, 0.0));
         atomicAdd(&answered[u32(settings.values.x)], 1u);

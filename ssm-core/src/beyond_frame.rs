@@ -8,25 +8,26 @@
 //! sampler's clamp finds (a floor beside a light resting on it read 0.75–0.89 where it is lit or
 //! umbra). Such receivers are common (under a light on a wall, the floor and the wall near it lie
 //! close to 90° off the light's normal), so where a light's frame reached that angle the framework
-//! renders the rest of the light's front hemisphere as four side faces around its centre (the
-//! sides of a hemicube, each the half in front of the light), and answers every receiver past the
-//! frame with a hard shadow from the centre through them
-//! (`shaders/core/beyond_frame.wgsl`). The same answer for every such technique: it is not the
-//! technique's own method, so the pass counts the pixels it answered and the reports say how many
-//! ([`BEYOND_FRAME_DIAGNOSTIC`]). Lights whose frame stays inside the widest angle get no faces and
-//! no pass: their cost and memory are unchanged.
+//! renders the rest of the light's front hemisphere as four side faces around its centre
+//! ([`SideFaceMaps`]), and answers every receiver past the frame with a hard shadow from the
+//! centre through them (`shaders/core/beyond_frame.wgsl`). The same answer for every such
+//! technique: it is not the technique's own method, so the pass counts the pixels it answered and
+//! the reports say how many ([`BEYOND_FRAME_DIAGNOSTIC`]). A technique that answers them itself
+//! ([`LightView::SideFaces`](crate::LightView::SideFaces)) gets no pass. Lights whose frame stays
+//! inside the widest angle get no faces and no pass: their cost and memory are unchanged.
+//!
+//! [`LightFrame`]: crate::LightFrame
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::frame::Frame;
-use crate::gpu_scene::Geometry;
-use crate::light_depth::{LightDepthMap, LightDepthMapDesc};
 use crate::passes::{
     bind_group, bind_group_layout, compute_pipeline, storage_buffer, storage_entry, texture_entry, uniform_buffer, uniform_entry,
     visibility_storage_entry,
 };
 use crate::read_counts::ReadCounts;
 use crate::shader::create_shader;
+use crate::side_faces::{SIDE_FACE_WIDTH, SideFaceMaps};
 use crate::technique::TechniqueSetup;
 use crate::work::ShaderWork;
 
@@ -37,14 +38,9 @@ pub const BEYOND_FRAME_PASS: &str = "beyond_frame";
 /// over the lights, in the last frame.
 pub const BEYOND_FRAME_DIAGNOSTIC: &str = "pixels_beyond_frame";
 
-/// Width of each side face's map, texels (the height is half: the part in front of the light).
-pub const SIDE_FACE_WIDTH: u32 = 1024;
-
 /// Texels of the receiver's own depth change across a side face's texel that its bias allows
 /// (`shaders/core/beyond_frame.wgsl`: from the receiver's plane, so unclamped at grazing angles).
 const SIDE_FACE_RECEIVER_BIAS_TEXELS: f32 = 0.75;
-/// Constant bias of the side faces' maps, as a fraction of the scene's diagonal.
-const SIDE_FACE_CONSTANT_BIAS: f32 = 1e-5;
 
 /// What the pass counts in a counting frame, in the order its shader indexes them.
 const COUNTERS: &[(&str, &str)] = &[(BEYOND_FRAME_PASS, "reads"), (BEYOND_FRAME_PASS, "storage_bytes")];
@@ -57,10 +53,7 @@ pub fn beyond_frame_label(technique: &str) -> String {
 
 /// One light's side faces and the lookup's bindings.
 struct LightFaces {
-    /// +u, −u, +v, −v.
-    maps: Vec<LightDepthMap>,
-    /// Each face's frame uniform (layout [`GpuContext::uniform_layout`]).
-    face_frames: Vec<wgpu::BindGroup>,
+    faces: SideFaceMaps,
     group: wgpu::BindGroup,
 }
 
@@ -123,41 +116,14 @@ impl BeyondFrame {
         })?;
         let own_layout = pipeline.get_bind_group_layout(2);
         let answered = storage_buffer(device, &format!("{label}_answered"), 4 * scene.light_frames.len() as u64);
-        // Receivers past the frame are shadowed by what casts: with roles, the occluders.
-        let geometry = if scene.has_roles { Geometry::Occluders } else { Geometry::All };
         let height = SIDE_FACE_WIDTH / 2;
         let mut lights = Vec::with_capacity(scene.light_frames.len());
-        for (light, (light_frame, output)) in scene.light_frames.iter().zip(setup.outputs).enumerate() {
-            if !light_frame.reaches_widest_angle() {
+        for (light, output) in setup.outputs.iter().enumerate() {
+            let Some(faces) = SideFaceMaps::new(gpu, scene, light, &label)? else {
                 lights.push(None);
                 continue;
-            }
-            let mut maps = Vec::with_capacity(4);
-            let mut face_frames = Vec::with_capacity(4);
-            for face in 0..4 {
-                let face_label = format!("{label}_light{light}_face{face}");
-                maps.push(LightDepthMap::new(
-                    gpu,
-                    scene,
-                    &LightDepthMapDesc {
-                        label: &face_label,
-                        width: SIDE_FACE_WIDTH,
-                        height,
-                        geometry,
-                        cull_mode: None,
-                        farthest: false,
-                        constant_bias: SIDE_FACE_CONSTANT_BIAS * light_frame.scene_diagonal,
-                        slope_bias: 0.0,
-                    },
-                )?);
-                let uniform = uniform_buffer(device, &format!("{face_label}_frame_uniform"), &light_frame.side_face_uniform(face));
-                face_frames.push(bind_group(
-                    device,
-                    &format!("{face_label}_frame_bind_group"),
-                    gpu.uniform_layout(),
-                    &[uniform.as_entire_binding()],
-                ));
-            }
+            };
+            let [plus_u, minus_u, plus_v, minus_v] = faces.linear_depth_views();
             let settings = uniform_buffer(
                 device,
                 &format!("{label}_light{light}_settings"),
@@ -169,16 +135,16 @@ impl BeyondFrame {
                 &own_layout,
                 &[
                     wgpu::BindingResource::TextureView(output),
-                    wgpu::BindingResource::TextureView(&maps[0].linear_depth_view),
-                    wgpu::BindingResource::TextureView(&maps[1].linear_depth_view),
-                    wgpu::BindingResource::TextureView(&maps[2].linear_depth_view),
-                    wgpu::BindingResource::TextureView(&maps[3].linear_depth_view),
+                    wgpu::BindingResource::TextureView(plus_u),
+                    wgpu::BindingResource::TextureView(minus_u),
+                    wgpu::BindingResource::TextureView(plus_v),
+                    wgpu::BindingResource::TextureView(minus_v),
                     answered.as_entire_binding(),
                     read_counts.buffer().as_entire_binding(),
                     settings.as_entire_binding(),
                 ],
             );
-            lights.push(Some(LightFaces { maps, face_frames, group }));
+            lights.push(Some(LightFaces { faces, group }));
         }
         Ok(Some(Self {
             answered_clear_label: format!("{label}_answered_clear"),
@@ -210,9 +176,7 @@ impl BeyondFrame {
             frame.clear_buffer(&self.answered_clear_label, &self.answered, 0, None);
             self.read_counts.clear(frame, 0);
         }
-        for (map, face_frame) in faces.maps.iter().zip(&faces.face_frames) {
-            map.encode_with(frame, face_frame);
-        }
+        faces.faces.encode(frame);
         let mut pass = frame.compute_pass(&self.label);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);

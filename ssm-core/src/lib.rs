@@ -61,11 +61,12 @@ mod registry;
 mod renderer;
 mod screen_pass;
 pub mod shader;
+mod side_faces;
 mod technique;
 mod timing;
 pub mod work;
 
-pub use beyond_frame::{BEYOND_FRAME_DIAGNOSTIC, BEYOND_FRAME_PASS, SIDE_FACE_WIDTH, beyond_frame_label};
+pub use beyond_frame::{BEYOND_FRAME_DIAGNOSTIC, BEYOND_FRAME_PASS, beyond_frame_label};
 pub use context::{ContextError, GpuContext, OPTIONAL_FEATURES};
 pub use error::{BoxedError, Error, Reason, Result};
 pub use frame::{CountedComputePass, CountedRenderPass, Frame, SharedInputs};
@@ -81,6 +82,7 @@ pub use params::{Choice, ParamError, ParamKind, ParamSpec, ParamValue, ParamValu
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
+pub use side_faces::{SIDE_FACE_WIDTH, SideFaceMaps};
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
     DebugOutput, ExtraImage, KnownLimit, LightSampling, LightView, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo,

@@ -37,7 +37,10 @@
 //! # }
 //! ```
 
+mod side_faces;
+
 use bytemuck::{Pod, Zeroable};
+pub use side_faces::{PcssSideFaceSettings, SIDE_FACES_PASS};
 use ssm_core::passes::{
     bind_group, bind_group_layout, compute_pipeline, storage_buffer, storage_entry, texture_entry, uniform_buffer, uniform_entry,
     visibility_storage_entry,
@@ -141,6 +144,9 @@ enum SearchAndFilter {
 pub struct Pcss {
     depth_map: LightDepthMap,
     search_and_filter: SearchAndFilter,
+    /// The receivers past the frame's widest angle, on a hemicube's side faces; `None` when no
+    /// light's frame reaches it.
+    side_faces: Option<side_faces::SideFaces>,
     map_bind_group: wgpu::BindGroup,
     read_counts: ReadCounts,
     width: u32,
@@ -186,7 +192,16 @@ impl Pcss {
             }
             TapSource::WorkgroupTile => Self::tiled(setup, &map_layout, &read_counts)?,
         };
-        Ok(Self { depth_map, search_and_filter, map_bind_group, read_counts, width: setup.scene.width, height: setup.scene.height })
+        let side_faces = side_faces::SideFaces::new(setup, &settings)?;
+        Ok(Self {
+            depth_map,
+            search_and_filter,
+            side_faces,
+            map_bind_group,
+            read_counts,
+            width: setup.scene.width,
+            height: setup.scene.height,
+        })
     }
 
     /// The compute pass of [`TapSource::WorkgroupTile`].
@@ -242,6 +257,9 @@ impl ShadowTechnique for Pcss {
                 pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
             }
         }
+        if let Some(side_faces) = &self.side_faces {
+            side_faces.encode(frame, light);
+        }
         Ok(())
     }
 
@@ -250,7 +268,13 @@ impl ShadowTechnique for Pcss {
     /// computed pixel one texel per shadow-map tap; in the tiled pass a tap read from workgroup
     /// memory is not a texel read, and the tile's loads are (one per texel of the union).
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
-        self.read_counts.work(gpu)
+        let Some(mut work) = self.read_counts.work(gpu)? else {
+            return Ok(None);
+        };
+        if let Some(side_faces) = &self.side_faces {
+            work.extend(side_faces.work(gpu)?.unwrap_or_default());
+        }
+        Ok(Some(work))
     }
 
     /// With `count_reads`: texel reads per pixel of the screen, and the pixels; with `tap_source =
@@ -310,19 +334,23 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     kind: TechniqueKind::Realtime,
     // One view of the light from its centre: the framework adds the own surface's share.
     light_sampling: ssm_core::LightSampling::Centre,
-    light_view: ssm_core::LightView::Frame,
+    // Past the frame's widest angle, its own search and filter on a hemicube's side faces.
+    light_view: ssm_core::LightView::SideFaces,
     params: PcssSettings::PARAMS,
     requirements,
     create,
     presets: PRESETS,
     trade: Some("blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41"),
     debug_outputs: &[],
-    uniforms: &[UniformCheck {
-        wgsl_struct: "PcssSettings",
-        wgsl_source: SHADER,
-        imports: LOCAL_SHADERS,
-        rust: PcssSettingsUniform::LAYOUT,
-    }],
+    uniforms: &[
+        UniformCheck { wgsl_struct: "PcssSettings", wgsl_source: SHADER, imports: LOCAL_SHADERS, rust: PcssSettingsUniform::LAYOUT },
+        UniformCheck {
+            wgsl_struct: "PcssSideFaceSettings",
+            wgsl_source: ssm_shaders::pcss::PCSS_SIDE_FACES,
+            imports: &[],
+            rust: PcssSideFaceSettings::LAYOUT,
+        },
+    ],
     limits: &[],
 };
 
