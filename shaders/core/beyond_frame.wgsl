@@ -29,39 +29,6 @@ struct BeyondFrameSettings {
 };
 @group(2) @binding(7) var<uniform> settings: BeyondFrameSettings;
 
-// Hard visibility from the light's centre through the side face that `offset` (from the centre)
-// falls in: 1 when no surface of the face's map is nearer along the face's axis.
-fn side_face_visibility(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
-    let n = frame.normal.xyz;
-    let size = settings.values.yz;
-    let side = side_face_of(frame, offset);
-    let across = side.across;
-    let forward = side.forward;
-    // The point's depth along the face's axis, and the depth its own surface (the tangent plane,
-    // normal `normal`) may have at the centre of the texel it falls in: the map holds the surface
-    // rasterized at texel centres. Seen from the light's centre at a grazing angle a surface's
-    // depth changes by far more than a texel's width across one texel (D² δ (|N·a| + |N·n|) /
-    // |N·o| for a texel of tangent δ, D the depth, o the point's offset from the centre), and a
-    // fixed or clamped bias would let it shadow itself, as a floor a hair below a light does
-    // everywhere. The bias is that change over settings.w texels, at most the depth itself.
-    let depth = max(dot(offset, forward), 1e-30);
-    let tangents = vec2<f32>(dot(offset, across), dot(offset, n)) / depth;
-    let uv = vec2<f32>(0.5 + 0.5 * tangents.x, tangents.y);
-    let texel_tangent = 1.0 / size.y;
-    let facing = max(abs(dot(normal, offset)), 1e-30);
-    let slope = (abs(dot(normal, across)) + abs(dot(normal, n))) * depth * depth / facing;
-    let bias = min(settings.values.w * texel_tangent * slope, depth);
-    let texel = vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), size - 1.0));
-    var stored = 0.0;
-    switch side.index {
-        case 0u: { stored = textureLoad(face_plus_u, texel, 0).x; }
-        case 1u: { stored = textureLoad(face_minus_u, texel, 0).x; }
-        case 2u: { stored = textureLoad(face_plus_v, texel, 0).x; }
-        default: { stored = textureLoad(face_minus_v, texel, 0).x; }
-    }
-    return select(0.0, 1.0, depth - bias <= stored);
-}
-
 @compute @workgroup_size(8, 8)
 fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(visibility);
@@ -74,7 +41,7 @@ fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     var stored = 0u;
     let offset = point.position - frame.centre.xyz;
     if (point.covered && !unlit_by_rule(point) && past_the_frame(frame, offset)) {
-        let answer = side_face_visibility(offset, point.normal);
+        let answer = side_face_hard_visibility(frame, face_plus_u, face_minus_u, face_plus_v, face_minus_v, offset, point.normal, settings.values.w);
         textureStore(visibility, texel, vec4<f32>(answer, 0.0, 0.0, 0.0));
         atomicAdd(&answered[u32(settings.values.x)], 1u);
         reads += 1u;

@@ -6,6 +6,7 @@
 // #import common/screen_pass.wgsl
 // #import common/shadow_map.wgsl
 // #import common/read_counts.wgsl
+// #import common/side_faces.wgsl
 
 struct MultiSmSettings {
     // 1 / K.
@@ -14,6 +15,11 @@ struct MultiSmSettings {
     normal_offset: f32,
     // Half the sides of one stratum of the light, world units, along the light's two axes.
     stratum_half_size: vec2<f32>,
+    // 1 where this light's samples have side faces (a sample's frame reached the widest angle).
+    side_faces: u32,
+    // The texels of the receiver's own depth change the side faces' bias allows.
+    side_face_bias_texels: f32,
+    padding: vec2<f32>,
 };
 
 // Group 0 (`frame`) holds this sample's frame: a point light at the sample, with the light's axes.
@@ -27,6 +33,13 @@ struct MultiSmSettings {
 // where the sample's lookup is made (the normal offset reads none); it stores one r32float, 4
 // bytes.
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+// This sample's side faces (common/side_faces.wgsl), +u, -u, +v, -v, drawn around it where its
+// frame reaches the widest angle (settings.side_faces): a receiver past its frame is looked up
+// there, one texel. A 1x1 texel never read otherwise.
+@group(2) @binding(4) var face_plus_u: texture_2d<f32>;
+@group(2) @binding(5) var face_minus_u: texture_2d<f32>;
+@group(2) @binding(6) var face_plus_v: texture_2d<f32>;
+@group(2) @binding(7) var face_minus_v: texture_2d<f32>;
 
 // The share of this sample's stratum (a rectangle of the light centred on the sample, the frame's
 // centre) in front of a closed surface's tangent plane at `point`; 1 on an open surface, which the
@@ -62,6 +75,11 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
             lit = 0.0;
         } else if (point.closed && light_centre_height(frame, point.position, point.normal) < 0.0) {
             lit = share;
+        } else if (settings.side_faces != 0u && frame_reaches_widest_angle(frame) && past_the_frame(frame, point.position - frame.centre.xyz)) {
+            // Past this sample's frame: its hard shadow through the side face around it.
+            reads += 1u;
+            let offset = point.position - frame.centre.xyz;
+            lit = share * side_face_hard_visibility(frame, face_plus_u, face_minus_u, face_plus_v, face_minus_v, offset, point.normal, settings.side_face_bias_texels);
         } else {
             let lookup = normal_offset_position(frame, shadow_map, point.position, point.normal, settings.normal_offset);
             let uvd = light_uv_depth(frame, lookup);

@@ -27,7 +27,7 @@ use crate::passes::{
 };
 use crate::read_counts::ReadCounts;
 use crate::shader::create_shader;
-use crate::side_faces::{SIDE_FACE_WIDTH, SideFaceMaps};
+use crate::side_faces::{SIDE_FACE_WIDTH, SideFaceFrames, SideFaceMaps};
 use crate::technique::TechniqueSetup;
 use crate::work::ShaderWork;
 
@@ -54,6 +54,7 @@ pub fn beyond_frame_label(technique: &str) -> String {
 /// One light's side faces and the lookup's bindings.
 struct LightFaces {
     faces: SideFaceMaps,
+    face_frames: SideFaceFrames,
     group: wgpu::BindGroup,
 }
 
@@ -119,7 +120,7 @@ impl BeyondFrame {
         let height = SIDE_FACE_WIDTH / 2;
         let mut lights = Vec::with_capacity(scene.light_frames.len());
         for (light, output) in setup.outputs.iter().enumerate() {
-            let Some(faces) = SideFaceMaps::new(gpu, scene, light, &label)? else {
+            let Some((faces, face_frames)) = SideFaceMaps::for_light(gpu, scene, light, &label)? else {
                 lights.push(None);
                 continue;
             };
@@ -144,7 +145,7 @@ impl BeyondFrame {
                     settings.as_entire_binding(),
                 ],
             );
-            lights.push(Some(LightFaces { faces, group }));
+            lights.push(Some(LightFaces { faces, face_frames, group }));
         }
         Ok(Some(Self {
             answered_clear_label: format!("{label}_answered_clear"),
@@ -176,7 +177,7 @@ impl BeyondFrame {
             frame.clear_buffer(&self.answered_clear_label, &self.answered, 0, None);
             self.read_counts.clear(frame, 0);
         }
-        faces.faces.encode(frame);
+        faces.faces.encode(frame, &faces.face_frames);
         let mut pass = frame.compute_pass(&self.label);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, light_frame, &[]);

@@ -82,7 +82,7 @@ pub use params::{Choice, ParamError, ParamKind, ParamSpec, ParamValue, ParamValu
 pub use registry::Registry;
 pub use renderer::{Renderer, VISIBILITY_FORMAT, VISIBILITY_RANGE_TOLERANCE};
 pub use screen_pass::ScreenPass;
-pub use side_faces::{SIDE_FACE_WIDTH, SideFaceMaps};
+pub use side_faces::{SIDE_FACE_WIDTH, SideFaceFrames, SideFaceMaps};
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
     DebugOutput, ExtraImage, KnownLimit, LightSampling, LightView, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo,

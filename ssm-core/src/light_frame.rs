@@ -389,6 +389,14 @@ mod tests {
 
     use super::*;
 
+    /// The WGSL that decides whether a frame reached its widest angle (multi-sm's samples) holds
+    /// the same tangent.
+    #[test]
+    fn the_shaders_widest_tangent_is_this_one() {
+        let line = format!("const MAX_HALF_ANGLE_TANGENT: f32 = {MAX_HALF_ANGLE_TANGENT:?};");
+        assert!(ssm_shaders::common::SIDE_FACES.contains(&line), "shaders/common/side_faces.wgsl lacks `{line}`");
+    }
+
     #[test]
     fn frame_contains_the_scene_and_agrees_with_the_projection_matrix() {
         for entry in ssm_scene::BUILTIN_SCENES {

@@ -217,8 +217,7 @@ pub enum LightSampling {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightView {
     /// Through one perspective frustum from the light: the shared light frame, a tile of it, or
-    /// one per light sample (hard, vssm, sssm, atty, pvsm, multi-sm, and a new technique by
-    /// default). Such a frustum stops at the frame's widest angle
+    /// one per light sample (hard, vssm, sssm, atty, pvsm, and a new technique by default). Such a frustum stops at the frame's widest angle
     /// ([`MAX_HALF_ANGLE_TANGENT`](crate::MAX_HALF_ANGLE_TANGENT), about 84° off the light's
     /// normal). Where a light's frame reaches it, the framework renders the rest of the light's
     /// front hemisphere as a hemicube's four side faces and answers every receiver past the
@@ -227,10 +226,11 @@ pub enum LightView {
     /// pixels it answered (the diagnostic `pixels_beyond_frame`): the technique's own method does
     /// not reach them. The technique needs the G-buffer for it ([`TechniqueInfo::needs`]).
     Frame,
-    /// Through the shared light frame, and past its widest angle through a hemicube's four side
-    /// faces of its own ([`SideFaceMaps`](crate::SideFaceMaps)), where it answers the receivers
-    /// with its own method (pcss: its blocker search and filter on the face a receiver lies in).
-    /// The framework adds nothing.
+    /// Through a perspective frame (the shared one, or one per light sample), and past its widest
+    /// angle through a hemicube's four side faces of its own ([`SideFaceMaps`](crate::SideFaceMaps)),
+    /// where it answers the receivers with its own method (pcss: its blocker search and filter on
+    /// the face a receiver lies in; multi-sm: each sample's hard shadow through faces around that
+    /// sample). The framework adds nothing.
     SideFaces,
     /// Over the light's whole front hemisphere: shadow volumes (wedges) and the ground truth's
     /// rays. The framework adds nothing.

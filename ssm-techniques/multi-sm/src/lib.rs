@@ -43,8 +43,8 @@ use ssm_core::shader::create_shader;
 use ssm_core::ssm_scene::RectLight;
 use ssm_core::{
     Error, Frame, GpuContext, LightDepthMap, LightFrame, LightFrameUniform, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE,
-    SHADOW_MAP_MIN_SIZE, Settings, ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck,
-    UniformStruct, register_technique, screen_space_requirements,
+    SHADOW_MAP_MIN_SIZE, Settings, ShadowMapBias, ShadowTechnique, SideFaceFrames, SideFaceMaps, TechniqueInfo, TechniqueKind,
+    TechniqueSetup, UniformCheck, UniformStruct, register_technique, screen_space_requirements,
 };
 
 /// The registered name.
@@ -80,18 +80,31 @@ pub struct MultiSmSettingsUniform {
     normal_offset: f32,
     /// Half the sides of one stratum of the light, world units (along its first and second axes).
     stratum_half_size: [f32; 2],
+    /// 1 where the light's samples have side faces (a sample's frame reached the widest angle).
+    side_faces: u32,
+    /// The texels of the receiver's own depth change the side faces' bias allows.
+    side_face_bias_texels: f32,
+    padding: [f32; 2],
 }
 
 impl MultiSmSettingsUniform {
-    /// The settings for a light of half sides `half_size` cut into `per_axis` × `per_axis` strata.
-    fn new(settings: &MultiSmSettings, half_size: Vec2, per_axis: u32) -> Self {
+    /// The settings for a light of half sides `half_size` cut into `per_axis` × `per_axis` strata,
+    /// its samples with side faces or not.
+    fn new(settings: &MultiSmSettings, half_size: Vec2, per_axis: u32, side_faces: bool) -> Self {
         Self {
             weight: 1.0 / settings.samples.max(1) as f32,
             normal_offset: settings.bias.normal_offset,
             stratum_half_size: (half_size / per_axis.max(1) as f32).to_array(),
+            side_faces: u32::from(side_faces),
+            side_face_bias_texels: SIDE_FACE_BIAS_TEXELS,
+            padding: [0.0; 2],
         }
     }
 }
+
+/// Texels of the receiver's own depth change across a side face's texel that its bias allows, as
+/// the framework's hard answer past the frame (`shaders/common/side_faces.wgsl`).
+const SIDE_FACE_BIAS_TEXELS: f32 = 0.75;
 
 /// The centres of the strata of a `per_axis` × `per_axis` grid on the light, in `[-1, 1]²`.
 #[must_use]
@@ -103,6 +116,9 @@ pub fn stratum_centres(per_axis: u32) -> Vec<Vec2> {
 /// K hard shadow maps from stratified points on the light, averaged.
 pub struct MultiShadowMaps {
     depth_map: LightDepthMap,
+    /// Past a sample's frame's widest angle, a hemicube's side faces around the sample, drawn for
+    /// one sample after another (`None` when no light reaches that angle).
+    side_faces: Option<SideFaceMaps>,
     /// Per light, per sample: the frame of a point light at the sample.
     sample_frames: Vec<Vec<SampleFrame>>,
     accumulate: wgpu::ComputePipeline,
@@ -136,8 +152,43 @@ impl MultiShadowMaps {
         let own_layout = bind_group_layout(
             device,
             "multi_sm_own_layout",
-            &[texture_entry(0), uniform_entry(1), visibility_storage_entry(2), ReadCounts::layout_entry(3)],
+            &[
+                texture_entry(0),
+                uniform_entry(1),
+                visibility_storage_entry(2),
+                ReadCounts::layout_entry(3),
+                texture_entry(4),
+                texture_entry(5),
+                texture_entry(6),
+                texture_entry(7),
+            ],
         );
+        let sample_frames = sample_frames(setup, per_axis);
+        // A light gets side faces where one of its samples' frames reaches the widest angle; the
+        // four maps serve every sample in turn.
+        let lights_with_faces: Vec<bool> =
+            sample_frames.iter().map(|samples| samples.iter().any(|sample| sample.side_face_frames.is_some())).collect();
+        let side_faces =
+            if lights_with_faces.contains(&true) { Some(SideFaceMaps::new(setup.gpu, setup.scene, "multi_sm_side")?) } else { None };
+        // Without faces the bindings hold a texel that is never read (the settings say so).
+        let unused_face = LightDepthMap::new(
+            setup.gpu,
+            setup.scene,
+            &ssm_core::LightDepthMapDesc {
+                label: "multi_sm_no_side_face",
+                width: 1,
+                height: 1,
+                geometry: ssm_core::Geometry::All,
+                cull_mode: None,
+                farthest: false,
+                constant_bias: 0.0,
+                slope_bias: 0.0,
+            },
+        )?;
+        let face_views = side_faces
+            .as_ref()
+            .map_or([&unused_face.linear_depth_view; 4], SideFaceMaps::linear_depth_views)
+            .map(wgpu::BindingResource::TextureView);
         let own_groups = setup
             .outputs
             .iter()
@@ -147,8 +198,9 @@ impl MultiShadowMaps {
                 let settings_buffer = uniform_buffer(
                     device,
                     &format!("multi_sm_settings_uniform_{light}"),
-                    &MultiSmSettingsUniform::new(&settings, half_size, per_axis),
+                    &MultiSmSettingsUniform::new(&settings, half_size, per_axis, lights_with_faces[light]),
                 );
+                let [plus_u, minus_u, plus_v, minus_v] = face_views.clone();
                 bind_group(
                     device,
                     &format!("multi_sm_own_bind_group_{light}"),
@@ -158,6 +210,10 @@ impl MultiShadowMaps {
                         settings_buffer.as_entire_binding(),
                         wgpu::BindingResource::TextureView(output),
                         read_counts.buffer().as_entire_binding(),
+                        plus_u,
+                        minus_u,
+                        plus_v,
+                        minus_v,
                     ],
                 )
             })
@@ -173,7 +229,8 @@ impl MultiShadowMaps {
         );
         Ok(Self {
             depth_map,
-            sample_frames: sample_frames(setup, per_axis),
+            side_faces,
+            sample_frames,
             accumulate,
             gbuffer_bind_group: gbuffer.bind_group.clone(),
             own_groups,
@@ -189,6 +246,8 @@ struct SampleFrame {
     frame: LightFrame,
     buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
+    /// The side faces' frames around the sample, where its frame reaches the widest angle.
+    side_face_frames: Option<SideFaceFrames>,
 }
 
 /// Per light, per stratum: the light frame of a point light at the stratum's centre, sealed
@@ -224,7 +283,10 @@ fn sample_frames(setup: &TechniqueSetup<'_>, per_axis: u32) -> Vec<Vec<SampleFra
                         setup.gpu.uniform_layout(),
                         &[buffer.as_entire_binding()],
                     );
-                    SampleFrame { frame: sample, buffer, bind_group }
+                    let side_face_frames = sample
+                        .reaches_widest_angle()
+                        .then(|| SideFaceFrames::new(setup.gpu, &sample, &format!("multi_sm_side_light{light_index}_sample{k}")));
+                    SampleFrame { frame: sample, buffer, bind_group, side_face_frames }
                 })
                 .collect()
         })
@@ -246,6 +308,9 @@ impl ShadowTechnique for MultiShadowMaps {
         drop(frame.render_pass("multi_sm_clear", &[color_attachment(output, Some(wgpu::Color::TRANSPARENT))], None));
         for sample in frames.iter() {
             self.depth_map.encode_with(frame, &sample.bind_group);
+            if let (Some(faces), Some(face_frames)) = (&self.side_faces, &sample.side_face_frames) {
+                faces.encode(frame, face_frames);
+            }
             let mut pass = frame.compute_pass(ACCUMULATE_PASS);
             pass.set_pipeline(&self.accumulate);
             pass.set_bind_group(0, &sample.bind_group, &[]);
@@ -287,7 +352,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     // A map per light sample, each with the shared rules for that point light (multi_sm.wgsl):
     // the own surface's share is in its answer, not charged twice.
     light_sampling: ssm_core::LightSampling::PerSample,
-    light_view: ssm_core::LightView::Frame,
+    // Past a sample's frame, that sample's hard shadow through a hemicube's side faces around it.
+    light_view: ssm_core::LightView::SideFaces,
     params: MultiSmSettings::PARAMS,
     requirements,
     create,

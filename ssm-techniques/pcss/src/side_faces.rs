@@ -8,7 +8,7 @@ use ssm_core::passes::{
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
-use ssm_core::{Frame, GpuContext, Result, SideFaceMaps, TechniqueSetup, UniformStruct};
+use ssm_core::{Frame, GpuContext, Result, SideFaceFrames, SideFaceMaps, TechniqueSetup, UniformStruct};
 
 use crate::PcssSettings;
 
@@ -41,6 +41,7 @@ pub struct PcssSideFaceSettings {
 /// One light's faces and the pass's bindings.
 struct LightFaces {
     faces: SideFaceMaps,
+    face_frames: SideFaceFrames,
     group: wgpu::BindGroup,
 }
 
@@ -94,7 +95,7 @@ impl SideFaces {
         );
         let mut lights = Vec::with_capacity(scene.light_frames.len());
         for (light, output) in setup.outputs.iter().enumerate() {
-            let Some(faces) = SideFaceMaps::new(gpu, scene, light, crate::NAME)? else {
+            let Some((faces, face_frames)) = SideFaceMaps::for_light(gpu, scene, light, crate::NAME)? else {
                 lights.push(None);
                 continue;
             };
@@ -121,7 +122,7 @@ impl SideFaces {
                     settings_buffer.as_entire_binding(),
                 ],
             );
-            lights.push(Some(LightFaces { faces, group }));
+            lights.push(Some(LightFaces { faces, face_frames, group }));
         }
         Ok(Some(Self {
             pipeline,
@@ -140,7 +141,7 @@ impl SideFaces {
         let Some(faces) = self.lights.get(light).and_then(Option::as_ref) else {
             return;
         };
-        faces.faces.encode(frame);
+        faces.faces.encode(frame, &faces.face_frames);
         let light_group = &frame.scene.light_bind_groups[light];
         let mut pass = frame.compute_pass(SIDE_FACES_PASS);
         pass.set_pipeline(&self.pipeline);
