@@ -978,7 +978,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: AttySettingsUniform::LAYOUT,
     }],
-    limits: &[],
+    limits: &[ssm_core::KnownLimit {
+        case: "light resting on the receiver",
+        mean_error: 0.25,
+        reason: "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): the soft shadow map is one virtual plane parallel to the light, onto which each micro-patch's penumbra pyramid cuts an axis-aligned rectangle (Atty et al. 2006, Sec. 3.3, Fig. 7); the micro-patches are parallel to the light (Sec. 3), which a hemicube's side faces, perpendicular to it, are not",
+    }],
 };
 
 /// The error Atty et al.'s figures plot (Sec. 5.2.1): the mean absolute error over the pixels in

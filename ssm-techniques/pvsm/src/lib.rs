@@ -1544,7 +1544,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         UniformCheck { wgsl_struct: "TileSettings", wgsl_source: TILE_PYRAMID_SHADER, imports: &[], rust: TileSettingsUniform::LAYOUT },
         UniformCheck { wgsl_struct: "Kernel", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: KernelRecord::LAYOUT },
     ],
-    limits: &[],
+    limits: &[ssm_core::KnownLimit {
+        case: "light resting on the receiver",
+        mean_error: 0.25,
+        reason: "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): the predicted resolutions are gathered in one tile grid on the shadow map plane, whose kd-tree tiles are the virtual shadow maps (Shen et al. 2011, Sec. 5.2); that plane cannot reach 90 degrees off its axis, and a hemicube's side faces would need a grid, a pyramid and a kd-tree each",
+    }],
 };
 
 register_technique!(INFO);

@@ -797,6 +797,10 @@ const PRESETS: &[ssm_core::Preset] = &[
 /// Why a light 1000 times longer than wide is beyond the method (the extremes matrix's tube cases).
 const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis";
 
+/// Why the receivers past the light frame's widest angle get the framework's hard shadow (the
+/// extremes matrix's light resting on the receiver).
+const ONE_FRAME_LIMIT: &str = "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): the separable blocker search runs along the rows, then the columns, of one shadow map, and the paper leaves cube shadow maps to future work (Buades et al. 2015, Sec. 7); a hemicube's side faces are four maps whose rows do not continue across their edges";
+
 /// The registration.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: NAME,
@@ -829,7 +833,10 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         imports: LOCAL_SHADERS,
         rust: SssmSettingsUniform::LAYOUT,
     }],
-    limits: &[ssm_core::KnownLimit { case: "tube light across the scene at 30 degrees", mean_error: 0.15, reason: TUBE_LIMIT }],
+    limits: &[
+        ssm_core::KnownLimit { case: "tube light across the scene at 30 degrees", mean_error: 0.15, reason: TUBE_LIMIT },
+        ssm_core::KnownLimit { case: "light resting on the receiver", mean_error: 0.25, reason: ONE_FRAME_LIMIT },
+    ],
 };
 
 register_technique!(INFO);
