@@ -81,12 +81,6 @@ const INTERIOR_SOFT: &[&str] = &["pcss", "sssm", "pvsm"];
 /// until its line is removed. They are bugs or missing features of the implementation, not limits
 /// of the papers (those are `KnownLimit`s, declared by the technique with the paper's reason).
 const OPEN_FAILURES: &[(&str, &str, &str)] = &[
-    // The light frame stops at 84 degrees off the light's normal: past it the framework answers
-    // with a hard shadow from the light's centre (LightView::Frame, ssm-core's beyond_frame.rs),
-    // the same error as hard's, where the truth's penumbra there is wide. pcss answers there with
-    // its own search and filter on a hemicube's side faces (LightView::SideFaces): 0.0178; multi-sm
-    // with each sample's hard shadow through side faces around it: 0.0561.
-    ("vssm", "light resting on the receiver", "past the frame's widest angle the framework's hard shadow answers"),
     // Under a near-point light the penumbra is under a texel of their maps: these blur or alias
     // the map's edge more than a hard shadow from a map of the same size errs by (pcss keeps the
     // map's hard edge there). vssm's texel-wide window centred on the point straddles two texels;
