@@ -124,27 +124,17 @@ impl BeyondFrame {
                 lights.push(None);
                 continue;
             };
-            let [plus_u, minus_u, plus_v, minus_v] = faces.linear_depth_views();
             let settings = uniform_buffer(
                 device,
                 &format!("{label}_light{light}_settings"),
                 &[light as f32, SIDE_FACE_WIDTH as f32, height as f32, SIDE_FACE_RECEIVER_BIAS_TEXELS],
             );
-            let group = bind_group(
-                device,
-                &format!("{label}_light{light}_bind_group"),
-                &own_layout,
-                &[
-                    wgpu::BindingResource::TextureView(output),
-                    wgpu::BindingResource::TextureView(plus_u),
-                    wgpu::BindingResource::TextureView(minus_u),
-                    wgpu::BindingResource::TextureView(plus_v),
-                    wgpu::BindingResource::TextureView(minus_v),
-                    answered.as_entire_binding(),
-                    read_counts.buffer().as_entire_binding(),
-                    settings.as_entire_binding(),
-                ],
-            );
+            // The visibility, the four faces, the counters and the settings (bindings 0 to 7).
+            let entries: Vec<_> = std::iter::once(wgpu::BindingResource::TextureView(output))
+                .chain(faces.bindings())
+                .chain([answered.as_entire_binding(), read_counts.buffer().as_entire_binding(), settings.as_entire_binding()])
+                .collect();
+            let group = bind_group(device, &format!("{label}_light{light}_bind_group"), &own_layout, &entries);
             lights.push(Some(LightFaces { faces, face_frames, group }));
         }
         Ok(Some(Self {

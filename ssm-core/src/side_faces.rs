@@ -115,4 +115,11 @@ impl SideFaceMaps {
     pub fn linear_depth_views(&self) -> [&wgpu::TextureView; 4] {
         [&self.maps[0].linear_depth_view, &self.maps[1].linear_depth_view, &self.maps[2].linear_depth_view, &self.maps[3].linear_depth_view]
     }
+
+    /// The four views as consecutive bindings of a bind group, +u, −u, +v, −v (the order
+    /// `shaders/common/side_faces.wgsl`'s users bind them in).
+    #[must_use]
+    pub fn bindings(&self) -> [wgpu::BindingResource<'_>; 4] {
+        self.linear_depth_views().map(wgpu::BindingResource::TextureView)
+    }
 }

@@ -107,21 +107,12 @@ impl SideFaces {
                 relative_bias: RELATIVE_BIAS,
             };
             let settings_buffer = uniform_buffer(device, &format!("pcss_side_faces_light{light}_settings"), &uniform);
-            let [plus_u, minus_u, plus_v, minus_v] = faces.linear_depth_views();
-            let group = bind_group(
-                device,
-                &format!("pcss_side_faces_light{light}_bind_group"),
-                &own_layout,
-                &[
-                    wgpu::BindingResource::TextureView(output),
-                    wgpu::BindingResource::TextureView(plus_u),
-                    wgpu::BindingResource::TextureView(minus_u),
-                    wgpu::BindingResource::TextureView(plus_v),
-                    wgpu::BindingResource::TextureView(minus_v),
-                    read_counts.buffer().as_entire_binding(),
-                    settings_buffer.as_entire_binding(),
-                ],
-            );
+            // The visibility, the four faces, the counters and the settings (bindings 0 to 6).
+            let entries: Vec<_> = std::iter::once(wgpu::BindingResource::TextureView(output))
+                .chain(faces.bindings())
+                .chain([read_counts.buffer().as_entire_binding(), settings_buffer.as_entire_binding()])
+                .collect();
+            let group = bind_group(device, &format!("pcss_side_faces_light{light}_bind_group"), &own_layout, &entries);
             lights.push(Some(LightFaces { faces, face_frames, group }));
         }
         Ok(Some(Self {
