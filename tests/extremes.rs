@@ -108,12 +108,6 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
         "light in an enclosure of open quads",
         "light leaks along the corners where two separate open quads meet (coincident silhouette edges)",
     ),
-    (
-        "sssm",
-        "light far larger than the occluder",
-        "the blurred hard shadow stays at 0.35-0.65 where the truth is 0.998: the blur's taps spread over a kernel far wider than the \
-         screen (0.3525 where either shadows, 0.2949 with 63 taps; 0.0241 over the truth's umbra and penumbra)",
-    ),
     ("atty", "wall lit at grazing angles", "error above the bound where either shadows"),
 ];
 

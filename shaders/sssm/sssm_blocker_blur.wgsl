@@ -153,14 +153,15 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
             total += tap_weight;
         } else {
             // Past the screen's edges: the shadow test of the point of this pixel's tangent plane
-            // seen there (the pixel's own value where the ray misses the plane).
+            // seen there. Where the ray misses the plane (past its horizon) the receiver is not
+            // there to sample, as a tap on another surface on the screen is not: no weight. (The
+            // pixel's own value there held a kernel far wider than the screen at the hard shadow
+            // over half its taps.)
             let plane = tangent_plane_point(rays, point.position, point.normal, tap);
-            var hard = own.w;
             if (plane.w > 0.0) {
-                hard = hard_visibility(plane.xyz, point.normal);
+                blurred += weight * hard_visibility(plane.xyz, point.normal);
+                total += weight;
             }
-            blurred += weight * hard;
-            total += weight;
         }
     }
     // Every tap on other surfaces (an even m has no centre tap): keep the hard value.

@@ -38,8 +38,6 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     }
     let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
-    let own_hard = packed_hard_value(textureLoad(blur_source, point.texel, 0));
-    reads += 1u;
     let offset = lookup_offset(point.position, point.normal);
     var blurred = 0.0;
     var total = 0.0;
@@ -67,8 +65,13 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
         if (!reuse) {
             // β failed, or the row lies past the screen's edges: the row is recomputed from the
             // depth map on this pixel's tangent plane (Sec. 4.2).
-            blurred += weight * recomputed_row(rays, point, offset, own_hard, centre.x, radii.x, row.y, m);
-            total += weight;
+            // A row whose every tap misses the plane (past its horizon) samples no receiver: no
+            // weight, as a row on another surface.
+            let recomputed = recomputed_row(rays, point, offset, centre.x, radii.x, row.y, m);
+            if (recomputed.y > 1e-6) {
+                blurred += weight * recomputed.x / recomputed.y;
+                total += weight;
+            }
         }
     }
     let visibility = clamp(select(own.x, blurred / total, total > 1e-6), 0.0, 1.0);
@@ -77,22 +80,21 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
 
 // A row of step 2's horizontal blur recomputed on this pixel's tangent plane with this pixel's
 // kernel: the m taps along the screen row at pixel height `row_y`, `radius_x` pixels either side
-// of the pixel's column `centre_x`, each the hard visibility of the point of the plane seen there
-// (the pixel's own hard value `own_hard` where the camera ray misses the plane), looked up with
-// the pixel's normal offset `offset`. Up to m texel reads (none for a tap behind the light).
-fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, own_hard: f32, centre_x: f32, radius_x: f32, row_y: f32, m: u32) -> f32 {
+// of the pixel's column `centre_x`, each the hard visibility of the point of the plane seen there,
+// looked up with the pixel's normal offset `offset`; a tap whose camera ray misses the plane adds
+// nothing. Returns the weighted sum and the weights' total. Up to m texel reads (none for a tap
+// behind the light).
+fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, centre_x: f32, radius_x: f32, row_y: f32, m: u32) -> vec2<f32> {
     var row_sum = 0.0;
     var row_total = 0.0;
     for (var i = 0u; i < m; i++) {
         let tap_offset = grid_offset(i, m);
         let plane = tangent_plane_point(rays, point.position, point.normal, vec2<f32>(centre_x + tap_offset * radius_x, row_y));
-        var hard = own_hard;
         if (plane.w > 0.0) {
-            hard = tap_visibility(plane.xyz, offset);
+            let weight = blur_weight(tap_offset);
+            row_sum += weight * tap_visibility(plane.xyz, offset);
+            row_total += weight;
         }
-        let weight = blur_weight(tap_offset);
-        row_sum += weight * hard;
-        row_total += weight;
     }
-    return row_sum / row_total;
+    return vec2<f32>(row_sum, row_total);
 }
