@@ -1548,7 +1548,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         ssm_core::KnownLimit {
             case: "thin bars under a near-point light",
             mean_error: 0.12,
-            reason: "where the penumbra is under a pixel the prediction asks for the lowest resolution without visible artefacts, a 1:1 mapping of pixels to texels for hard shadows (Shen et al. 2011, Sec. 5; here hard_texels = 4 texels a pixel): about a 350-texel map over this frame at 96x72, where hard renders 2048², so its sharp edges are placed to an eighth of a pixel and hard's to a twenty-fifth (0.0994 against 0.0212 where either shadows; hard_texels = 16 gives 0.0212, a fixed 4096² map 0.0014)",
+            reason: "where the penumbra is under a pixel the prediction asks for the lowest resolution without visible artefacts, a 1:1 mapping of pixels to texels for hard shadows (Shen et al. 2011, Sec. 5; here hard_texels = 4 texels a pixel): at 96x72 its finest tile resolves 1,269 texels across this frame (the diagnostic pvsm_finest_resolution) where hard's map has 2,048, and a sharp edge is placed only to within half a texel (0.0994 against 0.0212 where either shadows; hard_texels = 16 gives 0.0212, a fixed 4096² map 0.0014)",
         },
         ssm_core::KnownLimit {
             case: "light resting on the receiver",
