@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use ssm_core::metrics::compare_with_noise;
 use ssm_core::reference::{GroundTruth, Sampling, surface_points};
 use ssm_core::{BEYOND_FRAME_DIAGNOSTIC, BEYOND_FRAME_PASS, LightView, Renderer, Requirements, TechniqueInfo, TechniqueKind};
@@ -148,19 +148,17 @@ fn side_faces_draw_the_penumbra_past_the_frame() {
     let positions = renderer.read_positions().unwrap();
     let points = surface_points(&positions, &renderer.read_normals().unwrap(), &renderer.scene.camera, false);
     let truth = GroundTruth::new(&scene).trace(&scene.lights[0], &points, Sampling::DEFAULT, 1);
-    let covered: Vec<bool> = positions.iter().map(|p| p[3] > 0.5).collect();
     let frame = &renderer.scene.light_frames[0];
     assert!(frame.reaches_widest_angle(), "the case must reach past the frame");
-    let past: Vec<bool> = positions
+    // Past the frame: in front of the light, outside the frame's map (LightFrame::uv_depth, the
+    // lookup every frame technique makes).
+    let only_past: Vec<bool> = positions
         .iter()
         .map(|p| {
-            let offset = Vec3::new(p[0], p[1], p[2]) - frame.light.centre;
-            let depth = offset.dot(frame.light.normal());
-            let across = Vec2::new(offset.dot(frame.light.u_axis).abs(), offset.dot(frame.light.v_axis).abs());
-            p[3] > 0.5 && depth > 0.0 && (across.x > depth * frame.tan_half.x || across.y > depth * frame.tan_half.y)
+            let uvd = frame.uv_depth(Vec3::new(p[0], p[1], p[2]));
+            p[3] > 0.5 && uvd.z > 0.0 && (uvd.x < 0.0 || uvd.x > 1.0 || uvd.y < 0.0 || uvd.y > 1.0)
         })
         .collect();
-    let only_past: Vec<bool> = covered.iter().zip(&past).map(|(covered, past)| *covered && *past).collect();
     let error_past = |visibility: &[f32]| {
         compare_with_noise(&truth.visibility, Some(&truth.noise), visibility, &only_past, SIZE.0 as usize, SIZE.1 as usize).mae
     };

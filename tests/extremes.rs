@@ -59,11 +59,6 @@ const HARD_SHADOW_TECHNIQUES: &[&str] = &["hard", "plugin-hard"];
 const HARD_MUST_FAIL: &[&str] =
     &["light far larger than the occluder", "tube light along the occluder's side", "tube light across the scene at 30 degrees"];
 
-/// Errors closer than this are the same answer, up to rounding: where the truth is exact (its noise
-/// 0), a hard shadow read through Chebyshev's bound with its minimum variance (vssm's texel under
-/// the point) differs from the plain depth test by about 1e-6.
-const SAME_ERROR: f64 = 1e-4;
-
 /// A scene has a penumbra to compare soft techniques on when at least this share of its covered
 /// pixels is in a visible penumbra (between 0.02 and 0.98) in the ground truth.
 const PENUMBRA_SHARE: f32 = 0.01;
@@ -807,7 +802,7 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
                 // map: the most it can draw is the map's hard shadow, so it must be no worse.
                 let penumbra_texels = truth.widest_penumbra_texels(map_size.or(hard_map_size).unwrap_or(0));
                 let sub_texel = penumbra_texels < 1.0;
-                let no_worse = *error <= hard_error + SAME_ERROR || is_tie(*error, *noise, hard_error, hard_noise);
+                let no_worse = *error <= hard_error || is_tie(*error, *noise, hard_error, hard_noise);
                 if bound_of(info, case.name).1.is_some() {
                     if beats_hard && *error <= f64::from(COMMON_BOUND) {
                         failures.push(format!(

@@ -23,8 +23,8 @@
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 struct BeyondFrameSettings {
-    // x: this light's index (its word of `answered`); y: the faces' width in texels, z: their
-    // height; w: the texels of the receiver's own depth change its bias allows.
+    // x: this light's index (its word of `answered`); y: the texels of the receiver's own depth
+    // change its bias allows (side_face_hard_visibility); z, w unused.
     values: vec4<f32>,
 };
 @group(2) @binding(7) var<uniform> settings: BeyondFrameSettings;
@@ -41,7 +41,7 @@ fn beyond_frame_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     var stored = 0u;
     let offset = point.position - frame.centre.xyz;
     if (point.covered && !unlit_by_rule(point) && past_the_frame(frame, offset)) {
-        let answer = side_face_hard_visibility(frame, face_plus_u, face_minus_u, face_plus_v, face_minus_v, offset, point.normal, settings.values.w);
+        let answer = side_face_hard_visibility(frame, face_plus_u, face_minus_u, face_plus_v, face_minus_v, offset, point.normal, settings.values.y);
         textureStore(visibility, texel, vec4<f32>(answer, 0.0, 0.0, 0.0));
         atomicAdd(&answered[u32(settings.values.x)], 1u);
         reads += 1u;

@@ -15,11 +15,11 @@ struct MultiSmSettings {
     normal_offset: f32,
     // Half the sides of one stratum of the light, world units, along the light's two axes.
     stratum_half_size: vec2<f32>,
-    // 1 where this light's samples have side faces (a sample's frame reached the widest angle).
-    side_faces: u32,
     // The texels of the receiver's own depth change the side faces' bias allows.
     side_face_bias_texels: f32,
-    padding: vec2<f32>,
+    padding_0: f32,
+    padding_1: f32,
+    padding_2: f32,
 };
 
 // Group 0 (`frame`) holds this sample's frame: a point light at the sample, with the light's axes.
@@ -34,8 +34,8 @@ struct MultiSmSettings {
 // bytes.
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 // This sample's side faces (common/side_faces.wgsl), +u, -u, +v, -v, drawn around it where its
-// frame reaches the widest angle (settings.side_faces): a receiver past its frame is looked up
-// there, one texel. A 1x1 texel never read otherwise.
+// frame reaches the widest angle: a receiver past its frame is looked up there, one texel. A 1x1
+// texel, never read, where no sample's frame reaches it.
 @group(2) @binding(4) var face_plus_u: texture_2d<f32>;
 @group(2) @binding(5) var face_minus_u: texture_2d<f32>;
 @group(2) @binding(6) var face_plus_v: texture_2d<f32>;
@@ -75,7 +75,7 @@ fn multi_sm_accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
             lit = 0.0;
         } else if (point.closed && light_centre_height(frame, point.position, point.normal) < 0.0) {
             lit = share;
-        } else if (settings.side_faces != 0u && frame_reaches_widest_angle(frame) && past_the_frame(frame, point.position - frame.centre.xyz)) {
+        } else if (frame_reaches_widest_angle(frame) && past_the_frame(frame, point.position - frame.centre.xyz)) {
             // Past this sample's frame: its hard shadow through the side face around it.
             reads += 1u;
             let offset = point.position - frame.centre.xyz;

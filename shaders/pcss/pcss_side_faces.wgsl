@@ -25,6 +25,7 @@
 
 // #import common/screen_pass.wgsl
 // #import common/pixel_work.wgsl
+// #import common/shadow_map.wgsl
 // #import common/side_faces.wgsl
 
 @group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
@@ -48,28 +49,25 @@ struct PcssSideFaceSettings {
 };
 @group(2) @binding(6) var<uniform> settings: PcssSideFaceSettings;
 
-const NO_SURFACE: f32 = 3.40282347e38;
+// Texel reads of this invocation: the G-buffer's two, and one per tap inside a face's map.
+var<private> reads: u32 = 0u;
 
 // Every face's size in texels.
 fn face_size() -> vec2<f32> {
     return vec2<f32>(textureDimensions(face_plus_u));
 }
 
-var<private> reads: u32 = 0u;
-
-// The stored depth of face `face` at map coordinates `uv`, and the texel's centre; NO_SURFACE
-// outside the map.
+// The stored depth of face `face` at map coordinates `uv`; NO_SURFACE outside the map (no read).
 fn face_depth(face: u32, uv: vec2<f32>) -> f32 {
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
         return NO_SURFACE;
     }
     reads += 1u;
-    let texel = vec2<i32>(uv * face_size());
     switch face {
-        case 0u: { return textureLoad(face_plus_u, texel, 0).x; }
-        case 1u: { return textureLoad(face_minus_u, texel, 0).x; }
-        case 2u: { return textureLoad(face_plus_v, texel, 0).x; }
-        default: { return textureLoad(face_minus_v, texel, 0).x; }
+        case 0u: { return shadow_map_depth(face_plus_u, uv); }
+        case 1u: { return shadow_map_depth(face_minus_u, uv); }
+        case 2u: { return shadow_map_depth(face_plus_v, uv); }
+        default: { return shadow_map_depth(face_minus_v, uv); }
     }
 }
 

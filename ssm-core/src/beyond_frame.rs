@@ -27,7 +27,7 @@ use crate::passes::{
 };
 use crate::read_counts::ReadCounts;
 use crate::shader::create_shader;
-use crate::side_faces::{SIDE_FACE_WIDTH, SideFaceFrames, SideFaceMaps};
+use crate::side_faces::{SideFaceFrames, SideFaceMaps};
 use crate::technique::TechniqueSetup;
 use crate::work::ShaderWork;
 
@@ -39,7 +39,8 @@ pub const BEYOND_FRAME_PASS: &str = "beyond_frame";
 pub const BEYOND_FRAME_DIAGNOSTIC: &str = "pixels_beyond_frame";
 
 /// Texels of the receiver's own depth change across a side face's texel that its bias allows
-/// (`shaders/core/beyond_frame.wgsl`: from the receiver's plane, so unclamped at grazing angles).
+/// (`side_face_hard_visibility` in `shaders/common/side_faces.wgsl`: from the receiver's plane, so
+/// unclamped at grazing angles).
 const SIDE_FACE_RECEIVER_BIAS_TEXELS: f32 = 0.75;
 
 /// What the pass counts in a counting frame, in the order its shader indexes them.
@@ -117,7 +118,6 @@ impl BeyondFrame {
         })?;
         let own_layout = pipeline.get_bind_group_layout(2);
         let answered = storage_buffer(device, &format!("{label}_answered"), 4 * scene.light_frames.len() as u64);
-        let height = SIDE_FACE_WIDTH / 2;
         let mut lights = Vec::with_capacity(scene.light_frames.len());
         for (light, output) in setup.outputs.iter().enumerate() {
             let Some((faces, face_frames)) = SideFaceMaps::for_light(gpu, scene, light, &label)? else {
@@ -127,7 +127,7 @@ impl BeyondFrame {
             let settings = uniform_buffer(
                 device,
                 &format!("{label}_light{light}_settings"),
-                &[light as f32, SIDE_FACE_WIDTH as f32, height as f32, SIDE_FACE_RECEIVER_BIAS_TEXELS],
+                &[light as f32, SIDE_FACE_RECEIVER_BIAS_TEXELS, 0.0, 0.0],
             );
             // The visibility, the four faces, the counters and the settings (bindings 0 to 7).
             let entries: Vec<_> = std::iter::once(wgpu::BindingResource::TextureView(output))

@@ -81,7 +81,7 @@ impl SideFaceMaps {
     /// A GPU error creating the maps.
     pub fn new(gpu: &GpuContext, scene: &GpuScene, label: &str) -> Result<Self> {
         let geometry = if scene.has_roles { Geometry::Occluders } else { Geometry::All };
-        let scene_diagonal = scene.light_frames.first().map_or(1.0, |frame| frame.scene_diagonal);
+        let scene_diagonal = scene.bounds.size().length();
         let maps = (0..4)
             .map(|face| {
                 LightDepthMap::new(

@@ -35,8 +35,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec2;
 use ssm_core::passes::{
-    bind_group, bind_group_layout, color_attachment, compute_pipeline, texture_entry, uniform_buffer, uniform_entry,
-    visibility_storage_entry,
+    bind_group, bind_group_layout, color_attachment, compute_pipeline, labelled_view, render_texture, texture_entry, uniform_buffer,
+    uniform_entry, visibility_storage_entry,
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader;
@@ -80,24 +80,24 @@ pub struct MultiSmSettingsUniform {
     normal_offset: f32,
     /// Half the sides of one stratum of the light, world units (along its first and second axes).
     stratum_half_size: [f32; 2],
-    /// 1 where the light's samples have side faces (a sample's frame reached the widest angle).
-    side_faces: u32,
     /// The texels of the receiver's own depth change the side faces' bias allows.
     side_face_bias_texels: f32,
-    padding: [f32; 2],
+    padding_0: f32,
+    padding_1: f32,
+    padding_2: f32,
 }
 
 impl MultiSmSettingsUniform {
-    /// The settings for a light of half sides `half_size` cut into `per_axis` × `per_axis` strata,
-    /// its samples with side faces or not.
-    fn new(settings: &MultiSmSettings, half_size: Vec2, per_axis: u32, side_faces: bool) -> Self {
+    /// The settings for a light of half sides `half_size` cut into `per_axis` × `per_axis` strata.
+    fn new(settings: &MultiSmSettings, half_size: Vec2, per_axis: u32) -> Self {
         Self {
             weight: 1.0 / settings.samples.max(1) as f32,
             normal_offset: settings.bias.normal_offset,
             stratum_half_size: (half_size / per_axis.max(1) as f32).to_array(),
-            side_faces: u32::from(side_faces),
             side_face_bias_texels: SIDE_FACE_BIAS_TEXELS,
-            padding: [0.0; 2],
+            padding_0: 0.0,
+            padding_1: 0.0,
+            padding_2: 0.0,
         }
     }
 }
@@ -166,29 +166,16 @@ impl MultiShadowMaps {
         let sample_frames = sample_frames(setup, per_axis);
         // A light gets side faces where one of its samples' frames reaches the widest angle; the
         // four maps serve every sample in turn.
-        let lights_with_faces: Vec<bool> =
-            sample_frames.iter().map(|samples| samples.iter().any(|sample| sample.side_face_frames.is_some())).collect();
-        let side_faces =
-            if lights_with_faces.contains(&true) { Some(SideFaceMaps::new(setup.gpu, setup.scene, "multi_sm_side")?) } else { None };
-        // Without faces the bindings hold a texel that is never read (the settings say so).
-        let unused_face = LightDepthMap::new(
-            setup.gpu,
-            setup.scene,
-            &ssm_core::LightDepthMapDesc {
-                label: "multi_sm_no_side_face",
-                width: 1,
-                height: 1,
-                geometry: ssm_core::Geometry::All,
-                cull_mode: None,
-                farthest: false,
-                constant_bias: 0.0,
-                slope_bias: 0.0,
-            },
-        )?;
-        let face_views = side_faces
-            .as_ref()
-            .map_or([&unused_face.linear_depth_view; 4], SideFaceMaps::linear_depth_views)
-            .map(wgpu::BindingResource::TextureView);
+        let any_faces = sample_frames.iter().flatten().any(|sample| sample.side_face_frames.is_some());
+        let side_faces = if any_faces { Some(SideFaceMaps::new(setup.gpu, setup.scene, "multi_sm_side")?) } else { None };
+        // Without faces the bindings hold a texel that is never read: no sample's frame reaches
+        // the widest angle, which is what the shader asks before it reads a face.
+        let unused_face = labelled_view(
+            &render_texture(device, "multi_sm_no_side_face", 1, 1, wgpu::TextureFormat::R32Float, wgpu::TextureUsages::empty()),
+            "multi_sm_no_side_face",
+        );
+        let face_views =
+            side_faces.as_ref().map_or([&unused_face; 4], SideFaceMaps::linear_depth_views).map(wgpu::BindingResource::TextureView);
         let own_groups = setup
             .outputs
             .iter()
@@ -198,7 +185,7 @@ impl MultiShadowMaps {
                 let settings_buffer = uniform_buffer(
                     device,
                     &format!("multi_sm_settings_uniform_{light}"),
-                    &MultiSmSettingsUniform::new(&settings, half_size, per_axis, lights_with_faces[light]),
+                    &MultiSmSettingsUniform::new(&settings, half_size, per_axis),
                 );
                 let [plus_u, minus_u, plus_v, minus_v] = face_views.clone();
                 bind_group(
