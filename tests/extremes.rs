@@ -97,12 +97,7 @@ const OPEN_FAILURES: &[(&str, &str, &str)] = &[
     // Interiors.
     ("atty", "room lit from a wall over a table", "no better than a hard shadow in a room lit from a wall"),
     ("atty", "corridor lit from its ceiling", "no better than a hard shadow in a corridor"),
-    // Each to investigate.
-    (
-        "wedges",
-        "light in an enclosure of open quads",
-        "light leaks along the corners where two separate open quads meet (coincident silhouette edges)",
-    ),
+    // To investigate.
     ("atty", "wall lit at grazing angles", "error above the bound where either shadows"),
 ];
 
@@ -745,7 +740,7 @@ fn every_technique_is_near_the_ground_truth_on_every_extreme() {
             let (bound, reason) = bound_of(info, case.name);
             let (bound, common) = (f64::from(bound), f64::from(COMMON_BOUND));
             report.push(format!(
-                "{:>12} {:>7.4} ± {:.4} (bound {bound}) {}{}",
+                "{:>12} {:>7.4} ± {:.4} (bound {bound:.2}) {}{}",
                 info.name,
                 worst,
                 worst_noise.unwrap_or(0.0),

@@ -84,13 +84,22 @@ struct Face {
 };
 
 // One edge incidence: `v0 -> v1` is the edge as `face_a` winds it; `face_b`,
-// when present, winds it `v1 -> v0` (a manifold, consistently wound edge).
+// when present, winds it `v1 -> v0` (a manifold, consistently wound edge), or
+// `v0 -> v1` as well when `face_b_winds_forward` is 1 (two faces of a
+// two-sided surface whose windings disagree).
 struct EdgeRecord {
     v0: u32,
     v1: u32,
     face_a: u32,
     face_b: u32,
+    face_b_winds_forward: u32,
 };
+
+// Whether face_b, turned to face the light, runs the edge v1 -> v0 (the
+// opposite of face_a's stored winding) given its state.
+fn face_b_runs_backwards(record: EdgeRecord, reversed_b: bool) -> bool {
+    return (record.face_b_winds_forward == 0u) != reversed_b;
+}
 
 // One silhouette half-edge and its penumbra wedge (Sec. 4.2; Lengyel 2005).
 // `a -> b` is the edge oriented so that its shadow volume (the prism of its

@@ -195,14 +195,17 @@ fn participates(state: u32) -> bool {
 }
 
 // True when both faces of a paired record take part and their volume sides on
-// the edge cancel (same orientation towards the light): the edge is inside a region.
+// the edge cancel (turned to the light, they run the edge in opposite
+// directions): the edge is inside a region.
 fn joins(record: EdgeRecord) -> bool {
     if (record.face_b == NO_FACE) {
         return false;
     }
     let a = face_state[record.face_a];
     let b = face_state[record.face_b];
-    return participates(a) && participates(b) && ((a & STATE_REVERSED) == (b & STATE_REVERSED));
+    let a_runs_backwards = (a & STATE_REVERSED) != 0u;
+    let b_runs_backwards = face_b_runs_backwards(record, (b & STATE_REVERSED) != 0u);
+    return participates(a) && participates(b) && (a_runs_backwards != b_runs_backwards);
 }
 
 // Step 2, hook: across every joining edge, link the larger label to the smaller.
@@ -401,7 +404,7 @@ struct Emission {
 // The silhouette half-edges of record `r` (at most two). An edge between two
 // faces of one region whose sides cancel emits nothing; otherwise every face
 // that takes part emits its side, oriented as its light-facing winding runs
-// (face_b winds the edge backwards). Regions split by an unfinished labelling
+// (face_b winds the edge backwards unless `face_b_winds_forward`). Regions split by an unfinished labelling
 // still get closed volumes: the joining edge is emitted on both sides.
 fn emissions(r: u32, out: ptr<function, array<Emission, 2>>) -> u32 {
     let record = records[r];
@@ -428,9 +431,8 @@ fn emissions(r: u32, out: ptr<function, array<Emission, 2>>) -> u32 {
     }
     let state_b = face_state[record.face_b];
     if (participates(state_b)) {
-        // face_b winds the edge v1 -> v0.
-        let reversed = (state_b & STATE_REVERSED) != 0u;
-        (*out)[count] = Emission(record.face_b, select(record.v1, record.v0, reversed), select(record.v0, record.v1, reversed));
+        let backwards = face_b_runs_backwards(record, (state_b & STATE_REVERSED) != 0u);
+        (*out)[count] = Emission(record.face_b, select(record.v0, record.v1, backwards), select(record.v1, record.v0, backwards));
         count += 1u;
     }
     return count;

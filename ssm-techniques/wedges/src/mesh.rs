@@ -38,7 +38,8 @@ pub const NO_FACE: u32 = u32::MAX;
 pub const TWO_SIDED_COMPONENT: u32 = u32::MAX;
 
 /// One edge incidence as `shaders/wedges/wedges_common.wgsl` reads it (`EdgeRecord`):
-/// `v0 -> v1` as `face_a` winds it; `face_b`, when not [`NO_FACE`], winds it `v1 -> v0`.
+/// `v0 -> v1` as `face_a` winds it; `face_b`, when not [`NO_FACE`], winds it `v1 -> v0`, or
+/// `v0 -> v1` as well when [`EdgeRecord::face_b_winds_forward`] is 1.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct EdgeRecord {
@@ -48,8 +49,13 @@ pub struct EdgeRecord {
     pub v1: u32,
     /// The face that winds `v0 -> v1`.
     pub face_a: u32,
-    /// The face that winds `v1 -> v0`, or [`NO_FACE`].
+    /// The face that winds `v1 -> v0` (or `v0 -> v1`, see `face_b_winds_forward`), or [`NO_FACE`].
     pub face_b: u32,
+    /// 1 when `face_b` winds the edge `v0 -> v1` like `face_a`: two faces of a two-sided surface
+    /// whose windings disagree (two open quads meeting at a corner, one wound inwards and one
+    /// outwards). Each frame turns such faces to the light, after which their sides on the edge
+    /// may cancel like any manifold edge's; else 0.
+    pub face_b_winds_forward: u32,
 }
 
 /// What the preparation found, for messages and diagnostics.
@@ -172,17 +178,29 @@ impl CastingMesh {
             }
             match list.as_slice() {
                 [(from, to, face_a), (from_b, to_b, face_b)] if from == to_b && to == from_b => {
-                    records.push(EdgeRecord { v0: *from, v1: *to, face_a: *face_a, face_b: *face_b });
+                    records.push(EdgeRecord { v0: *from, v1: *to, face_a: *face_a, face_b: *face_b, face_b_winds_forward: 0 });
+                    half_edge_capacity += 2;
+                }
+                // Two faces winding the edge the same way: their component is two-sided (its
+                // faces are turned to the light each frame), but the edge stays one edge between
+                // two faces, so that where the turned faces' sides cancel it joins them into one
+                // silhouette region like a manifold edge. Recorded alone, each face would emit its
+                // side and the two separate surfaces would be two silhouettes whose penumbrae are
+                // blended (Sec. 3.2) where they abut, leaking light along the seam.
+                [(from, to, face_a), (from_b, to_b, face_b)] if from == from_b && to == to_b => {
+                    report.inconsistent_edges += 1;
+                    records.push(EdgeRecord { v0: *from, v1: *to, face_a: *face_a, face_b: *face_b, face_b_winds_forward: 1 });
+                    irregular_faces.extend([*face_a, *face_b]);
                     half_edge_capacity += 2;
                 }
                 _ => {
-                    match list.len() {
-                        1 => report.open_edges += 1,
-                        2 => report.inconsistent_edges += 1,
-                        _ => report.non_manifold_edges += 1,
+                    if list.len() == 1 {
+                        report.open_edges += 1;
+                    } else {
+                        report.non_manifold_edges += 1;
                     }
                     for &(from, to, face) in list {
-                        records.push(EdgeRecord { v0: from, v1: to, face_a: face, face_b: NO_FACE });
+                        records.push(EdgeRecord { v0: from, v1: to, face_a: face, face_b: NO_FACE, face_b_winds_forward: 0 });
                         irregular_faces.push(face);
                     }
                     half_edge_capacity += list.len() as u64;
@@ -289,6 +307,30 @@ mod tests {
         assert_eq!(mesh.report.two_sided_components, 1);
         let shared: Vec<&EdgeRecord> = mesh.records.iter().filter(|r| (r.v0.min(r.v1), r.v0.max(r.v1)) == (0, 1)).collect();
         assert_eq!(shared.len(), 3, "one single record per face on the shared edge");
+    }
+
+    #[test]
+    fn two_open_quads_wound_the_same_way_on_a_shared_edge_are_paired_there() {
+        // Two walls meeting at a corner, one wound inwards and one outwards: the shared edge is
+        // wound the same way by both, and stays one paired record (flagged) so that the frame's
+        // turned faces can cancel there; both are two-sided.
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::Y,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.0, 1.0, -1.0),
+        ];
+        // Wall A: 0-1 shared, winds 0 -> 1 in its first triangle; wall B winds 0 -> 1 too.
+        let indices = vec![0, 1, 2, 1, 3, 2, 0, 1, 4, 1, 5, 4];
+        let mesh = prepared(&Mesh::with_generated_normals("corner", positions, indices));
+        assert_eq!(mesh.report.inconsistent_edges, 1);
+        assert_eq!(mesh.report.two_sided_components, 1);
+        let shared: Vec<&EdgeRecord> = mesh.records.iter().filter(|r| (r.v0.min(r.v1), r.v0.max(r.v1)) == (0, 1)).collect();
+        assert_eq!(shared.len(), 1, "{shared:?}");
+        assert_eq!((shared[0].face_b_winds_forward, shared[0].face_a, shared[0].face_b), (1, 0, 2));
+        assert_eq!(mesh.records.iter().filter(|r| r.face_b_winds_forward == 1).count(), 1);
     }
 
     #[test]

@@ -75,7 +75,7 @@ impl AllocationPlan {
                 buffer("wedges_half_edges", "half-edge", u64::from(mesh.half_edge_capacity), WEDGE_RECORD_BYTES),
                 buffer("wedges_positions", "vertex", mesh.positions.len() as u64, 16),
                 buffer("wedges_faces", "face", faces, 16),
-                buffer("wedges_edge_records", "edge record", records, 16),
+                buffer("wedges_edge_records", "edge record", records, std::mem::size_of::<crate::EdgeRecord>() as u64),
                 buffer("wedges_face_state", "face", faces, 4),
                 buffer("wedges_region_labels", "face", faces, 4),
                 buffer("wedges_region_ranks", "face", faces, 4),
@@ -257,7 +257,7 @@ mod tests {
         CastingMesh {
             positions: vec![[0.0; 4]; faces / 2 + 2],
             faces: vec![[0; 4]; faces],
-            records: vec![crate::EdgeRecord { v0: 0, v1: 0, face_a: 0, face_b: 0 }; faces * 3 / 2],
+            records: vec![crate::EdgeRecord { v0: 0, v1: 0, face_a: 0, face_b: 0, face_b_winds_forward: 0 }; faces * 3 / 2],
             closed_convex: vec![1],
             half_edge_capacity: (faces * 3) as u32,
             report: crate::MeshReport { faces, components: 1, ..crate::MeshReport::default() },
