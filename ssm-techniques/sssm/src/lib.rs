@@ -795,7 +795,7 @@ const PRESETS: &[ssm_core::Preset] = &[
 ];
 
 /// Why a light 1000 times longer than wide is beyond the method (the extremes matrix's tube cases).
-const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis";
+const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis; and the Gaussian's profile is that of a light weighted by a Gaussian (the paper's ground truth, Sec. 5, Fig. 13), not of a uniform tube, whose penumbra along it is a linear ramp: 0.1151 where either shadows, 0.0874 with filter = mean (the box, the uniform light's profile; the tube along the occluder's side: 0.0988 and 0.0245), at 96x72 on lavapipe";
 
 /// Why the receivers past the light frame's widest angle get the framework's hard shadow (the
 /// extremes matrix's light resting on the receiver).
