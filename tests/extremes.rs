@@ -97,7 +97,8 @@ enum Refusal {
     LimitTooLow(&'static str),
 }
 
-/// Ground points outside "light in an enclosure of open quads": one inside the frame, three past
+/// Ground points outside "light in an enclosure of open quads" (and its variant with a gap, away
+/// from the gap): one inside the frame, three past
 /// its widest angle.
 const OUTSIDE_THE_ENCLOSURE: [Vec3; 4] =
     [Vec3::new(1.8, 0.0, 1.8), Vec3::new(5.0, 0.0, 0.0), Vec3::new(-4.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 5.0)];
@@ -418,6 +419,24 @@ fn extreme_cases() -> Vec<Case> {
              [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, 1.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n",
+        ),
+        Expect::ShadowedAt(&OUTSIDE_THE_ENCLOSURE),
+    ));
+    // The same enclosure with a gap under one wall (z = 1, raised 0.1 off the ground): light leaves
+    // through it onto the ground just outside that wall (to z = 1.6), and everywhere else outside
+    // stays umbra, within the frame and past it.
+    cases.push(case(
+        "light in an enclosure of open quads with a gap",
+        from_manifest(
+            "open-enclosure-gap",
+            "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[light]]\ncentre = [0.0, 0.3, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
+             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.7]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.45, 1.0]\nrole = \"both\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
              [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n",

@@ -20,6 +20,16 @@
 //! the light's centre (`wedges_winding`); each face therefore carries its
 //! closed component's index.
 //!
+//! **Edges that meet without sharing vertices.** Two surfaces whose edges
+//! overlap along a line but end at different points (a wall standing on
+//! another's edge, a wall raised above the ground beside its neighbour; a
+//! T-junction of a modelled mesh) share no welded edge, so each would be
+//! its own silhouette there and their penumbrae would be blended (Sec. 3.2)
+//! where they abut. A welded vertex lying on an open edge of another face
+//! splits that face (`split_t_junctions`): the overlapping parts become
+//! shared edges, which join the surfaces into one silhouette where their
+//! sides cancel.
+//!
 //! **Convex closed components.** A closed component whose every edge is
 //! convex bounds a convex solid (when it does not cross itself), which a ray
 //! from the light enters or leaves once: it adds at most one to a point's
@@ -28,6 +38,7 @@
 
 use std::collections::HashMap;
 
+use glam::{IVec3, Vec3};
 use ssm_scene::Adjacency;
 
 /// No second face: [`EdgeRecord::face_b`] of an incidence recorded alone.
@@ -77,6 +88,8 @@ pub struct MeshReport {
     pub two_sided_components: usize,
     /// Closed components whose every edge is convex.
     pub convex_components: usize,
+    /// Faces split because a welded vertex lay on one of their open edges (T-junctions).
+    pub split_faces: usize,
 }
 
 impl MeshReport {
@@ -142,13 +155,14 @@ impl CastingMesh {
     /// Prepares the adjacency's welded mesh: records per edge, components, and the two-sided rule.
     #[must_use]
     pub fn prepare(adjacency: &Adjacency) -> Self {
-        let positions = adjacency.welded_positions.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
-        let face_count = adjacency.triangles.len();
-        let mut report = MeshReport { faces: face_count, ..MeshReport::default() };
+        let (welded, triangles, split_faces) = split_t_junctions(&adjacency.welded_positions, &adjacency.triangles);
+        let positions = welded.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        let face_count = triangles.len();
+        let mut report = MeshReport { faces: face_count, split_faces, ..MeshReport::default() };
         // Every directed edge (from, to, face), grouped by undirected key in first-seen order.
         let mut order: Vec<EdgeKey> = Vec::new();
         let mut incidences: HashMap<EdgeKey, Vec<Incidence>> = HashMap::new();
-        for (face, triangle) in adjacency.triangles.iter().enumerate() {
+        for (face, triangle) in triangles.iter().enumerate() {
             if triangle[0] == triangle[1] || triangle[1] == triangle[2] || triangle[2] == triangle[0] {
                 report.collapsed_faces += 1;
             }
@@ -212,8 +226,7 @@ impl CastingMesh {
         two_sided_roots.dedup();
         // Closed components numbered densely in order of their first face.
         let mut closed_index: HashMap<u32, u32> = HashMap::new();
-        let faces: Vec<[u32; 4]> = adjacency
-            .triangles
+        let faces: Vec<[u32; 4]> = triangles
             .iter()
             .enumerate()
             .map(|(face, t)| {
@@ -229,17 +242,125 @@ impl CastingMesh {
             .collect();
         report.two_sided_components = two_sided_roots.len();
         report.components = closed_index.len() + two_sided_roots.len();
-        let closed_convex = convex_components(adjacency, &faces, &records, closed_index.len());
+        let closed_convex = convex_components(&welded, &faces, &records, closed_index.len());
         report.convex_components = closed_convex.iter().filter(|c| **c == 1).count();
         Self { positions, faces, records, closed_convex, half_edge_capacity: u32::try_from(half_edge_capacity).unwrap_or(u32::MAX), report }
     }
 }
 
+/// A welded vertex lies on an edge when its distance to the edge's line is at most this share of
+/// the edge's length (float rounding of transformed coordinates, far below any modelled gap).
+const ON_EDGE_TOLERANCE: f32 = 1e-5;
+
+/// Grid cells one edge may visit in the search for vertices on it; a longer edge (against the
+/// open edges' mean length) is not split.
+const MAX_CELLS_PER_EDGE: i64 = 1 << 16;
+
+/// The triangles with every face that has a welded vertex on one of its open edges (an edge of
+/// no other face) split so that the vertex becomes a corner: the face's boundary, with the
+/// vertices found on each edge in order, fanned from its centroid (a new vertex), winding kept.
+/// Returns the positions (the welded ones, then the centroids), the triangles and the count of
+/// faces split. A mesh without open edges comes back unchanged.
+fn split_t_junctions(welded: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>, usize) {
+    let mut uses: HashMap<EdgeKey, u32> = HashMap::new();
+    for triangle in triangles {
+        for k in 0..3 {
+            let (a, b) = (triangle[k], triangle[(k + 1) % 3]);
+            if a != b {
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+    }
+    let open: Vec<EdgeKey> = uses.iter().filter(|(_, count)| **count == 1).map(|(key, _)| *key).collect();
+    if open.is_empty() {
+        return (welded.to_vec(), triangles.to_vec(), 0);
+    }
+    // The endpoints of open edges, in a grid of cells the open edges' mean length wide: only they
+    // can lie on another open edge without sharing it (a vertex inside a closed surface has no
+    // open edge).
+    let mean_length = open.iter().map(|(a, b)| welded[*a as usize].distance(welded[*b as usize])).sum::<f32>() / open.len() as f32;
+    let cell = mean_length.max(f32::MIN_POSITIVE);
+    let cell_of = |p: Vec3| (p / cell).floor().as_ivec3();
+    let mut grid: HashMap<IVec3, Vec<u32>> = HashMap::new();
+    let mut endpoints: Vec<u32> = open.iter().flat_map(|(a, b)| [*a, *b]).collect();
+    endpoints.sort_unstable();
+    endpoints.dedup();
+    for v in &endpoints {
+        grid.entry(cell_of(welded[*v as usize])).or_default().push(*v);
+    }
+    // Per open edge, the vertices strictly inside it, by their place along it.
+    let mut on_edge: HashMap<EdgeKey, Vec<(f32, u32)>> = HashMap::new();
+    for &(a, b) in &open {
+        let (pa, pb) = (welded[a as usize], welded[b as usize]);
+        let along = pb - pa;
+        let length_squared = along.length_squared();
+        let (low, high) = (cell_of(pa.min(pb)), cell_of(pa.max(pb)));
+        let span = (high - low + IVec3::ONE).as_i64vec3();
+        if length_squared <= 0.0 || span.x * span.y * span.z > MAX_CELLS_PER_EDGE {
+            continue;
+        }
+        let tolerance = ON_EDGE_TOLERANCE * length_squared.sqrt();
+        let mut found = Vec::new();
+        for x in low.x..=high.x {
+            for y in low.y..=high.y {
+                for z in low.z..=high.z {
+                    for &v in grid.get(&IVec3::new(x, y, z)).into_iter().flatten() {
+                        if v == a || v == b {
+                            continue;
+                        }
+                        let offset = welded[v as usize] - pa;
+                        let t = offset.dot(along) / length_squared;
+                        if t > 1e-6 && t < 1.0 - 1e-6 && (offset - along * t).length() <= tolerance {
+                            found.push((t, v));
+                        }
+                    }
+                }
+            }
+        }
+        if !found.is_empty() {
+            found.sort_by(|x, y| x.0.total_cmp(&y.0));
+            on_edge.insert((a, b), found);
+        }
+    }
+    if on_edge.is_empty() {
+        return (welded.to_vec(), triangles.to_vec(), 0);
+    }
+    let mut positions = welded.to_vec();
+    let mut split = Vec::with_capacity(triangles.len() + 4 * on_edge.len());
+    let mut split_faces = 0;
+    for triangle in triangles {
+        let mut boundary = Vec::with_capacity(6);
+        for k in 0..3 {
+            let (from, to) = (triangle[k], triangle[(k + 1) % 3]);
+            boundary.push(from);
+            if let Some(points) = on_edge.get(&(from.min(to), from.max(to))) {
+                // Stored from the smaller vertex to the larger: walk them the way this face runs.
+                if from < to {
+                    boundary.extend(points.iter().map(|(_, v)| *v));
+                } else {
+                    boundary.extend(points.iter().rev().map(|(_, v)| *v));
+                }
+            }
+        }
+        if boundary.len() == 3 {
+            split.push(*triangle);
+            continue;
+        }
+        split_faces += 1;
+        let centroid = positions.len() as u32;
+        positions.push(triangle.iter().map(|v| welded[*v as usize]).sum::<Vec3>() / 3.0);
+        for k in 0..boundary.len() {
+            split.push([centroid, boundary[k], boundary[(k + 1) % boundary.len()]]);
+        }
+    }
+    (positions, split, split_faces)
+}
+
 /// Per closed component: 1 when every one of its (paired) edges is convex, that is when each face's
 /// third corner lies on or behind the other face's plane, within a rounding of its size.
-fn convex_components(adjacency: &Adjacency, faces: &[[u32; 4]], records: &[EdgeRecord], closed: usize) -> Vec<u32> {
+fn convex_components(welded: &[Vec3], faces: &[[u32; 4]], records: &[EdgeRecord], closed: usize) -> Vec<u32> {
     let mut convex = vec![1u32; closed];
-    let position = |v: u32| adjacency.welded_positions[v as usize];
+    let position = |v: u32| welded[v as usize];
     let third = |face: &[u32; 4], a: u32, b: u32| face[..3].iter().copied().find(|v| *v != a && *v != b);
     for record in records {
         let (Some(face_a), Some(face_b)) = (faces.get(record.face_a as usize), faces.get(record.face_b as usize)) else { continue };
@@ -331,6 +452,43 @@ mod tests {
         assert_eq!(shared.len(), 1, "{shared:?}");
         assert_eq!((shared[0].face_b_winds_forward, shared[0].face_a, shared[0].face_b), (1, 0, 2));
         assert_eq!(mesh.records.iter().filter(|r| r.face_b_winds_forward == 1).count(), 1);
+    }
+
+    #[test]
+    fn a_vertex_on_another_faces_open_edge_splits_that_face_and_the_overlap_is_shared() {
+        // Wall A: the quad x = 0, y in [0, 1], z in [0, 1]; wall B stands on its edge z = 0 from
+        // y = 0.25 up (x in [0, -1]): B's corner (0, 0.25, 0) lies on A's open edge
+        // (0, 0, 0)-(0, 1, 0), which it shares from 0.25 to 1 without a vertex there.
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::Y,
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::Z,
+            Vec3::new(0.0, 0.25, 0.0),
+            Vec3::new(-1.0, 0.25, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ];
+        let indices = vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 1];
+        let mesh = prepared(&Mesh::with_generated_normals("t-junction", positions, indices));
+        assert_eq!(mesh.report.split_faces, 1, "{:?}", mesh.report);
+        // The split face is fanned from a new centroid: 4 boundary vertices, 4 triangles.
+        assert_eq!(mesh.faces.len(), 4 - 1 + 4);
+        assert_eq!(mesh.positions.len(), 7 + 1);
+        // (0, 0.25, 0)-(0, 1, 0) is now one edge of two faces (4 and 1 are its welded ids).
+        let shared: Vec<&EdgeRecord> = mesh.records.iter().filter(|r| (r.v0.min(r.v1), r.v0.max(r.v1)) == (1, 4)).collect();
+        assert_eq!(shared.len(), 1, "{shared:?}");
+        assert_ne!(shared[0].face_b, NO_FACE);
+        // Both walls are one component now.
+        assert_eq!(mesh.report.components, 1);
+        // The part of A's edge below B stays open: 0 to 4.
+        assert!(mesh.records.iter().any(|r| (r.v0.min(r.v1), r.v0.max(r.v1)) == (0, 4) && r.face_b == NO_FACE));
+    }
+
+    #[test]
+    fn a_mesh_without_open_edges_is_not_searched_for_t_junctions() {
+        let ball = prepared(&sphere("s", 1.0, 12, 6));
+        assert_eq!(ball.report.split_faces, 0);
+        assert_eq!(ball.faces.len(), sphere("s", 1.0, 12, 6).indices.len() / 3);
     }
 
     #[test]
