@@ -57,12 +57,14 @@ fn load_horizontal_source(texel: vec2<i32>) -> BlurSource {
     return unpack_blur_source(packed_hard_value(packed), packed);
 }
 
-// The blocker search of a computed pixel, its penumbra and its blur widths: (the hard or lit
-// value, blur half-width along x and along y in pixels, blocker rows reused), and whether the
-// horizontal blur remains to be done (else the vector is the pass's output).
+// The blocker search of a computed pixel and its penumbra: (the hard or lit value, the blockers'
+// average light depth or 0 where there is no blur, the pixel's light depth, blocker rows reused),
+// from which steps 2 and 3 both find the blur's axes (blur_axes); whether the first blur remains
+// to be done (else the vector is the pass's output), and the axes when it does.
 struct BlockerSearch {
     result: vec4<f32>,
     blur: bool,
+    axes: BlurAxes,
 };
 
 fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
@@ -109,41 +111,34 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
             penumbra_error_value = difference * difference;
         }
     }
+    let no_axes = BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
     // No blocker: fully lit (Sec. 4.2).
     if (count == 0.0) {
-        return BlockerSearch(vec4<f32>(1.0, 0.0, 0.0, reused), false);
+        return BlockerSearch(vec4<f32>(1.0, 0.0, d, reused), false, no_axes);
     }
     let blocker = sum / count;
     // Eq. 1: w_penumbra = w_light (z_receiver - z_avg) / z_avg, as the shadow-map half-extent of
     // PCSS's filter (the same kernel pcss filters over), then laid on the receiver's tangent plane
-    // and measured along each screen axis.
-    let extent = light_half_extent_uv(frame, blocker, d);
-    var radii = kernel_screen_radii(point.position, point.normal, light_uv_depth(frame, point.position).xy, extent);
-    if (radii.x < 0.0) {
-        // The plane runs along the light's rays: the width on a surface facing the camera.
-        // The mean of the rectangle's half-sides: a single width.
-        let light_half_size = 0.5 * (frame.u_axis.w + frame.v_axis.w);
-        radii = vec2<f32>(facing_radius(point.position, light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6)));
-    }
+    // and projected onto the screen.
+    let axes = blur_axes(point, blocker, d);
     // A penumbra under half a pixel keeps the hard value.
-    if (max(radii.x, radii.y) < 0.5) {
-        return BlockerSearch(vec4<f32>(own.w, 0.0, 0.0, reused), false);
+    if (under_half_a_pixel(axes)) {
+        return BlockerSearch(vec4<f32>(own.w, 0.0, d, reused), false, no_axes);
     }
-    return BlockerSearch(vec4<f32>(own.w, radii, reused), true);
+    return BlockerSearch(vec4<f32>(own.w, blocker, d, reused), true, axes);
 }
 
-// The horizontal blur over m taps of the pixel at `centre` (pixel position of its centre) after
-// its blocker search `searched` (blocker_search's result with blur = true); each tap's pixel comes
-// from `horizontal_source`.
-fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>) -> vec4<f32> {
-    let radii = searched.yz;
+// The first blur (along the screen's rows, or the light's first side) over m taps of the pixel at
+// `centre` (pixel position of its centre) after its blocker search `searched` (blocker_search's
+// result with blur = true, its axes `axes`); each tap's pixel comes from `horizontal_source`.
+fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, searched: vec4<f32>, axes: BlurAxes) -> vec4<f32> {
     let m = max(settings.blur_kernel, 1u);
     let rays = camera_rays();
     var blurred = 0.0;
     var total = 0.0;
     for (var j = 0u; j < m; j++) {
         let offset = grid_offset(j, m);
-        let tap = vec2<f32>(centre.x + offset * radii.x, centre.y);
+        let tap = centre + offset * axes.first;
         let weight = blur_weight(offset);
         if (on_screen(tap)) {
             let source = horizontal_source(vec2<i32>(tap));
@@ -166,5 +161,5 @@ fn horizontal_blur(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, search
     }
     // Every tap on other surfaces (an even m has no centre tap): keep the hard value.
     let horizontal = select(own.w, blurred / total, total > 1e-6);
-    return vec4<f32>(horizontal, radii, searched.w);
+    return vec4<f32>(horizontal, searched.yzw);
 }

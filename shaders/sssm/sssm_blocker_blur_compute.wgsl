@@ -13,7 +13,8 @@
 @group(2) @binding(8) var vertical_tap_source: texture_storage_2d<rgba32float, write>;
 
 fn horizontal_source(texel: vec2<i32>) -> BlurSource {
-    let index = segment_index(texel.x);
+    // A tap off the group's row (the blur along the light's sides leaves it) reads the texture.
+    let index = select(-1, segment_index(texel.x), texel.y == segment_line);
     if (index < 0) {
         return load_horizontal_source(texel);
     }
@@ -34,6 +35,8 @@ fn sssm_blocker_blur_rows(
     var own = vec4<f32>(0.0);
     var computed = false;
     var blur = false;
+    var axes = BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
+    segment_line = texel.y;
     reads = 0u;
     if (inside) {
         point = screen_point_at(texel);
@@ -47,8 +50,9 @@ fn sssm_blocker_blur_rows(
             let searched = blocker_search(point, own);
             result = searched.result;
             blur = searched.blur;
+            axes = searched.axes;
             if (blur) {
-                reach_for(result.y);
+                reach_for(abs(axes.first.x));
             }
         }
         store_penumbra_error(texel);
@@ -65,7 +69,7 @@ fn sssm_blocker_blur_rows(
     }
     workgroupBarrier();
     if (blur) {
-        result = horizontal_blur(vec2<f32>(texel) + 0.5, point, own, result);
+        result = horizontal_blur(vec2<f32>(texel) + 0.5, point, own, result, axes);
     }
     if (inside) {
         textureStore(horizontal_blur_target, texel, result);

@@ -9,8 +9,9 @@ fn horizontal_source(texel: vec2<i32>) -> BlurSource {
 }
 
 struct BlockerBlurOutput {
-    // (horizontally blurred visibility, blur half-width along x and along y in pixels, blocker
-    // rows reused); w = -1 where nothing was computed (background, behind the light).
+    // (first blur's visibility, the blockers' average light depth or 0 where there is no blur,
+    // the pixel's light depth, blocker rows reused); w = -1 where nothing was computed
+    // (background, behind the light).
     @location(0) horizontal_blur: vec4<f32>,
     // packed_vertical_tap_source.
     @location(1) vertical_tap_source: vec4<f32>,
@@ -31,7 +32,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> BlockerBlurOutput {
     store_penumbra_error(point.texel);
     var result = searched.result;
     if (searched.blur) {
-        result = horizontal_blur(in.clip.xy, point, own, result);
+        result = horizontal_blur(in.clip.xy, point, own, result, searched.axes);
     }
     record_reads(1u, point.texel);
     record_failed_rows(1u, point.texel);

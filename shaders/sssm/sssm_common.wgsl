@@ -22,7 +22,14 @@ struct SssmSettings {
     // a in a blur tap's weight exp(-a x²) at its offset x in [-1, 1] (Sec. 4.4): 1 / (2σ²) for the
     // Gaussian of σ kernel half-widths, 0 for the mean filter.
     blur_weight_exponent: f32,
+    // BLUR_ALONG_SCREEN (the paper's rows and columns) or BLUR_ALONG_LIGHT (the light's two sides
+    // as the screen sees them on the receiver's tangent plane).
+    blur_axes: u32,
 };
+
+// The settings' blur_axes.
+const BLUR_ALONG_SCREEN: u32 = 0u;
+const BLUR_ALONG_LIGHT: u32 = 1u;
 
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
@@ -270,25 +277,69 @@ fn plane_screen_position(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> 
     return screen_position(light_point(uv, depth));
 }
 
-// Half-widths in pixels, along the screen's x and y, of the blur that stands for the PCF kernel of
-// shadow-map half-extent `extent` around `uv` (the paper projects the penumbra into screen space,
-// Sec. 4.2). The kernel is laid on the receiver's tangent plane and projected: its two half-axes
-// become screen vectors a and b, and each separable pass takes the root-sum-square of their
-// components along its axis, the box with the projected parallelogram's second moments. On a
-// surface seen at an angle the vertical width shrinks with the foreshortening, as it must.
-// Returns a negative x where the plane runs along the light's rays or behind the eye.
-fn kernel_screen_radii(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, extent: vec2<f32>) -> vec2<f32> {
+// The PCF kernel of shadow-map half-extent `extent` around `uv` laid on the receiver's tangent
+// plane through `point` (normal `normal`) and projected onto the screen: its two half-axes, the
+// light's two sides, as screen vectors a (along u) and b (along v), in pixels (the paper projects
+// the penumbra into screen space, Sec. 4.2). `found` is false where the plane runs along the
+// light's rays or behind the eye.
+struct KernelAxes {
+    a: vec2<f32>,
+    b: vec2<f32>,
+    found: bool,
+};
+
+fn kernel_screen_axes(point: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, extent: vec2<f32>) -> KernelAxes {
     let right = plane_screen_position(point, normal, uv + vec2<f32>(extent.x, 0.0));
     let left = plane_screen_position(point, normal, uv - vec2<f32>(extent.x, 0.0));
     let down = plane_screen_position(point, normal, uv + vec2<f32>(0.0, extent.y));
     let up = plane_screen_position(point, normal, uv - vec2<f32>(0.0, extent.y));
     if (right.z * left.z * down.z * up.z == 0.0) {
-        return vec2<f32>(-1.0);
+        return KernelAxes(vec2<f32>(0.0), vec2<f32>(0.0), false);
     }
-    let a = 0.5 * (right.xy - left.xy);
-    let b = 0.5 * (down.xy - up.xy);
-    // Never wider than a few screens: a plane at a grazing angle to the light stretches without bound.
-    return min(sqrt(a * a + b * b), 4.0 * camera.viewport.xy);
+    return KernelAxes(0.5 * (right.xy - left.xy), 0.5 * (down.xy - up.xy), true);
+}
+
+// The blur's two half-axes in pixels: step 2 blurs along `first`, step 3 along `second`.
+struct BlurAxes {
+    first: vec2<f32>,
+    second: vec2<f32>,
+};
+
+// `axis` no longer than a few screens: a plane at a grazing angle to the light stretches the
+// kernel without bound.
+fn screen_capped(axis: vec2<f32>) -> vec2<f32> {
+    let cap = 4.0 * max(camera.viewport.x, camera.viewport.y);
+    return axis * min(1.0, cap / max(length(axis), 1e-12));
+}
+
+// The blur that stands for PCSS's filter at a pixel at `point` whose blocker average is `blocker`
+// at light depth `d` (Eq. 1; blocker > 0), computed alike by steps 2 and 3. Along the screen (the
+// paper's rows and columns): each pass takes the root-sum-square of the projected kernel's axes'
+// components along its axis, the box with the projected parallelogram's second moments (on a
+// surface seen at an angle the vertical width shrinks with the foreshortening, as it must).
+// Along the light: the passes run along the projected axes themselves, so the blur is the
+// projected kernel's parallelogram, which follows a tube light's two sides at any angle to the
+// screen (a separable filter along any two directions is still the product of two 1-D ones).
+fn blur_axes(point: ScreenPoint, blocker: f32, d: f32) -> BlurAxes {
+    let extent = light_half_extent_uv(frame, blocker, d);
+    let kernel = kernel_screen_axes(point.position, point.normal, light_uv_depth(frame, point.position).xy, extent);
+    if (!kernel.found) {
+        // The plane runs along the light's rays: the width on a surface facing the camera, the
+        // mean of the rectangle's half-sides, a single width.
+        let light_half_size = 0.5 * (frame.u_axis.w + frame.v_axis.w);
+        let radius = facing_radius(point.position, light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6));
+        return BlurAxes(vec2<f32>(radius, 0.0), vec2<f32>(0.0, radius));
+    }
+    if (settings.blur_axes == BLUR_ALONG_LIGHT) {
+        return BlurAxes(screen_capped(kernel.a), screen_capped(kernel.b));
+    }
+    let radii = min(sqrt(kernel.a * kernel.a + kernel.b * kernel.b), 4.0 * camera.viewport.xy);
+    return BlurAxes(vec2<f32>(radii.x, 0.0), vec2<f32>(0.0, radii.y));
+}
+
+// Whether a blur is narrower than half a pixel along both axes (the hard value stands).
+fn under_half_a_pixel(axes: BlurAxes) -> bool {
+    return max(length(axes.first), length(axes.second)) < 0.5;
 }
 
 // What a blur tap needs of the pixel it lands on: the value blurred there, and what the bilateral

@@ -22,6 +22,8 @@ var<workgroup> group_reach: atomic<u32>;
 // no pixel of the group blurs).
 var<private> segment_start: i32;
 var<private> segment_length: i32;
+// The row (step 2) or column (step 3) the segment lies on: a tap elsewhere reads the texture.
+var<private> segment_line: i32;
 
 // Widens the group's reach for a blur of half-width `radius` pixels (before the first barrier).
 // Taps lie within the radius of the pixel's centre: in its texel's column or row ± ceil(radius).

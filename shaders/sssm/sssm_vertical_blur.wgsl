@@ -21,18 +21,23 @@ fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
     return unpack_vertical_tap_source(textureLoad(vertical_tap_source, texel, 0));
 }
 
-// The vertical blur's half-width in pixels at a computed pixel whose step 2 result is `own`
-// (0 where the penumbra is under half a pixel and the horizontal value stands).
-fn vertical_radius(own: vec4<f32>) -> f32 {
-    return select(own.z, 0.0, max(own.y, own.z) < 0.5);
+// The blur's axes at the computed pixel at `point` whose step 2 result is `own` (the same as step
+// 2's: blur_axes of the same blocker depth and light depth); zero where step 2 did not blur (no
+// blocker, or a penumbra under half a pixel: the first blur's value stands).
+fn step_2_axes(point: ScreenPoint, own: vec4<f32>) -> BlurAxes {
+    if (own.y <= 0.0) {
+        return BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
+    }
+    return blur_axes(point, own.y, own.z);
 }
 
 // (visibility, share of rows reused in steps 2 and 3) of the computed pixel at `centre` (pixel
-// position of its centre), whose step 2 result is `own`; each tap's pixel comes from `vertical_source`.
-fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> {
+// position of its centre), whose step 2 result is `own` and blur axes `axes` (step_2_axes); each
+// tap's pixel comes from `vertical_source`. The second blur runs along `axes.second`, each of its
+// rows along `axes.first` (the screen's columns and rows, or the light's two sides).
+fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>, axes: BlurAxes) -> vec2<f32> {
     let n = f32(max(settings.blocker_kernel, 1u));
-    let radii = own.yz;
-    if (max(radii.x, radii.y) < 0.5) {
+    if (under_half_a_pixel(axes)) {
         // No blur: only the blocker rows counted.
         return vec2<f32>(own.x, own.w / n);
     }
@@ -44,7 +49,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     var reused = 0.0;
     for (var j = 0u; j < m; j++) {
         let tap_offset = grid_offset(j, m);
-        let row = centre + vec2<f32>(0.0, tap_offset * radii.y);
+        let row = centre + tap_offset * axes.second;
         let weight = blur_weight(tap_offset);
         var reuse = false;
         if (row_read_from_screen(row)) {
@@ -67,7 +72,7 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
             // depth map on this pixel's tangent plane (Sec. 4.2).
             // A row whose every tap misses the plane (past its horizon) samples no receiver: no
             // weight, as a row on another surface.
-            let recomputed = recomputed_row(rays, point, offset, centre.x, radii.x, row.y, m);
+            let recomputed = recomputed_row(rays, point, offset, row, axes.first, m);
             if (recomputed.y > 1e-6) {
                 blurred += weight * recomputed.x / recomputed.y;
                 total += weight;
@@ -78,18 +83,17 @@ fn vertical(centre: vec2<f32>, point: ScreenPoint, own: vec4<f32>) -> vec2<f32> 
     return vec2<f32>(visibility, (own.w + reused) / (n + f32(m)));
 }
 
-// A row of step 2's horizontal blur recomputed on this pixel's tangent plane with this pixel's
-// kernel: the m taps along the screen row at pixel height `row_y`, `radius_x` pixels either side
-// of the pixel's column `centre_x`, each the hard visibility of the point of the plane seen there,
-// looked up with the pixel's normal offset `offset`; a tap whose camera ray misses the plane adds
-// nothing. Returns the weighted sum and the weights' total. Up to m texel reads (none for a tap
-// behind the light).
-fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, centre_x: f32, radius_x: f32, row_y: f32, m: u32) -> vec2<f32> {
+// A row of step 2's first blur recomputed on this pixel's tangent plane with this pixel's
+// kernel: the m taps at pixel position `row` ± `first` (the first blur's half-axis), each the hard
+// visibility of the point of the plane seen there, looked up with the pixel's normal offset
+// `offset`; a tap whose camera ray misses the plane adds nothing. Returns the weighted sum and the
+// weights' total. Up to m texel reads (none for a tap behind the light).
+fn recomputed_row(rays: CameraRays, point: ScreenPoint, offset: vec3<f32>, row: vec2<f32>, first: vec2<f32>, m: u32) -> vec2<f32> {
     var row_sum = 0.0;
     var row_total = 0.0;
     for (var i = 0u; i < m; i++) {
         let tap_offset = grid_offset(i, m);
-        let plane = tangent_plane_point(rays, point.position, point.normal, vec2<f32>(centre_x + tap_offset * radius_x, row_y));
+        let plane = tangent_plane_point(rays, point.position, point.normal, row + tap_offset * first);
         if (plane.w > 0.0) {
             let weight = blur_weight(tap_offset);
             row_sum += weight * tap_visibility(plane.xyz, offset);

@@ -12,7 +12,8 @@
 @group(2) @binding(8) var visibility_target: texture_storage_2d<r32float, write>;
 
 fn vertical_source(texel: vec2<i32>) -> BlurSource {
-    let index = segment_index(texel.y);
+    // A tap off the group's column (the blur along the light's sides leaves it) reads the texture.
+    let index = select(-1, segment_index(texel.y), texel.x == segment_line);
     if (index < 0) {
         return load_vertical_source(texel);
     }
@@ -31,18 +32,20 @@ fn sssm_vertical_blur_columns(@builtin(workgroup_id) group: vec3<u32>, @builtin(
     var point: ScreenPoint;
     var own = vec4<f32>(1.0, 0.0, 0.0, -1.0);
     var computed = false;
+    var axes = BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
+    segment_line = texel.x;
     reads = 0u;
     if (inside) {
         point = screen_point_at(texel);
-        // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
+        // (first blur, blockers' light depth or 0, the pixel's light depth, blocker rows reused or -1).
         own = textureLoad(horizontal_blur, texel, 0);
         // The G-buffer's two texels and step 2's, read at every pixel of the screen.
         reads = 3u;
         if (own.w >= 0.0) {
             computed = true;
-            let radius = vertical_radius(own);
-            if (radius > 0.0) {
-                reach_for(radius);
+            axes = step_2_axes(point, own);
+            if (!under_half_a_pixel(axes)) {
+                reach_for(abs(axes.second.y));
             }
         }
     }
@@ -69,7 +72,7 @@ fn sssm_vertical_blur_columns(@builtin(workgroup_id) group: vec3<u32>, @builtin(
         record_reads(2u, texel);
         return;
     }
-    let result = vertical(vec2<f32>(texel) + 0.5, point, own);
+    let result = vertical(vec2<f32>(texel) + 0.5, point, own, axes);
     textureStore(reuse_share, texel, vec4<f32>(result.y));
     textureStore(visibility_target, texel, vec4<f32>(result.x));
     record_reads(2u, texel);

@@ -17,7 +17,7 @@ struct VerticalBlurOutput {
 @fragment
 fn sssm_vertical_blur(in: FullscreenVertex) -> VerticalBlurOutput {
     let point = screen_point(in);
-    // (horizontal blur, half-width along x, along y, blocker rows reused or -1).
+    // (first blur, blockers' light depth or 0, the pixel's light depth, blocker rows reused or -1).
     let own = textureLoad(horizontal_blur, point.texel, 0);
     // The G-buffer's two texels and step 2's, read at every pixel.
     reads = 3u;
@@ -25,7 +25,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> VerticalBlurOutput {
         record_reads(2u, point.texel);
         return VerticalBlurOutput(own.x, -1.0);
     }
-    let result = vertical(in.clip.xy, point, own);
+    let result = vertical(in.clip.xy, point, own, step_2_axes(point, own));
     record_reads(2u, point.texel);
     record_failed_rows(2u, point.texel);
     return VerticalBlurOutput(result.x, result.y);

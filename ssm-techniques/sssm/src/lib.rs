@@ -85,6 +85,19 @@ pub enum BlurFilter {
     Mean,
 }
 
+/// The directions of the two separable blurs (steps 2 and 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
+pub enum BlurAxes {
+    /// The screen's rows, then its columns (the paper, Sec. 4.2), each as wide as the projected
+    /// PCF kernel's extent along it (the root-sum-square of its two half-axes' components).
+    Screen,
+    /// The light's two sides as the screen sees them on the receiver's tangent plane: the blur is
+    /// the projected kernel's own parallelogram, so a tube light's penumbra is blurred along the
+    /// tube and not across it at any angle to the screen. Rows leave the screen's rows and
+    /// columns, so the shared-row compute passes read such taps from the textures.
+    Light,
+}
+
 /// How steps 2 and 3 run (the same pixels either way).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
 pub enum BlurPasses {
@@ -140,6 +153,9 @@ pub struct SssmSettings {
     /// Gaussian standard deviation in units of the blur's half-width (the paper's N(0, 0.5)).
     #[param(default = 0.5, min = 0.05, max = 4.0)]
     pub sigma: f32,
+    /// Directions of the two blurs: screen (the screen's rows and columns, the paper) or light (the light's two sides as projected on the receiver's tangent plane, which follow a tube light at any angle to the screen).
+    #[param(choice, default = "screen")]
+    pub blur_axes: BlurAxes,
     /// What the blocker taps are compared with (as pcss's).
     #[param(flatten)]
     pub receiver: ReceiverModel,
@@ -175,6 +191,7 @@ pub struct SssmSettingsUniform {
     normal_offset: f32,
     bilateral_depth: f32,
     blur_weight_exponent: f32,
+    blur_axes: u32,
 }
 
 impl From<&SssmSettings> for SssmSettingsUniform {
@@ -191,6 +208,10 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             blur_weight_exponent: match settings.filter {
                 BlurFilter::Gaussian => 0.5 / (settings.sigma.max(1e-3) * settings.sigma.max(1e-3)),
                 BlurFilter::Mean => 0.0,
+            },
+            blur_axes: match settings.blur_axes {
+                BlurAxes::Screen => 0,
+                BlurAxes::Light => 1,
             },
         }
     }
@@ -795,7 +816,7 @@ const PRESETS: &[ssm_core::Preset] = &[
 ];
 
 /// Why a light 1000 times longer than wide is beyond the method (the extremes matrix's tube cases).
-const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis; and the Gaussian's profile is that of a light weighted by a Gaussian (the paper's ground truth, Sec. 5, Fig. 13), not of a uniform tube, whose penumbra along it is a linear ramp: 0.1151 where either shadows, 0.0874 with filter = mean (the box, the uniform light's profile; the tube along the occluder's side: 0.0988 and 0.0245), at 96x72 on lavapipe";
+const TUBE_LIMIT: &str = "the penumbra is blurred by a separable Gaussian along the screen's axes, which emulates a circular light (Buades et al. 2015, Sec. 4.4: a screen-aligned rectangular filter gives alignment artefacts, so the Gaussian is chosen): a tube's penumbra, as long as the tube along it and as narrow as its width across, is blurred across as well wherever the tube does not run along a screen axis; and the Gaussian's profile is that of a light weighted by a Gaussian (the paper's ground truth, Sec. 5, Fig. 13), not of a uniform tube, whose penumbra along it is a linear ramp: 0.1151 where either shadows, 0.0874 with filter = mean (the box, the uniform light's profile; the tube along the occluder's side: 0.0988 and 0.0245), at 96x72 on lavapipe; with blur_axes = light the blurs run along the light's two sides as the screen sees them instead, which follows the tube at any angle (ssm-techniques/sssm/tests/sssm.rs: 0.0844 at 30 degrees with the Gaussian, 0.0317 with the mean, 160x120), but the paper's rows stay the default, being more accurate on its own kind of scene (ssm compare --scene leaves --width 320 --height 240: 0.0761, against 0.0777 along the light; the truth exact there)";
 
 /// Why the receivers past the light frame's widest angle get the framework's hard shadow (the
 /// extremes matrix's light resting on the receiver).

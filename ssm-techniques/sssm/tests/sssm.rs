@@ -376,8 +376,11 @@ fn shared_row_passes_give_the_fragment_passes_pixels() {
     let gpu = gpu();
     let mut huge_light = builtin("parallel-square").unwrap().build();
     huge_light.lights[0].half_size *= 20.0;
-    let cases: [Case; 8] = [
+    let cases: [Case; 10] = [
         ("leaves", builtin("leaves").unwrap().build(), SIZE, &[("alpha", "0.1"), ("beta", "0.1")]),
+        // Blurs along the light's sides leave the group's row and column.
+        ("leaves along the light", builtin("leaves").unwrap().build(), SIZE, &[("alpha", "0.1"), ("beta", "0.1"), ("blur_axes", "light")]),
+        ("tube at 45 degrees along the light", tube_over_parallel_square(45.0), SIZE, &[("blur_axes", "light"), ("filter", "mean")]),
         (
             "leaves, clamped edge rows",
             builtin("leaves").unwrap().build(),
@@ -709,4 +712,47 @@ fn sssm_reads_eight_times_fewer_texels_than_pcss_at_table_4s_largest_kernels() {
     }
     assert!(savings[1] >= 8.0, "29/41: SSSM reads {:.2} times fewer than PCSS, issue 40 asks at least 8", savings[1]);
     assert!(savings[1] > savings[0], "the saving grows with the kernels: {savings:?}");
+}
+
+/// A tube light (1000 times longer than wide) over `parallel-square`, its long side `degrees` off
+/// the screen's rows: its penumbra runs along the tube and is as narrow as its width across it.
+fn tube_over_parallel_square(degrees: f32) -> Scene {
+    let mut scene = builtin("parallel-square").unwrap().build();
+    let along = Vec3::new(degrees.to_radians().cos(), 0.0, degrees.to_radians().sin());
+    scene.lights =
+        vec![ssm_scene::RectLight::try_facing(Vec3::new(0.0, 4.0, 0.0), -Vec3::Y, along, glam::Vec2::new(4.0, 0.004), 1.0).unwrap()];
+    scene
+}
+
+/// With `blur_axes = light` the two blurs run along the light's sides as the screen sees them, so
+/// a tube's penumbra is blurred along the tube only, at any angle to the screen's axes; along the
+/// screen's rows and columns (the paper's) it is blurred across as well wherever the tube does not
+/// run along one of them. With the mean filter (a uniform tube's profile) the error where either
+/// shadows stays within half the extremes matrix's common bound at every angle, with the paper's
+/// Gaussian within the bound.
+#[test]
+fn blurs_along_the_light_follow_a_tube_at_any_angle_to_the_screen() {
+    let gpu = gpu();
+    for degrees in [0.0, 30.0, 45.0, 70.0] {
+        let scene = tube_over_parallel_square(degrees);
+        let reference = ssm_testing::reference(&gpu, &scene, 12, SIZE);
+        let covered = reference.coverage();
+        let error = |settings: &[(&str, &str)]| {
+            let rendered = render(&gpu, &scene, &ssm_sssm::INFO, settings, SIZE.0, SIZE.1).unwrap();
+            compare(&reference.visibility, &rendered.visibility, &covered, SIZE.0 as usize, SIZE.1 as usize).mae
+        };
+        let screen = error(&[("filter", "mean"), ("blur_axes", "screen")]);
+        let light = error(&[("filter", "mean"), ("blur_axes", "light")]);
+        let light_gaussian = error(&[("blur_axes", "light")]);
+        println!(
+            "tube {degrees}° off the screen's rows, MAE where either shadows, mean filter: screen {screen:.4}, light {light:.4}; Gaussian, light: {light_gaussian:.4}"
+        );
+        assert!(light <= 0.05, "{degrees}°: {light}");
+        assert!(light_gaussian <= 0.1, "{degrees}°: {light_gaussian}");
+        if degrees > 0.0 {
+            assert!(light < 0.6 * screen, "{degrees}°: along the light {light}, along the screen {screen}");
+        } else {
+            assert!((light - screen).abs() < 1e-3, "along a screen axis both are the same blur: {light} vs {screen}");
+        }
+    }
 }
