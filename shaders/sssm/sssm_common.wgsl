@@ -22,14 +22,30 @@ struct SssmSettings {
     // a in a blur tap's weight exp(-a x²) at its offset x in [-1, 1] (Sec. 4.4): 1 / (2σ²) for the
     // Gaussian of σ kernel half-widths, 0 for the mean filter.
     blur_weight_exponent: f32,
-    // BLUR_ALONG_SCREEN (the paper's rows and columns) or BLUR_ALONG_LIGHT (the light's two sides
-    // as the screen sees them on the receiver's tangent plane).
+    // BLUR_ALONG_SCREEN (the paper's rows and columns), BLUR_ALONG_LIGHT (the light's two sides as
+    // the screen sees them on the receiver's tangent plane), or BLUR_AXES_AUTO (the light's sides
+    // for a light ELONGATED_LIGHT_RATIO times longer than wide or more, else the screen's).
     blur_axes: u32,
 };
 
 // The settings' blur_axes.
 const BLUR_ALONG_SCREEN: u32 = 0u;
 const BLUR_ALONG_LIGHT: u32 = 1u;
+const BLUR_AXES_AUTO: u32 = 2u;
+
+// With BLUR_AXES_AUTO, a light whose long side is this many times its short one or more is
+// blurred along its sides: the paper's screen-aligned Gaussian emulates a round light (Sec. 4.4),
+// which a tube is not, and whose penumbra it would blur across the tube wherever the tube does
+// not run along a screen axis.
+const ELONGATED_LIGHT_RATIO: f32 = 2.0;
+
+// Whether the blurs of this light run along its sides (the settings' blur_axes).
+fn blur_along_light() -> bool {
+    let long_side = max(frame.u_axis.w, frame.v_axis.w);
+    let short_side = min(frame.u_axis.w, frame.v_axis.w);
+    return settings.blur_axes == BLUR_ALONG_LIGHT
+        || (settings.blur_axes == BLUR_AXES_AUTO && long_side >= ELONGATED_LIGHT_RATIO * short_side);
+}
 
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
@@ -330,7 +346,7 @@ fn blur_axes(point: ScreenPoint, blocker: f32, d: f32) -> BlurAxes {
         let radius = facing_radius(point.position, light_half_size * max(d - blocker, 0.0) / max(blocker, 1e-6));
         return BlurAxes(vec2<f32>(radius, 0.0), vec2<f32>(0.0, radius));
     }
-    if (settings.blur_axes == BLUR_ALONG_LIGHT) {
+    if (blur_along_light()) {
         return BlurAxes(screen_capped(kernel.a), screen_capped(kernel.b));
     }
     let radii = min(sqrt(kernel.a * kernel.a + kernel.b * kernel.b), 4.0 * camera.viewport.xy);
