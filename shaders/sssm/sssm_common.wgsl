@@ -26,6 +26,9 @@ struct SssmSettings {
     // the screen sees them on the receiver's tangent plane), or BLUR_AXES_AUTO (the light's sides
     // for a light ELONGATED_LIGHT_RATIO times longer than wide or more, else the screen's).
     blur_axes: u32,
+    // 1 (the settings' filter = auto): blurs along the light's sides weigh their taps equally
+    // (blur_weight_exponent 0), whatever blur_weight_exponent says.
+    box_along_light: u32,
 };
 
 // The settings' blur_axes.
@@ -147,7 +150,11 @@ fn blocker_row(row_uv: vec2<f32>, half_width: f32, receiver: TapPlane, n: u32) -
 // The weight of a blur tap at offset `offset` in [-1, 1] of the kernel's half-width (Sec. 4.4:
 // a Gaussian of σ half-widths, the paper's N(0, 0.5), or 1 for the mean filter).
 fn blur_weight(offset: f32) -> f32 {
-    return exp(-settings.blur_weight_exponent * offset * offset);
+    // With filter = auto, the box along the light's sides: it is the uniform light's own profile
+    // (PCSS's filter), and the Gaussian's reason, hiding the screen alignment of a box (Sec. 4.4),
+    // does not arise there.
+    let exponent = select(settings.blur_weight_exponent, 0.0, settings.box_along_light != 0u && blur_along_light());
+    return exp(-exponent * offset * offset);
 }
 
 // The world point at shadow-map coordinates `uv` and linear light depth `depth` (inverse of light_uv_depth).

@@ -83,6 +83,10 @@ pub enum BlurFilter {
     Gaussian,
     /// Equal weights: the box filter PCSS applies.
     Mean,
+    /// Gaussian where the blurs run along the screen's rows and columns (the paper's choice,
+    /// which hides a box's alignment to the screen), equal weights where they run along the
+    /// light's sides (`blur_axes`): there the box is the uniform light's own profile.
+    Auto,
 }
 
 /// The directions of the two separable blurs (steps 2 and 3).
@@ -151,8 +155,8 @@ pub struct SssmSettings {
     /// β: blur rows are reused when normal-adjusted camera depths differ by less than this fraction of the scene's diagonal (0: never).
     #[param(default = 0.01, min = 0.0, max = 1.0)]
     pub beta: f32,
-    /// Blur weights (Sec. 4.4).
-    #[param(choice, default = "gaussian")]
+    /// Blur weights (Sec. 4.4): gaussian, mean, or auto (gaussian along the screen's rows and columns, the paper's; mean along the light's sides, the uniform light's own profile).
+    #[param(choice, default = "auto")]
     pub filter: BlurFilter,
     /// Gaussian standard deviation in units of the blur's half-width (the paper's N(0, 0.5)).
     #[param(default = 0.5, min = 0.05, max = 4.0)]
@@ -196,6 +200,7 @@ pub struct SssmSettingsUniform {
     bilateral_depth: f32,
     blur_weight_exponent: f32,
     blur_axes: u32,
+    box_along_light: u32,
 }
 
 impl From<&SssmSettings> for SssmSettingsUniform {
@@ -210,7 +215,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
             bilateral_depth: settings.bilateral_depth,
             // Sec. 4.4: exp(-x²/2σ²) at tap offset x in half-widths; exp(0) = 1 for the mean.
             blur_weight_exponent: match settings.filter {
-                BlurFilter::Gaussian => 0.5 / (settings.sigma.max(1e-3) * settings.sigma.max(1e-3)),
+                BlurFilter::Gaussian | BlurFilter::Auto => 0.5 / (settings.sigma.max(1e-3) * settings.sigma.max(1e-3)),
                 BlurFilter::Mean => 0.0,
             },
             blur_axes: match settings.blur_axes {
@@ -218,6 +223,7 @@ impl From<&SssmSettings> for SssmSettingsUniform {
                 BlurAxes::Light => 1,
                 BlurAxes::Auto => 2,
             },
+            box_along_light: u32::from(settings.filter == BlurFilter::Auto),
         }
     }
 }

@@ -744,9 +744,9 @@ fn blurs_along_the_light_follow_a_tube_at_any_angle_to_the_screen() {
         let screen = error(&[("filter", "mean"), ("blur_axes", "screen")]);
         let light = error(&[("filter", "mean"), ("blur_axes", "light")]);
         let light_gaussian = error(&[("blur_axes", "light")]);
-        // At the defaults (`auto`) a tube is blurred along its sides.
+        // At the defaults (`auto` axes and filter) a tube is blurred along its sides with the box.
         let defaults = error(&[]);
-        assert_eq!(defaults, light_gaussian, "{degrees}°: auto blurs a tube along its sides");
+        assert_eq!(defaults, light, "{degrees}°: auto blurs a tube along its sides, with equal weights");
         println!(
             "tube {degrees}° off the screen's rows, MAE where either shadows, mean filter: screen {screen:.4}, light {light:.4}; Gaussian, light: {light_gaussian:.4}"
         );
@@ -760,14 +760,16 @@ fn blurs_along_the_light_follow_a_tube_at_any_angle_to_the_screen() {
     }
 }
 
-/// `blur_axes = auto` blurs a light less than twice as long as wide along the screen's rows and
-/// columns, as the paper does: the same pixels as `screen` on a square light, not those of `light`.
+/// `blur_axes = auto` and `filter = auto` blur a light less than twice as long as wide along the
+/// screen's rows and columns with the Gaussian, as the paper does: the same pixels as `screen` and
+/// `gaussian` on a square light, not those of `light` or `mean`.
 #[test]
-fn auto_blurs_a_square_light_along_the_screen() {
+fn auto_blurs_a_square_light_along_the_screen_with_the_gaussian() {
     let gpu = gpu();
     let scene = builtin("contact").unwrap().build();
-    let visibility = |axes: &str| render(&gpu, &scene, &ssm_sssm::INFO, &[("blur_axes", axes)], SIZE.0, SIZE.1).unwrap().visibility;
-    let (auto, screen, light) = (visibility("auto"), visibility("screen"), visibility("light"));
-    assert_eq!(auto, screen);
-    assert_ne!(auto, light, "along the light's sides the blur differs on contact's tilted faces");
+    let visibility = |settings: &[(&str, &str)]| render(&gpu, &scene, &ssm_sssm::INFO, settings, SIZE.0, SIZE.1).unwrap().visibility;
+    let defaults = visibility(&[]);
+    assert_eq!(defaults, visibility(&[("blur_axes", "screen"), ("filter", "gaussian")]));
+    assert_ne!(defaults, visibility(&[("blur_axes", "light")]), "along the light's sides the blur differs on contact's tilted faces");
+    assert_ne!(defaults, visibility(&[("filter", "mean")]));
 }
