@@ -103,6 +103,22 @@ enum Refusal {
 const OUTSIDE_THE_ENCLOSURE: [Vec3; 4] =
     [Vec3::new(1.8, 0.0, 1.8), Vec3::new(5.0, 0.0, 0.0), Vec3::new(-4.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 5.0)];
 
+/// The manifest of a light inside five open quads on a wide ground: a ceiling above the light and
+/// four walls 0.8 high around it, the wall at z = 1 `near_wall_height` high, centred
+/// `near_wall_centre` above the ground (its bottom off the ground when shorter).
+fn open_enclosure(near_wall_height: &str, near_wall_centre: &str) -> String {
+    format!(
+        "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[light]]\ncentre = [0.0, 0.3, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [2.0, {near_wall_height}]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, {near_wall_centre}, 1.0]\nrole = \"both\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n"
+    )
+}
+
 /// What must hold for every technique on a scene, beyond the error bound.
 #[derive(Clone, Copy, Debug)]
 enum Expect {
@@ -412,17 +428,7 @@ fn extreme_cases() -> Vec<Case> {
     // so no framework cull; outside, the ground is umbra, within the frame and past it.
     cases.push(case(
         "light in an enclosure of open quads",
-        from_manifest(
-            "open-enclosure",
-            "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
-             [[light]]\ncentre = [0.0, 0.3, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, 1.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n",
-        ),
+        from_manifest("open-enclosure", &open_enclosure("0.8", "0.4")),
         Expect::ShadowedAt(&OUTSIDE_THE_ENCLOSURE),
     ));
     // The same enclosure with a gap under one wall (z = 1, raised 0.1 off the ground): light leaves
@@ -430,17 +436,7 @@ fn extreme_cases() -> Vec<Case> {
     // stays umbra, within the frame and past it.
     cases.push(case(
         "light in an enclosure of open quads with a gap",
-        from_manifest(
-            "open-enclosure-gap",
-            "[camera]\nposition = [0.0, 7.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n\
-             [[light]]\ncentre = [0.0, 0.3, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [24.0, 24.0]\nrole = \"receiver\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 2.0]\ntranslate = [0.0, 0.8, 0.0]\nrole = \"occluder\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.7]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.45, 1.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [2.0, 0.8]\nrotate_degrees = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.4, -1.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [1.0, 0.4, 0.0]\nrole = \"both\"\n\
-             [[object]]\nprimitive = \"plane\"\nsize = [0.8, 2.0]\nrotate_degrees = [0.0, 0.0, 90.0]\ntranslate = [-1.0, 0.4, 0.0]\nrole = \"both\"\n",
-        ),
+        from_manifest("open-enclosure-gap", &open_enclosure("0.7", "0.45")),
         Expect::ShadowedAt(&OUTSIDE_THE_ENCLOSURE),
     ));
     // An occluder quad lying in the receiver's plane (it shadows nothing), and a block above.
