@@ -98,10 +98,15 @@ enum Refusal {
 }
 
 /// Ground points outside "light in an enclosure of open quads" (and its variant with a gap, away
-/// from the gap): one inside the frame, three past
-/// its widest angle.
-const OUTSIDE_THE_ENCLOSURE: [Vec3; 4] =
-    [Vec3::new(1.8, 0.0, 1.8), Vec3::new(5.0, 0.0, 0.0), Vec3::new(-4.0, 0.0, 3.0), Vec3::new(0.0, 0.0, 5.0)];
+/// from the gap): one inside the frame, four past its widest angle.
+const OUTSIDE_THE_ENCLOSURE: [Vec3; 5] = [
+    Vec3::new(1.8, 0.0, 1.8),
+    Vec3::new(5.0, 0.0, 0.0),
+    Vec3::new(-4.0, 0.0, 3.0),
+    Vec3::new(0.0, 0.0, 5.0),
+    // On a diagonal, where a hemicube's side faces meet.
+    Vec3::new(3.5, 0.0, 3.5),
+];
 
 /// The manifest of a light inside five open quads on a wide ground: a ceiling above the light and
 /// four walls 0.8 high around it, the wall at z = 1 `near_wall_height` high, centred

@@ -89,6 +89,41 @@ fn blocks(face: u32, receiver: vec3<f32>, plane_normal: vec3<f32>, uv: vec2<f32>
     return vec2<f32>(select(0.0, 1.0, stored < plane * (1.0 - settings.relative_bias)), stored);
 }
 
+// The receiver's pixel as every face sees it: its offset from the light's centre and its normal
+// (world), and both in its own face's coordinates.
+struct SideFaceReceiver {
+    face: SideFace,
+    offset: vec3<f32>,
+    normal: vec3<f32>,
+    point: vec3<f32>,
+    plane_normal: vec3<f32>,
+};
+
+// The tap at `tap` (the receiver's face's coordinates, forward > 0) against the receiver's plane,
+// looked up in the face the tap's direction lies in: its own face's map unless the tap crossed a
+// diagonal of the hemicube, where the faces meet (a search or filter around a receiver near a
+// diagonal reaches over it), then the neighbouring face's, with the plane in that face's
+// coordinates. Returns (1 where it blocks, the stored surface's depth along the receiver's face's
+// axis, so that blockers found on either face average on one axis).
+fn blocks_at(receiver: SideFaceReceiver, tap: vec3<f32>) -> vec2<f32> {
+    let uv = side_face_uv(tap);
+    if (uv.x >= 0.0 && uv.x < 1.0) {
+        return blocks(receiver.face.index, receiver.point, receiver.plane_normal, uv);
+    }
+    let direction = tap.x * receiver.face.across + tap.y * frame.normal.xyz + tap.z * receiver.face.forward;
+    let other = side_face_of(frame, direction);
+    let in_other = side_face_coordinates(frame, other, direction);
+    let found = blocks(
+        other.index,
+        side_face_coordinates(frame, other, receiver.offset),
+        side_face_coordinates(frame, other, receiver.normal),
+        side_face_uv(in_other),
+    );
+    // The stored surface lies on the tap's ray at depth found.y along the other face's axis.
+    let surface = direction * (found.y / max(in_other.z, 1e-12));
+    return vec2<f32>(found.x, dot(surface, receiver.face.forward));
+}
+
 // The point at depth `depth` along the face's axis on the segment from `receiver` to the light
 // point `light_point` (face coordinates, down 0); w = 0 where the segment does not reach it.
 fn through_plane(receiver: vec3<f32>, light_point: vec3<f32>, depth: f32) -> vec4<f32> {
@@ -108,7 +143,7 @@ fn light_point(face: SideFace, s: f32, t: f32) -> vec3<f32> {
 fn side_face_pcss(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
     let face = side_face_of(frame, offset);
     let receiver = side_face_coordinates(frame, face, offset);
-    let plane_normal = side_face_coordinates(frame, face, normal);
+    let seen = SideFaceReceiver(face, offset, normal, receiver, side_face_coordinates(frame, face, normal));
 
     // 1. The search: n x n points of the light, each segment from the receiver to the point (cut at
     // the near plane) tapped once, at a depth along it of its own (stratified over the n² taps):
@@ -131,7 +166,7 @@ fn side_face_pcss(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
             // The golden ratio's sequence spreads the taps' places along their segments evenly
             // over the n² taps, whatever n.
             let along = fract(0.5 + f32(j * n + i) * 0.618034);
-            let tap = blocks(face.index, receiver, plane_normal, side_face_uv(mix(receiver, far_end.xyz, along)));
+            let tap = blocks_at(seen, mix(receiver, far_end.xyz, along));
             if (tap.x > 0.0) {
                 blocker_sum += tap.y;
                 blocker_count += 1u;
@@ -155,7 +190,7 @@ fn side_face_pcss(offset: vec3<f32>, normal: vec3<f32>) -> f32 {
                 lit += 1.0;
                 continue;
             }
-            lit += 1.0 - blocks(face.index, receiver, plane_normal, side_face_uv(through.xyz)).x;
+            lit += 1.0 - blocks_at(seen, through.xyz).x;
         }
     }
     return lit / f32(m * m);
