@@ -23,7 +23,9 @@ fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
 
 // The blur's axes at the computed pixel at `point` whose step 2 result is `own` (the same as step
 // 2's: blur_axes of the same blocker depth and light depth); zero where step 2 did not blur (no
-// blocker, or a penumbra under half a pixel: the first blur's value stands).
+// blocker, or a penumbra under half a pixel: the first blur's value stands). Recomputed rather
+// than handed on: the value and the reused rows leave two of step 2's four channels, where the
+// two axes need four; this costs arithmetic, no texel read.
 fn step_2_axes(point: ScreenPoint, own: vec4<f32>) -> BlurAxes {
     if (own.y <= 0.0) {
         return BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
