@@ -89,7 +89,7 @@ def main():
     parser.add_argument("--width", type=int, default=320, help="image width of every run (default 320)")
     parser.add_argument("--height", type=int, default=240, help="image height of every run (default 240)")
     parser.add_argument("--paper-sizes", action="store_true", help="each preset at its paper's viewport instead of --width/--height")
-    parser.add_argument("--frames", type=int, default=1, help="frames timed per point after a warm-up (default 1: lavapipe runs every preset in a few hours; a GPU run can afford 5)")
+    parser.add_argument("--frames", type=int, default=5, help="frames timed per point after a warm-up (default 5); tables give their median and interquartile range")
     parser.add_argument("--output-root", type=Path, default=ROOT, help="write the generated files under this folder, laid out as the workspace (default: the workspace itself; elsewhere README.md is left alone)")
     parser.add_argument("--splice-summary", action="store_true", help="only copy docs/results/summary.md (written by the last full run) into README.md")
     parser.add_argument("--only", default="", help="comma-separated parts to run: summary, trade, lights, kinds, and technique names (default: all)")
@@ -352,7 +352,7 @@ def summary_table(rows, args, prefix=""):
             words[entry["name"]] = entry
     scenes = SUMMARY_SCENES
     head = ("| technique | best at | worst at | cost class | " + " | ".join(f"MAE `{s}`" for s in scenes)
-            + f" | ms `{scenes[0]}` | texel reads `{scenes[0]}` |\n|---|---|---|---|" + "---:|" * (len(scenes) + 2) + "\n")
+            + f" | ms `{scenes[0]}` (IQR) | texel reads `{scenes[0]}` |\n|---|---|---|---|" + "---:|" * (len(scenes) + 2) + "\n")
     order = [entry for entry in words] + sorted(name for name in rows if name not in words)
     lines = []
     for name in order:
@@ -363,11 +363,19 @@ def summary_table(rows, args, prefix=""):
         cells = [f"[`{name}`]({prefix}ssm-techniques/{name}/README.md)" if (ROOT / "ssm-techniques" / name).is_dir() else f"`{name}`",
                  entry.get("best", ""), entry.get("worst", ""), entry.get("cost", "")]
         cells += [error_cell(rows[name].get(s, {})) for s in scenes]
-        cells.append(first.get("gpu_ms_median", "") and f"{float(first['gpu_ms_median']):.2f}")
+        cells.append(time_cell(first))
         cells.append(first.get("texel_reads", "") and f"{int(float(first['texel_reads'])):,}")
         lines.append("| " + " | ".join(cells) + " |")
     return head + "\n".join(lines) + (f"\n\nMAE: mean absolute error of the visibility over the pixels that the ground truth or the technique "
                                       f"shadows, ± the ground truth's own error over the same pixels; {args.width}×{args.height} pixels.\n")
+
+
+def time_cell(row):
+    """A row's median GPU time with its interquartile range across the timed frames; empty when not timed."""
+    if row.get("gpu_ms_median") in (None, ""):
+        return ""
+    spread = f" ({float(row['gpu_ms_q1']):.2f}–{float(row['gpu_ms_q3']):.2f})" if row.get("gpu_ms_q1") not in (None, "") else ""
+    return f"{float(row['gpu_ms_median']):.2f}{spread}"
 
 
 def error_cell(row):

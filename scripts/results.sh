@@ -9,7 +9,7 @@
 # On an adapter other than lavapipe (a lent GPU: scripts/gpu-bench-pack.sh) everything goes to one
 # file, docs/results-<adapter>.md, beside the lavapipe one.
 #
-#   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 1] [--only summary,trade,lights,kinds,pvsm,...]
+#   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 5] [--only summary,trade,lights,kinds,pvsm,...]
 #   scripts/results.sh --splice-summary   (only copies docs/results/summary.md into README.md)
 #
 # Needs python3 (3.11+, for tomllib). Takes hours on lavapipe at the defaults; --only runs a part.

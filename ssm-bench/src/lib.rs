@@ -125,6 +125,24 @@ pub fn median(values: &[f64]) -> Option<f64> {
     Some(if sorted.len().is_multiple_of(2) { (sorted[mid - 1] + sorted[mid]) * 0.5 } else { sorted[mid] })
 }
 
+/// The first and third quartiles of `values` (linear interpolation between order statistics, as
+/// numpy's default): the interquartile range a timed point's spread is reported as. `None` when
+/// empty; one value is its own range.
+#[must_use]
+pub fn quartiles(values: &[f64]) -> Option<(f64, f64)> {
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if sorted.is_empty() {
+        return None;
+    }
+    sorted.sort_by(f64::total_cmp);
+    let at = |p: f64| {
+        let position = p * (sorted.len() - 1) as f64;
+        let (below, above) = (position.floor() as usize, position.ceil() as usize);
+        sorted[below] + (sorted[above] - sorted[below]) * (position - below as f64)
+    };
+    Some((at(0.25), at(0.75)))
+}
+
 /// The shared inputs every output of `ssm render` needs: the G-buffer, for
 /// the shaded image and the world positions.
 #[must_use]
@@ -216,6 +234,7 @@ pub fn write_run(renderer: &Renderer, measured: &report::Measured, dir: &Path) -
         "frames": measured.frames.len(),
         "gpu_ms_median": measured.gpu_ms_median(),
         "gpu_ms_min": measured.gpu_ms_min(),
+        "gpu_ms_iqr": measured.gpu_ms_quartiles().map(|(q1, q3)| [q1, q3]),
         "cpu_wall_ms_median": measured.cpu_ms_median(),
         "pass_ms_medians": measured.pass_medians().into_iter().map(|(k, v)| (k, json!(v))).collect::<serde_json::Map<_, _>>(),
         "shared_passes": renderer.shared_timings,
@@ -249,5 +268,19 @@ pub fn support_on(gpu: &GpuContext, info: &TechniqueInfo) -> String {
     match (info.requirements)(&info.default_params()).and_then(|r| r.check_device(info.name, gpu)) {
         Ok(()) => "yes".into(),
         Err(e) => format!("no: {e}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{median, quartiles};
+
+    #[test]
+    fn quartiles_interpolate_between_order_statistics() {
+        assert_eq!(quartiles(&[5.0, 1.0, 4.0, 2.0, 3.0]), Some((2.0, 4.0)));
+        assert_eq!(quartiles(&[4.0, 1.0, 3.0, 2.0]), Some((1.75, 3.25)));
+        assert_eq!(quartiles(&[7.0, f64::NAN]), Some((7.0, 7.0)));
+        assert_eq!(quartiles(&[]), None);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), Some(2.5));
     }
 }

@@ -55,6 +55,13 @@ impl Measured {
         median(&per_frame)
     }
 
+    /// First and third quartiles of the frame time over frames (as [`Measured::gpu_ms_median`]):
+    /// the spread tables print beside the median.
+    #[must_use]
+    pub fn gpu_ms_quartiles(&self) -> Option<(f64, f64)> {
+        crate::quartiles(&self.frames.iter().filter(|f| f.gpu_ms.is_some()).map(FrameTimings::frame_ms).collect::<Vec<_>>())
+    }
+
     /// Smallest frame time over frames (as [`Measured::gpu_ms_median`]).
     #[must_use]
     pub fn gpu_ms_min(&self) -> Option<f64> {
@@ -381,6 +388,9 @@ pub struct Row {
     pub gpu_ms_median: Option<f64>,
     /// Minimum GPU ms per frame.
     pub gpu_ms_min: Option<f64>,
+    /// First and third quartiles of the GPU ms per frame: the spread printed beside the median
+    /// (`None` in per-light rows and without timestamps).
+    pub gpu_ms_quartiles: Option<(f64, f64)>,
     /// Median CPU wall ms per frame.
     pub cpu_ms: f64,
     /// Error metrics against the reference, averaged over lights.
@@ -439,6 +449,8 @@ pub const CSV_COLUMNS: &[&str] = &[
     "truth_noise",
     "truth_noise_penumbra",
     "shadowed_pixels",
+    "gpu_ms_q1",
+    "gpu_ms_q3",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -465,6 +477,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         height,
         gpu_ms_median: measured.gpu_ms_median(),
         gpu_ms_min: measured.gpu_ms_min(),
+        gpu_ms_quartiles: measured.gpu_ms_quartiles(),
         cpu_ms: measured.cpu_ms_median(),
         metrics: average(&per_light),
         flip: flip_mean(&reference.shaded, &measured.shaded, width, height),
@@ -493,6 +506,7 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
                 light: Some(light),
                 gpu_ms_median: measured.gpu_ms_median_for_light(light),
                 gpu_ms_min: None,
+                gpu_ms_quartiles: None,
                 metrics: compare_with_noise(truth, truth_noise(reference, light), image, covered, width, height),
                 passes: measured.pass_medians_for_light(light),
                 // Counted over the whole frame: the `all` row holds it.
@@ -593,6 +607,7 @@ impl Row {
         .into_iter()
         .chain(self.work_fields())
         .chain([number(Some(m.mae), 6), number(m.truth_noise, 6), number(m.truth_noise_penumbra, 6), m.shadowed_pixels.to_string()])
+        .chain([number(self.gpu_ms_quartiles.map(|q| q.0), 4), number(self.gpu_ms_quartiles.map(|q| q.1), 4)])
         .collect()
     }
 
@@ -642,6 +657,7 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         "height": row.height,
         "gpu_ms_median": row.gpu_ms_median.map(finite),
         "gpu_ms_min": row.gpu_ms_min.map(finite),
+        "gpu_ms_iqr": row.gpu_ms_quartiles.map(|(q1, q3)| [finite(q1), finite(q3)]),
         "cpu_ms": finite(row.cpu_ms),
         "metrics": {
             "mae": finite(m.mae),
@@ -742,6 +758,7 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                 height: u32::try_from(whole("height")?).context("height")?,
                 gpu_ms_median: optional("gpu_ms_median")?,
                 gpu_ms_min: optional("gpu_ms_min")?,
+                gpu_ms_quartiles: optional("gpu_ms_q1")?.zip(optional("gpu_ms_q3")?),
                 cpu_ms: float("cpu_ms")?,
                 metrics: ErrorMetrics {
                     mae: float("mae")?,
@@ -821,7 +838,7 @@ const TABLE_HEADER: [&str; 12] = [
     "technique",
     "params",
     "GPU ms (median)",
-    "GPU ms (min)",
+    "GPU ms (IQR)",
     "MAE (± truth)",
     "MAE penumbra (± truth)",
     "RMSE",
@@ -848,7 +865,7 @@ fn table_cells(r: &Row) -> [String; 12] {
         r.technique.clone(),
         r.params.replace(';', "; "),
         number(r.gpu_ms_median, 3),
-        number(r.gpu_ms_min, 3),
+        r.gpu_ms_quartiles.map_or_else(String::new, |(q1, q3)| format!("{q1:.3}–{q3:.3}")),
         with_noise(m.mae, m.truth_noise),
         with_noise(m.mae_penumbra, m.truth_noise_penumbra),
         format!("{:.4}", m.rmse),
@@ -1310,6 +1327,7 @@ mod tests {
             height: 72,
             gpu_ms_median: gpu,
             gpu_ms_min: gpu,
+            gpu_ms_quartiles: gpu.map(|ms| (ms * 0.9, ms * 1.1)),
             cpu_ms: 12.5,
             metrics: ErrorMetrics {
                 mae: 0.0234567,

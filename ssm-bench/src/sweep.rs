@@ -461,6 +461,8 @@ pub struct MarkdownRow {
     pub point: String,
     /// Median time per frame, ms.
     pub ms: f64,
+    /// First and third quartiles of the time per frame, ms (GPU timestamps only).
+    pub ms_quartiles: Option<(f64, f64)>,
     /// The headline error against the ground truth ([`ErrorAxis::Mae`]).
     pub mae: f64,
     /// The ground truth's own error over the same pixels, when known.
@@ -484,15 +486,16 @@ pub struct MarkdownRow {
 pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
     let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
     text.push_str(
-        "| sweep | scene | technique | point | ms | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|\n",
+        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for row in rows {
         let point = if row.point.is_empty() { "defaults" } else { &row.point };
         text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {} | {:.4} | {:.1} | {} | {} |\n",
+            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} |\n",
             row.scene,
             row.technique,
             row.ms,
+            row.ms_quartiles.map_or_else(|| "-".to_owned(), |(q1, q3)| format!("{q1:.2}–{q3:.2}")),
             crate::report::with_noise(row.mae, row.truth_noise),
             row.mae_penumbra,
             row.psnr,
@@ -669,6 +672,7 @@ mod tests {
             technique: technique.into(),
             point: String::new(),
             ms: 12.345,
+            ms_quartiles: Some((12.0, 12.5)),
             mae: 0.02345,
             truth_noise: Some(0.00123),
             mae_penumbra: 0.01234,
@@ -679,7 +683,10 @@ mod tests {
         let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
         let lines: Vec<&str> = first.lines().collect();
         assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
-        assert_eq!(lines[4], "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 |");
+        assert_eq!(
+            lines[4],
+            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 |"
+        );
         assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }
 

@@ -25,8 +25,9 @@ pub(super) struct RenderArgs {
     /// Parameter assignment `<technique>.<param>=<value>`; repeatable.
     #[arg(long = "set", value_name = "TECHNIQUE.PARAM=VALUE")]
     settings: Vec<String>,
-    /// Frames timed after one warm-up frame; timings.json holds each and the median.
-    #[arg(long, default_value_t = 1)]
+    /// Frames timed after one warm-up frame; timings.json holds each, the median and the
+    /// interquartile range.
+    #[arg(long, default_value_t = 5)]
     frames: u32,
     #[command(flatten)]
     work: CountWorkArg,
@@ -77,7 +78,12 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
         let dir = args.out.join(info.name);
         write_run(&renderer, run, &dir)?;
         let time = match run.gpu_ms_median() {
-            Some(ms) => format!("{ms:.3} ms GPU"),
+            Some(ms) => match run.gpu_ms_quartiles() {
+                Some((q1, q3)) if run.frames.len() > 1 => {
+                    format!("{ms:.3} ms GPU (median; IQR {q1:.3}–{q3:.3}, {} frames)", run.frames.len())
+                }
+                _ => format!("{ms:.3} ms GPU"),
+            },
             None => format!("{:.3} ms CPU wall (no timestamps)", run.cpu_ms_median()),
         };
         say!("{:<8} {time}  [{}]  -> {}", info.name, run.params, dir.display());

@@ -56,8 +56,8 @@ pub(super) struct SweepArgs {
     size: SweepImageSize,
     #[command(flatten)]
     frame_order: FrameOrderArgs,
-    /// Frames timed per point after one warm-up.
-    #[arg(long, default_value_t = 3)]
+    /// Frames timed per point after one warm-up; the tables give their median and interquartile range.
+    #[arg(long, default_value_t = 5)]
     frames: u32,
     #[command(flatten)]
     work: CountWorkArg,
@@ -304,6 +304,7 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 technique: row.technique.clone(),
                 point: point.join(" "),
                 ms: sweep::time_of(row),
+                ms_quartiles: row.gpu_ms_quartiles,
                 mae: row.metrics.mae,
                 truth_noise: row.metrics.truth_noise,
                 mae_penumbra: row.metrics.mae_penumbra,
