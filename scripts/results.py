@@ -187,11 +187,13 @@ def main():
 
     # 5. The summary table (README.md and the results file), joined with docs/summary.toml's words.
     if summary_rows:
-        table = summary_table(summary_rows, args)
+        # Written from docs/results/ (its links resolve there); spliced into README.md with its
+        # links made relative to the workspace's root.
+        table = summary_table(summary_rows, args, "../../")
         body.insert(0, "## summary\n\nThe README's summary table.\n\n" + summary_table(summary_rows, args, "../") + "\n")
         if lavapipe and out_root == ROOT:
             summary = (f"{table}\nFrom `{command_line}` on {adapter}, {date}, commit {commit} "
-                       f"([docs/results.md](docs/results.md)).\n")
+                       f"([docs/results.md](../results.md)).\n")
             (docs / "results" / "summary.md").write_text(summary)
             splice_summary(summary)
     # Written now, and again after each technique on another adapter: a run stopped part-way (a
@@ -315,7 +317,9 @@ def merged_sections(previous, fresh):
 
 
 def splice_summary(summary):
-    """Puts `summary` between README.md's summary markers (nothing happens without them)."""
+    """Puts `summary` (docs/results/summary.md, links relative to docs/results/) between README.md's
+    summary markers, its links made relative to the workspace's root (nothing happens without them)."""
+    summary = summary.replace("](../../", "](").replace("](../results.md)", "](docs/results.md)")
     readme = ROOT / "README.md"
     text = readme.read_text()
     if SUMMARY_BEGIN in text and SUMMARY_END in text:

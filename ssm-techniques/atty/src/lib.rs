@@ -155,7 +155,7 @@ pub struct AttySettings {
     /// A micro-patch less than this many of its widths in front of a receiver hides nothing: without `receiver_plane`, removes the moiré of objects with role `both` shadowing themselves, but also the shadow of an occluder that close to a receiver (0: the paper).
     #[param(default = 0.0, min = 0.0, max = 16.0)]
     pub self_shadow_tolerance: f32,
-    /// What bounds each micro-patch's penumbra rectangle: the far plane, or the deepest receiver under it (same result; less fill for a pyramid pass, which did not pay on lavapipe).
+    /// What bounds each micro-patch's penumbra rectangle: the far plane, or the deepest receiver under it (same result; fewer accumulation fragments, for a pyramid pass whose texel reads exceed what they save).
     #[param(choice, default = "far_plane")]
     pub penumbra_bound: PenumbraBound,
     /// Aligned blocks of occluder texels whose depths differ by at most this many micro-patch widths are drawn as one micro-patch (Sec. 5.1.2: neighbours at one depth join exactly; 0: one patch per texel).
@@ -1001,13 +1001,18 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// umbra or penumbra in the ground truth, not the workspace's headline error.
 const PAPER_ERROR: &str = "mae-penumbra";
 
-/// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps.
+/// The paper's own receiver model, which every reproduction of its figures runs: a receiver's
+/// depth alone decides (no receiver plane; `receiver_plane` is this workspace's model for objects
+/// that both cast and receive, which the paper leaves out, Sec. 7).
+const PAPER_MODE: &str = "atty.receiver_plane=false";
+
+/// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps, in the paper's mode.
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "atty-map-size",
         summary: "Atty et al., Fig. 17 (error) and Fig. 22 (time, with --error time) against the occluder map's size, one- and two-sided; in counted work (--count-work) the accumulation's fragments grow with the micro-patches, n², while each patch covers fewer",
         scenes: &["floating-sphere"],
-        varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true"],
+        varies: &["atty.occluder_map_size=33,63,127,200,255,383,511", "atty.two_sided=false,true", PAPER_MODE],
         x_axis: "atty.occluder_map_size",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
@@ -1017,7 +1022,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-map-size-time",
         summary: "Atty et al., Fig. 22: frame time against the occluder map's size (128², 256², 512²), one- and two-sided",
         scenes: &["floating-sphere"],
-        varies: &["atty.occluder_map_size=128,256,512", "atty.two_sided=false,true"],
+        varies: &["atty.occluder_map_size=128,256,512", "atty.two_sided=false,true", PAPER_MODE],
         x_axis: "atty.occluder_map_size",
         y_axis: "time",
         ..ssm_core::Preset::DEFAULT
@@ -1026,7 +1031,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-light-size",
         summary: "Atty et al., Fig. 18 and Fig. 24(b) (error; Fig. 24(a), time, with --error time) against the light's size for 63², 127², 255² maps (not powers of two, as the paper notes in Sec. 5.2.3; a thick occluder such as floating-sphere)",
         scenes: &["floating-sphere"],
-        varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255"],
+        varies: &["scene.light_scale=0.02,0.25,0.5,1,1.5,2", "atty.occluder_map_size=63,127,255", PAPER_MODE],
         x_axis: "scene.light_scale",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
@@ -1036,7 +1041,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-occluder-height",
         summary: "Atty et al., Fig. 20: error as the occluders move from the receiver towards the light (on floating-sphere: from 0.05 above the ground to 0.05 below the light)",
         scenes: &["floating-sphere"],
-        varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true"],
+        varies: &["scene.occluder_lift=-0.75,-0.5,0,0.5,1,1.5,1.9,1.95", "atty.two_sided=false,true", PAPER_MODE],
         x_axis: "scene.occluder_lift",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
@@ -1046,7 +1051,7 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-occluder-shift",
         summary: "Atty et al., Fig. 19: error as the occluder moves sideways under the light (scene.occluder_shift, in light widths from its centre), 128² map, one- and two-sided",
         scenes: &["floating-sphere"],
-        varies: &["scene.occluder_shift=-1,-0.5,-0.25,0,0.25,0.5,1", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
+        varies: &["scene.occluder_shift=-1,-0.5,-0.25,0,0.25,0.5,1", "atty.occluder_map_size=128", "atty.two_sided=false,true", PAPER_MODE],
         x_axis: "scene.occluder_shift",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
@@ -1056,7 +1061,12 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-polygons",
         summary: "Atty et al., Fig. 21: error (and time, with --error time) against the occluder's polygon count, a sphere tessellated from 16 to 261,632 triangles (scene.segments, rings in step), 128² map",
         scenes: &["floating-sphere"],
-        varies: &["scene.segments:rings=4:3,16:8,64:32,256:128,512:256", "atty.occluder_map_size=128", "atty.two_sided=false,true"],
+        varies: &[
+            "scene.segments:rings=4:3,16:8,64:32,256:128,512:256",
+            "atty.occluder_map_size=128",
+            "atty.two_sided=false,true",
+            PAPER_MODE,
+        ],
         x_axis: "scene.segments",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
@@ -1066,10 +1076,24 @@ const PRESETS: &[ssm_core::Preset] = &[
         name: "atty-small-maps",
         summary: "Atty et al., Fig. 23: large lights with small occluder maps, the error of 32², 64², 128² maps as the light grows (one to four times floating-sphere's)",
         scenes: &["floating-sphere"],
-        varies: &["scene.light_scale=1,2,3,4", "atty.occluder_map_size=32,64,128", "atty.two_sided=true"],
+        varies: &["scene.light_scale=1,2,3,4", "atty.occluder_map_size=32,64,128", "atty.two_sided=true", PAPER_MODE],
         x_axis: "scene.light_scale",
         y_axis: PAPER_ERROR,
         pixels: "receivers",
+        ..ssm_core::Preset::DEFAULT
+    },
+    ssm_core::Preset {
+        name: "atty-paper-mode",
+        summary: "The default receiver model (receiver_plane) against the paper's mode on the paper's analytic case, parallel-square (exact truth), over a whole cycle of the occluder map's grid phase near 256² and near 1024² (compare the means over each eight sizes: one size alone is decided by where the square's edges fall on the texel grid), with FP32 and Appendix A's FP16 accumulation, one patch per texel (merge_tolerance 0, as the paper)",
+        scenes: &["parallel-square"],
+        varies: &[
+            "atty.receiver_plane=false,true",
+            "atty.occluder_map_size=252,253,254,255,256,257,258,259,1020,1021,1022,1023,1024,1025,1026,1027",
+            "atty.accumulation=f32,f16",
+            "atty.merge_tolerance=0",
+        ],
+        x_axis: "atty.occluder_map_size",
+        y_axis: PAPER_ERROR,
         ..ssm_core::Preset::DEFAULT
     },
 ];

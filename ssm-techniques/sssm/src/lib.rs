@@ -173,8 +173,8 @@ pub struct SssmSettings {
     /// How steps 2 and 3 run: fragment passes or shared-row compute passes (same result).
     #[param(choice, default = "fragment")]
     pub blur_passes: BlurPasses,
-    /// Where blocker rows and blur rows past the screen's edges come from: clamp (the nearest pixel on the screen when it passes the reuse test, as a clamp-to-edge read would: the paper's screen-space passes, wrong where the shadow changes past the edge) or recompute (the depth map, as a failed reuse test's: exact borders, at n or m reads a row).
-    #[param(choice, default = "clamp")]
+    /// Where blocker rows and blur rows past the screen's edges come from: recompute (the depth map, as Sec. 4.1 recomputes a row that cannot be reused: exact borders, at n or m reads a row) or clamp (the nearest pixel on the screen when it passes the reuse test, as a clamp-to-edge read would: fewer reads, wrong where the shadow changes past the edge).
+    #[param(choice, default = "recompute")]
     pub edge_rows: EdgeRows,
     /// Count each pass's texel reads per pixel of the screen, the G-buffer's and the previous step's own texel included at every pixel (diagnostics `sssm_<pass>_reads_per_pixel`), and the kernel rows that failed their reuse test per computed pixel, by cause (`sssm_blocker_rows_failed_<cause>_rows_per_pixel` for step 2, `sssm_blur_rows_failed_<cause>_rows_per_pixel` for step 3; causes `off_screen`, `no_data`, `depth`; with `edge_rows = clamp`, `off_screen` counts only blocker rows behind the eye, the others being read from the edge); the atomics cost time, so off when timing.
     #[param(default = false)]
@@ -734,12 +734,13 @@ const TABLE4_VIEWPORT: (u32, u32) = (1280, 960);
 const PRESETS: &[ssm_core::Preset] = &[
     ssm_core::Preset {
         name: "sssm-table4",
-        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); and the pre-filtered VSSM, whose cost does not depend on a kernel. With --count-work, texel reads per frame beside the times (the test sssm_reads_eight_times_fewer_texels_than_pcss_at_table_4s_largest_kernels asserts at least 8x fewer than PCSS at 29/41)",
+        summary: "Buades et al., Table 4: PCSS and SSSM at kernel pairs 7/15, 11/21, 29/41, SSSM at the table's thresholds (alpha = beta = 0.01, 0.1, 0.15, 0.2, 0.5; 0.1 is the paper's headline, 3.2x PCSS's frame rate at 29/41); both with the receiver-plane model (on leaves, the plant scene's nearest); the rows past the screen's edges recomputed from the depth map, as Sec. 4.1 recomputes a row it cannot reuse; and the pre-filtered VSSM, whose cost does not depend on a kernel. With --count-work, texel reads per frame beside the times (the test sssm_reads_six_times_fewer_texels_than_pcss_at_table_4s_largest_kernels asserts at least 6x fewer than PCSS at 29/41 per pixel)",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
             "sssm.blocker_kernel:blur_kernel=7:15,11:21,29:41",
             "sssm.alpha:beta=0.01:0.01,0.1:0.1,0.15:0.15,0.2:0.2,0.5:0.5",
+            "sssm.edge_rows=recompute",
             "vssm",
         ],
         size: Some(TABLE4_VIEWPORT),
@@ -759,7 +760,7 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "sssm-edges",
-        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (the default, as a clamp-to-edge read would) or recomputed from the depth map, at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with --count-work, in texel reads)",
+        summary: "PCSS and SSSM with the blocker and blur rows past the screen's edges clamped to the nearest pixel on the screen (as a clamp-to-edge read would) or recomputed from the depth map (the default, Sec. 4.1), at Table 4's kernel pairs with alpha = beta = 0.1 and Table 4's 1280x960 (on leaves): what exact borders cost (with --count-work, in texel reads) and gain in error",
         scenes: &["leaves"],
         varies: &[
             "pcss.blocker_kernel:pcf_kernel=7:15,11:21,29:41",
