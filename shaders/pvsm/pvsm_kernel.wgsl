@@ -20,13 +20,33 @@
 @group(2) @binding(4) var<storage, read_write> grid: array<atomic<u32>>;
 // COUNTER_* of pvsm_common.wgsl.
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
-// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_KERNEL_SHAPE (texel reads) and
-// READ_COUNTER_KERNEL_SHAPE_ATOMICS (atomic operations).
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_KERNEL_SHAPE (texel reads),
+// READ_COUNTER_KERNEL_SHAPE_ATOMICS (atomic operations) and READ_COUNTER_PREDICTED_TEXELS (a
+// diagnostic: the texels the pixel's own predicted resolution puts under its filter).
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 // The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
 const READ_COUNTER_KERNEL_SHAPE: u32 = 1u;
 const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 2u;
+const READ_COUNTER_PREDICTED_TEXELS: u32 = 9u;
+
+// Most texels one pixel's count below adds: keeps a 32-bit bucket from overflowing at a large
+// viewport under a filter many thousand predicted texels wide (a cost no prediction asks for).
+const PREDICTED_TEXELS_CAP: f32 = 100000.0;
+
+// Records, for a filtered pixel, the texels of its own predicted size (Eq. 5) that its filter (the
+// parallelogram of half axes (u.x, u.y) and (0, v_height), area 4·|u.x|·v_height) covers, at least
+// one: what the filter would read from a tile of exactly the pixel's resolution, against which the
+// walk's reads in the tile it gets (pvsm_filter.wgsl) are set (the diagnostics'
+// pvsm_filter_reads_over_predicted).
+fn record_predicted_texels(pixel: vec2<u32>, u: vec2<f32>, v_height: f32, texel: vec2<f32>) {
+    if (COUNT_READS) {
+        let texels = clamp(4.0 * abs(u.x) * v_height / max(texel.x * texel.y, 1e-30), 1.0, PREDICTED_TEXELS_CAP);
+        let word = read_count_word(READ_COUNTER_PREDICTED_TEXELS, vec2<i32>(pixel));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], u32(round(texels)));
+    }
+}
 
 // Records one pixel's texel reads (one per textureLoad, ReadCounts' convention: the G-buffer's two
 // at every pixel, trivial ones included, and the low-resolution map's) and atomics, with
@@ -448,4 +468,5 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     kernels[index] = kernel;
     atomicAdd(&counters[COUNTER_FILTERED], 1u);
     record_kernel_work(id.xy, reads, atomics);
+    record_predicted_texels(id.xy, kernel.u_axis, kernel.v_height, texel_size);
 }

@@ -278,6 +278,14 @@ impl Running {
         drop(self.technique);
         let work = if job.count_work { crate::work::count(renderer, info, job.params)? } else { None };
         let work_note = (job.count_work && work.is_none()).then_some(crate::work::GROUND_TRUTH_NOT_COUNTED);
+        // The counting build's diagnostics that the timed one cannot give (per-pass counts and
+        // what a technique sets them against) join the row's.
+        let mut diagnostics = diagnostics;
+        for (key, value) in work.iter().flat_map(|w| &w.diagnostics) {
+            if !diagnostics.iter().any(|(known, _)| known == key) {
+                diagnostics.push((key.clone(), *value));
+            }
+        }
         Ok(Measured {
             info,
             params: job.params.clone(),
@@ -799,6 +807,8 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                             passes: crate::work::parse_passes_column(field("passes_work"))
                                 .with_context(|| format!("line {line_number}"))?,
                             uncounted_passes: 0,
+                            // Already among the row's diagnostics column.
+                            diagnostics: Vec::new(),
                         })
                     }
                 },
@@ -1390,6 +1400,7 @@ mod tests {
                 ..ssm_core::PassWork::default()
             }],
             uncounted_passes: 0,
+            diagnostics: Vec::new(),
         });
         rows[2].work = Some(FrameWork { shader_counts: true, pipeline_statistics: false, ..rows[0].work.clone().unwrap() });
         let text = csv(&rows);

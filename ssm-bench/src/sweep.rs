@@ -71,6 +71,8 @@ pub struct PresetSpec {
     /// The image size (width, height) unless `--width`/`--height` say otherwise: the paper's,
     /// where it states one.
     pub size: Option<(u32, u32)>,
+    /// Fixed `--set` assignments (`<technique>.<param>=<value>`), under the command line's own.
+    pub settings: Vec<String>,
 }
 
 impl PresetSpec {
@@ -93,6 +95,7 @@ impl PresetSpec {
             y_axis,
             pixels,
             size: preset.size,
+            settings: preset.settings.iter().map(|s| (*s).to_owned()).collect(),
         })
     }
 }
@@ -119,6 +122,7 @@ pub fn trade_preset(registry: &Registry) -> PresetSpec {
         y_axis: ErrorAxis::Mae,
         pixels: PixelSet::All,
         size: None,
+        settings: Vec::new(),
     }
 }
 
@@ -141,6 +145,7 @@ pub fn lights_preset(registry: &Registry) -> PresetSpec {
         y_axis: ErrorAxis::Time,
         pixels: PixelSet::All,
         size: None,
+        settings: Vec::new(),
     }
 }
 

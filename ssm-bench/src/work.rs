@@ -349,6 +349,7 @@ mod tests {
                 },
             ],
             uncounted_passes: 0,
+            diagnostics: Vec::new(),
         }
     }
 

@@ -94,7 +94,7 @@ fn the_device_script_hands_back_the_table_and_the_sweeps() {
         let ms: f64 = cells[5].parse().unwrap_or_else(|_| panic!("a time in `{row}`"));
         assert!(ms.is_finite() && ms > 0.0, "{row}");
         // The work beside the time: lavapipe has pipeline statistics, so invocations are counted.
-        let invocations: u64 = cells[9].parse().unwrap_or_else(|_| panic!("counted invocations in `{row}`"));
+        let invocations: u64 = cells[11].parse().unwrap_or_else(|_| panic!("counted invocations in `{row}`"));
         assert!(invocations > 0, "{row}");
     }
 

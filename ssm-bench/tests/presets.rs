@@ -26,6 +26,14 @@ fn every_preset_resolves_against_the_registry() {
                 overrides.check_scene(scene).unwrap_or_else(|e| panic!("preset {}: scene {scene}: {e:#}", spec.name));
             }
         }
+        // The fixed settings name a registered technique (the ground truth included) and one of
+        // its parameters, with a value in range.
+        for setting in &spec.settings {
+            let (key, value) = setting.split_once('=').unwrap_or_else(|| panic!("preset {}: setting {setting}", spec.name));
+            let (technique, param) = key.split_once('.').unwrap_or_else(|| panic!("preset {}: setting {setting}", spec.name));
+            let info = registry.iter().find(|i| i.name == technique).unwrap_or_else(|| panic!("preset {}: {setting}", spec.name));
+            info.params_from([(param, value)]).unwrap_or_else(|e| panic!("preset {}: {setting}: {e}", spec.name));
+        }
         for scene in &spec.scenes {
             // Built-in names load; manifests are resolved from the repository's root.
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);

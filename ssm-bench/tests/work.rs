@@ -190,7 +190,7 @@ fn a_sweep_with_cost_work_counts_every_point_and_plots_error_against_work() {
     }
     let markdown = std::fs::read_to_string(out.join("sweep.md")).unwrap();
     for line in markdown.lines().skip(4) {
-        let invocations: u64 = line.split('|').nth(9).unwrap().trim().parse().unwrap_or_else(|_| panic!("invocations in `{line}`"));
+        let invocations: u64 = line.split('|').nth(10).unwrap().trim().parse().unwrap_or_else(|_| panic!("invocations in `{line}`"));
         assert!(invocations > 0, "{line}");
     }
     let plot = std::fs::read_to_string(out.join("sweep-work.svg")).unwrap();

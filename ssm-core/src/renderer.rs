@@ -141,6 +141,7 @@ impl Renderer {
         if let Some(shader_work) = technique.counted_work(&self.gpu)? {
             work.add_shader_work(&shader_work);
         }
+        work.diagnostics = technique.diagnostics(&self.gpu);
         Ok(work)
     }
 

@@ -261,13 +261,18 @@ pub struct Preset {
     /// The image size (width, height) the paper measured at, where it says: `ssm sweep --preset`
     /// renders at it unless `--width`/`--height` say otherwise (without one, 640×480).
     pub size: Option<(u32, u32)>,
+    /// Fixed `--set` assignments of the paper's configuration that no `--vary` carries,
+    /// `<technique>.<param>=<value>` (`reference.footprint=pixel`: a truth averaged over each
+    /// pixel's footprint, for a technique that anti-aliases); the command line's `--set` of the
+    /// same parameter wins.
+    pub settings: &'static [&'static str],
 }
 
 impl Preset {
     /// A preset with the usual axes (time against the headline error, all pixels); set
     /// the other fields with struct update syntax.
     pub const DEFAULT: Self =
-        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae", pixels: "all", size: None };
+        Self { name: "", summary: "", scenes: &[], varies: &[], x_axis: "time", y_axis: "mae", pixels: "all", size: None, settings: &[] };
 }
 
 /// Size and field offsets of a Rust struct uploaded as a uniform

@@ -126,6 +126,10 @@ pub struct FrameWork {
     pub passes: Vec<PassWork>,
     /// Passes past [`MAX_COUNTED_PASSES`], without pipeline statistics.
     pub uncounted_passes: u32,
+    /// The counting instance's own diagnostics ([`ShadowTechnique::diagnostics`](crate::ShadowTechnique::diagnostics)
+    /// after the counting frame): the figures only a build that counts can give, such as the
+    /// reads per pixel of one pass or what they are set against.
+    pub diagnostics: Vec<(String, f64)>,
 }
 
 impl FrameWork {

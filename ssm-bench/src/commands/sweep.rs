@@ -123,8 +123,9 @@ fn list_presets(registry: &ssm_core::Registry) -> Result<()> {
         let owner = preset.owner.map_or_else(String::new, |o| format!(" [{o}]"));
         say!("{}{owner}: {}", preset.name, preset.summary);
         let (width, height) = sweep::image_size(None, None, Some(&preset));
+        let settings: String = preset.settings.iter().map(|s| format!(" --set {s}")).collect();
         say!(
-            "  --scene {}  --vary {}  (x: {}, y: {}, pixels: {}, {width}x{height})",
+            "  --scene {}  --vary {}{settings}  (x: {}, y: {}, pixels: {}, {width}x{height})",
             preset.scenes.join("|"),
             preset.varies.join(" --vary "),
             preset.x_axis,
@@ -148,6 +149,18 @@ pub(super) fn sweep_name(value: impl clap::ValueEnum) -> String {
 /// The pixel set as `--pixels` spells it.
 fn sweep_pixels_name(pixels: report::PixelSet) -> String {
     clap::ValueEnum::to_possible_value(&pixels).map_or_else(String::new, |v| v.get_name().to_owned())
+}
+
+/// The fixed settings of a sweep: the preset's (its paper's configuration), except those of a
+/// parameter the command line sets, then the command line's.
+fn with_preset_settings(registry: &ssm_core::Registry, args: &SweepArgs) -> Result<Vec<String>> {
+    let preset = args.preset.as_deref().map(|name| sweep::preset(registry, name)).transpose()?;
+    let key = |setting: &str| setting.split_once('=').map(|(key, _)| key.trim().to_owned());
+    let given: Vec<Option<String>> = args.settings.iter().map(|s| key(s)).collect();
+    let mut settings: Vec<String> =
+        preset.map(|p| p.settings).unwrap_or_default().into_iter().filter(|s| !given.contains(&key(s))).collect();
+    settings.extend(args.settings.iter().cloned());
+    Ok(settings)
 }
 
 /// The preset's defaults under the command line's choices, and the plan, checked before the GPU is touched.
@@ -472,7 +485,8 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
     if args.list_presets {
         return list_presets(registry);
     }
-    let settings: Vec<(&str, &str, &str)> = args.settings.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
+    let settings_text = with_preset_settings(registry, args)?;
+    let settings: Vec<(&str, &str, &str)> = settings_text.iter().map(|s| parse_setting(s)).collect::<Result<_>>()?;
     // Every grid point resolved before the GPU is touched: a bad value fails fast.
     let sweep = resolve_sweep(args, registry, &settings)?;
     let techniques: Vec<&TechniqueInfo> = sweep.plan.points.iter().map(|(info, _, _)| *info).collect();
@@ -486,7 +500,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
             preset: args.preset.clone(),
             scene: sweep.scene_spec.clone(),
             varies: sweep.specs.clone(),
-            settings: args.settings.clone(),
+            settings: settings_text.clone(),
             size: sweep.size,
             frames: args.frames,
             pixels: sweep_pixels_name(sweep.pixels),
