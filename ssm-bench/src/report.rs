@@ -280,7 +280,6 @@ impl Running {
         let work_note = (job.count_work && work.is_none()).then_some(crate::work::GROUND_TRUTH_NOT_COUNTED);
         // The counting build's diagnostics that the timed one cannot give (per-pass counts and
         // what a technique sets them against) join the row's.
-        let mut diagnostics = diagnostics;
         for (key, value) in work.iter().flat_map(|w| &w.diagnostics) {
             if !diagnostics.iter().any(|(known, _)| known == key) {
                 diagnostics.push((key.clone(), *value));

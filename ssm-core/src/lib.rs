@@ -85,8 +85,8 @@ pub use screen_pass::ScreenPass;
 pub use side_faces::{SIDE_FACE_WIDTH, SideFaceFrames, SideFaceMaps};
 pub use ssm_derive::{Choice, Settings, UniformStruct};
 pub use technique::{
-    DebugOutput, ExtraImage, KnownLimit, LightSampling, LightView, Preset, Requirements, RustLayout, ShadowTechnique, TechniqueInfo,
-    TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
+    DebugOutput, ExtraImage, KnownLimit, LightSampling, LightView, PaperConfiguration, Preset, Requirements, RustLayout, ShadowTechnique,
+    TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct,
 };
 pub use timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer, PassTiming, TimingSource};
 pub use work::{FrameWork, PassWork, ShaderWork};

@@ -1921,6 +1921,7 @@ pub const INFO: crate::TechniqueInfo = crate::TechniqueInfo {
     debug_outputs: &[crate::DebugOutput { name: NOISE_OUTPUT, doc: NOISE_DOC, overlay: false }],
     uniforms: &[],
     limits: &[],
+    paper_configuration: crate::PaperConfiguration::DEFAULTS,
 };
 
 /// The debug output holding the ground truth's own error per pixel ([`ReferenceImage::noise`]);

@@ -92,6 +92,7 @@ mod tests {
         debug_outputs: &[],
         uniforms: &[],
         limits: &[],
+        paper_configuration: crate::PaperConfiguration::DEFAULTS,
     };
     static ALPHA_AGAIN: TechniqueInfo = TechniqueInfo {
         name: "alpha",
@@ -108,6 +109,7 @@ mod tests {
         debug_outputs: &[],
         uniforms: &[],
         limits: &[],
+        paper_configuration: crate::PaperConfiguration::DEFAULTS,
     };
     static BETA: TechniqueInfo = TechniqueInfo {
         name: "beta",
@@ -124,6 +126,7 @@ mod tests {
         debug_outputs: &[],
         uniforms: &[],
         limits: &[],
+        paper_configuration: crate::PaperConfiguration::DEFAULTS,
     };
 
     #[test]

@@ -349,6 +349,35 @@ pub struct TechniqueInfo {
     /// allowed there and the paper's reason. Empty for a technique that meets the common bound
     /// everywhere.
     pub limits: &'static [KnownLimit],
+    /// The paper's own configuration, where the defaults depart from it: the cross-crate test
+    /// `tests/paper_configuration.rs` holds every default no less accurate than it on the paper's
+    /// own kind of scene.
+    pub paper_configuration: PaperConfiguration,
+}
+
+/// A technique's paper's own configuration: the settings its published figures were measured
+/// with, where the technique's defaults depart from them, and the scenes of the paper's own kind
+/// on which the defaults must be no less accurate (`tests/paper_configuration.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaperConfiguration {
+    /// `param=value` of the technique's own parameters that give the paper's method; empty where
+    /// the defaults are the paper's.
+    pub settings: &'static [&'static str],
+    /// The paper's own kind of scene: built-in names or manifests (from the workspace's root).
+    pub scenes: &'static [&'static str],
+    /// `param=value` of the ground truth the paper's output is judged against (`footprint=pixel`
+    /// for a visibility averaged over each pixel's footprint); the defaults are judged against
+    /// the ground truth at its defaults.
+    pub truth: &'static [&'static str],
+    /// Where one value of a parameter is decided by how the scene falls on a texel grid (its
+    /// aliasing phase), `param=v1,v2,...`: both configurations are judged by their mean error over
+    /// these values (a whole cycle of the phase) rather than at the default alone.
+    pub averaged_over: Option<&'static str>,
+}
+
+impl PaperConfiguration {
+    /// The defaults are the paper's configuration.
+    pub const DEFAULTS: Self = Self { settings: &[], scenes: &[], truth: &[], averaged_over: None };
 }
 
 /// An extreme case where a technique's published method limits its accuracy: the extremes

@@ -36,6 +36,12 @@ pub(super) fn techniques(format: Format) -> Result<()> {
                         "name": o.name, "doc": o.doc, "overlay": o.overlay,
                     })).collect::<Vec<_>>(),
                     "presets": info.presets.iter().map(|p| p.name).collect::<Vec<_>>(),
+                    "paper_configuration": (!info.paper_configuration.settings.is_empty()).then(|| serde_json::json!({
+                        "settings": info.paper_configuration.settings,
+                        "scenes": info.paper_configuration.scenes,
+                        "truth": info.paper_configuration.truth,
+                        "averaged_over": info.paper_configuration.averaged_over,
+                    })),
                 }))
             })
             .collect::<Result<Vec<_>>>()?;
@@ -50,6 +56,12 @@ pub(super) fn techniques(format: Format) -> Result<()> {
     for info in registry.iter() {
         say!("{}: {}", info.name, info.summary);
         say!("  paper: {}", info.paper);
+        let paper = info.paper_configuration;
+        if !paper.settings.is_empty() {
+            let settings: Vec<String> = paper.settings.iter().map(|s| format!("--set {}.{s}", info.name)).collect();
+            let truth: String = paper.truth.iter().map(|s| format!(" --set reference.{s}")).collect();
+            say!("  the paper's configuration: {}{truth} (its scenes: {})", settings.join(" "), paper.scenes.join(", "));
+        }
         let requirements = (info.requirements)(&info.default_params())?;
         say!("  needs: {}", requirements.describe());
         if let Ok(gpu) = &gpu {

@@ -995,16 +995,27 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             reason: "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): the soft shadow map is one virtual plane parallel to the light, onto which each micro-patch's penumbra pyramid cuts an axis-aligned rectangle (Atty et al. 2006, Sec. 3.3, Fig. 7); the micro-patches are parallel to the light (Sec. 3), which a hemicube's side faces, perpendicular to it, are not",
         },
     ],
+    paper_configuration: ssm_core::PaperConfiguration {
+        // The receiver's depth alone decides, and the SSM is read at the point itself (Sec. 3.1's
+        // projective texture lookup; the normal offset is this workspace's, Holbert 2011).
+        settings: &["receiver_plane=false", "normal_offset=0"],
+        scenes: &["parallel-square", "floating-sphere"],
+        truth: &[],
+        // Where the occluder's edges fall on the occluder map's grid moves the error several times
+        // over (Sec. 5.1.1's half-texel bound, either way): a whole cycle of sizes around 256.
+        averaged_over: Some("occluder_map_size=252,253,254,255,256,257,258,259"),
+    },
 };
 
 /// The error Atty et al.'s figures plot (Sec. 5.2.1): the mean absolute error over the pixels in
 /// umbra or penumbra in the ground truth, not the workspace's headline error.
 const PAPER_ERROR: &str = "mae-penumbra";
 
-/// The paper's own receiver model, which every reproduction of its figures runs: a receiver's
-/// depth alone decides (no receiver plane; `receiver_plane` is this workspace's model for objects
-/// that both cast and receive, which the paper leaves out, Sec. 7).
-const PAPER_MODE: &str = "atty.receiver_plane=false";
+/// The paper's own receiver model and lookup, which every reproduction of its figures runs: a
+/// receiver's depth alone decides (no receiver plane; `receiver_plane` is this workspace's model for
+/// objects that both cast and receive, which the paper leaves out, Sec. 7), and the SSM is read at
+/// the point itself (Sec. 3.1; no normal offset).
+const PAPER_MODE: &str = "atty.receiver_plane:normal_offset=false:0";
 
 /// Atty et al.'s studies (Sec. 5.2 and 6.2), as sweeps, in the paper's mode.
 const PRESETS: &[ssm_core::Preset] = &[
@@ -1084,10 +1095,10 @@ const PRESETS: &[ssm_core::Preset] = &[
     },
     ssm_core::Preset {
         name: "atty-paper-mode",
-        summary: "The default receiver model (receiver_plane) against the paper's mode on the paper's analytic case, parallel-square (exact truth), over a whole cycle of the occluder map's grid phase near 256² and near 1024² (compare the means over each eight sizes: one size alone is decided by where the square's edges fall on the texel grid), with FP32 and Appendix A's FP16 accumulation, one patch per texel (merge_tolerance 0, as the paper)",
-        scenes: &["parallel-square"],
+        summary: "The default receiver model (receiver_plane) against the paper's mode (read at the point, and with this workspace's normal offset) on the paper's analytic case, parallel-square (exact truth), and on floating-sphere, over a whole cycle of the occluder map's grid phase near 256² and near 1024² (compare the means over each eight sizes: one size alone is decided by where the square's edges fall on the texel grid), with FP32 and Appendix A's FP16 accumulation, one patch per texel (merge_tolerance 0, as the paper)",
+        scenes: &["parallel-square", "floating-sphere"],
         varies: &[
-            "atty.receiver_plane=false,true",
+            "atty.receiver_plane:normal_offset=false:0,false:0.5,true:0.5",
             "atty.occluder_map_size=252,253,254,255,256,257,258,259,1020,1021,1022,1023,1024,1025,1026,1027",
             "atty.accumulation=f32,f16",
             "atty.merge_tolerance=0",

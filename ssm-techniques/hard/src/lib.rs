@@ -164,6 +164,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "HardSettings", wgsl_source: SHADER, imports: &[], rust: HardSettingsUniform::LAYOUT }],
     limits: &[],
+    paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };
 
 register_technique!(INFO);

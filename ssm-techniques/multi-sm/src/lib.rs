@@ -349,6 +349,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     debug_outputs: &[],
     uniforms: &[UniformCheck { wgsl_struct: "MultiSmSettings", wgsl_source: SHADER, imports: &[], rust: MultiSmSettingsUniform::LAYOUT }],
     limits: &[],
+    paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };
 
 register_technique!(INFO);

@@ -352,6 +352,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         },
     ],
     limits: &[],
+    paper_configuration: ssm_core::PaperConfiguration {
+        // Fernando's sketch compares each tap with the receiver's own depth.
+        settings: &["receiver_plane=false"],
+        scenes: &["contact", "parallel-square"],
+        truth: &[],
+        averaged_over: None,
+    },
 };
 
 register_technique!(INFO);

@@ -1591,6 +1591,14 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             reason: "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): the predicted resolutions are gathered in one tile grid on the shadow map plane, whose kd-tree tiles are the virtual shadow maps (Shen et al. 2011, Sec. 5.2); that plane cannot reach 90 degrees off its axis, and a hemicube's side faces would need a grid, a pyramid and a kd-tree each",
         },
     ],
+    paper_configuration: ssm_core::PaperConfiguration {
+        // Sec. 4.2's analytic anti-aliasing, judged against the visibility averaged over each
+        // pixel's footprint, which it computes.
+        settings: &["antialiasing=true"],
+        scenes: &["leaves", "bar-grid"],
+        truth: &["footprint=pixel"],
+        averaged_over: None,
+    },
 };
 
 register_technique!(INFO);

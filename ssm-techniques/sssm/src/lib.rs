@@ -864,6 +864,14 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         rust: SssmSettingsUniform::LAYOUT,
     }],
     limits: &[ssm_core::KnownLimit { case: "light resting on the receiver", mean_error: 0.25, reason: ONE_FRAME_LIMIT }],
+    paper_configuration: ssm_core::PaperConfiguration {
+        // Table 4's headline thresholds, the plain (unweighted) blur, the Gaussian along the
+        // screen's rows and columns (Sec. 4.4).
+        settings: &["alpha=0.1", "beta=0.1", "bilateral_depth=0", "filter=gaussian", "blur_axes=screen"],
+        scenes: &["leaves"],
+        truth: &[],
+        averaged_over: None,
+    },
 };
 
 register_technique!(INFO);

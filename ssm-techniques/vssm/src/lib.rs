@@ -333,6 +333,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             reason: "past the light frame's widest angle (84 degrees off the light's normal) the framework answers with a hard shadow from the light's centre (counted: pixels_beyond_frame): its search and filter are rectangles of one summed-area table (Yang et al. 2010), the light's back-projection only while the map is parallel to the light; on a hemicube's side faces, perpendicular to it, the light's image is a tilted quadrilateral reaching the whole face, which a rectangle query would blur over (pcss's side faces tap the quadrilateral point by point instead)",
         },
     ],
+    paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };
 
 register_technique!(INFO);

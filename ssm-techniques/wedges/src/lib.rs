@@ -1182,6 +1182,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         },
     ],
     limits: &[],
+    paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };
 
 register_technique!(INFO);

@@ -151,6 +151,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     debug_outputs: &[],
     uniforms: &[],
     limits: &[],
+    paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };
 
 register_technique!(INFO);
