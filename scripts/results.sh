@@ -6,11 +6,15 @@
 #                                                 truth's cost), the trade plot, several lights, one scene per kind (docs/choosing.md)
 #   ssm-techniques/<t>/results.md (+ results/)    each technique's paper presets and examples
 #   README.md, between <!-- summary --> markers   the summary table (words from docs/summary.toml)
+#   docs/choosing.md, between <!-- rankings:... --> markers   the rankings of each kind of scene
 # On an adapter other than lavapipe (a lent GPU: scripts/gpu-bench-pack.sh) everything goes to one
 # file, docs/results-<adapter>.md, beside the lavapipe one.
 #
 #   scripts/results.sh [--width 320 --height 240 | --paper-sizes] [--frames 5] [--only summary,trade,lights,kinds,pvsm,...]
-#   scripts/results.sh --splice-summary   (only copies docs/results/summary.md into README.md)
+#   scripts/results.sh --splice-summary   (runs nothing: rewrites README.md's summary block and docs/choosing.md's
+#                                          rankings from docs/results/summary.md and docs/results.md;
+#                                          python3 scripts/results.py --rankings-from docs/results.md does it without a build)
+#   python3 scripts/results.py --check-rankings   (what ssm-bench/tests/rankings.rs runs)
 #
 # Needs python3 (3.11+, for tomllib). Takes hours on lavapipe at the defaults; --only runs a part.
 set -euo pipefail

@@ -18,6 +18,8 @@ fresh = results.part_sections("\n".join(["## summary\n\nnew summary\n", "## defa
 print("".join(results.merged_sections(previous, fresh)), end="")
 "####;
     let output = Command::new("python3")
+        // No scripts/__pycache__ left in the checkout by the import of results.py.
+        .env("PYTHONDONTWRITEBYTECODE", "1")
         .arg("-c")
         .arg(check)
         .arg(&script)
