@@ -62,6 +62,17 @@ impl Measured {
         crate::quartiles(&self.frames.iter().filter(|f| f.gpu_ms.is_some()).map(FrameTimings::frame_ms).collect::<Vec<_>>())
     }
 
+    /// Median over frames of the CPU work inside the frame (the frame's CPU scopes: a paper's CPU
+    /// step, such as PVSM's kd-tree, and mid-frame read-backs' mapping), already part of
+    /// [`FrameTimings::frame_ms`]; `None` for a technique with no CPU work in its frame.
+    #[must_use]
+    pub fn cpu_step_ms_median(&self) -> Option<f64> {
+        if self.frames.iter().all(|f| f.cpu_scopes.is_empty()) {
+            return None;
+        }
+        median(&self.frames.iter().map(|f| f.cpu_scopes.iter().map(|s| s.ms).sum()).collect::<Vec<_>>())
+    }
+
     /// Smallest frame time over frames (as [`Measured::gpu_ms_median`]).
     #[must_use]
     pub fn gpu_ms_min(&self) -> Option<f64> {
@@ -398,6 +409,9 @@ pub struct Row {
     /// First and third quartiles of the GPU ms per frame: the spread printed beside the median
     /// (`None` in per-light rows and without timestamps).
     pub gpu_ms_quartiles: Option<(f64, f64)>,
+    /// Median CPU ms per frame of the work inside the frame that a paper puts on the CPU (and
+    /// mid-frame read-backs' mapping), part of the frame's time; `None` where there is none.
+    pub cpu_step_ms: Option<f64>,
     /// Median CPU wall ms per frame.
     pub cpu_ms: f64,
     /// Error metrics against the reference, averaged over lights.
@@ -458,6 +472,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "shadowed_pixels",
     "gpu_ms_q1",
     "gpu_ms_q3",
+    "cpu_step_ms",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -485,6 +500,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         gpu_ms_median: measured.gpu_ms_median(),
         gpu_ms_min: measured.gpu_ms_min(),
         gpu_ms_quartiles: measured.gpu_ms_quartiles(),
+        cpu_step_ms: measured.cpu_step_ms_median(),
         cpu_ms: measured.cpu_ms_median(),
         metrics: average(&per_light),
         flip: flip_mean(&reference.shaded, &measured.shaded, width, height),
@@ -514,6 +530,7 @@ pub fn rows_per_light(scene: &str, renderer: &Renderer, measured: &Measured, ref
                 gpu_ms_median: measured.gpu_ms_median_for_light(light),
                 gpu_ms_min: None,
                 gpu_ms_quartiles: None,
+                cpu_step_ms: None,
                 metrics: compare_with_noise(truth, truth_noise(reference, light), image, covered, width, height),
                 passes: measured.pass_medians_for_light(light),
                 // Counted over the whole frame: the `all` row holds it.
@@ -614,7 +631,7 @@ impl Row {
         .into_iter()
         .chain(self.work_fields())
         .chain([number(Some(m.mae), 6), number(m.truth_noise, 6), number(m.truth_noise_penumbra, 6), m.shadowed_pixels.to_string()])
-        .chain([number(self.gpu_ms_quartiles.map(|q| q.0), 4), number(self.gpu_ms_quartiles.map(|q| q.1), 4)])
+        .chain([number(self.gpu_ms_quartiles.map(|q| q.0), 4), number(self.gpu_ms_quartiles.map(|q| q.1), 4), number(self.cpu_step_ms, 4)])
         .collect()
     }
 
@@ -665,6 +682,7 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         "gpu_ms_median": row.gpu_ms_median.map(finite),
         "gpu_ms_min": row.gpu_ms_min.map(finite),
         "gpu_ms_iqr": row.gpu_ms_quartiles.map(|(q1, q3)| [finite(q1), finite(q3)]),
+        "cpu_step_ms": row.cpu_step_ms.map(finite),
         "cpu_ms": finite(row.cpu_ms),
         "metrics": {
             "mae": finite(m.mae),
@@ -766,6 +784,7 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                 gpu_ms_median: optional("gpu_ms_median")?,
                 gpu_ms_min: optional("gpu_ms_min")?,
                 gpu_ms_quartiles: optional("gpu_ms_q1")?.zip(optional("gpu_ms_q3")?),
+                cpu_step_ms: optional("cpu_step_ms")?,
                 cpu_ms: float("cpu_ms")?,
                 metrics: ErrorMetrics {
                     mae: float("mae")?,
@@ -1337,6 +1356,7 @@ mod tests {
             gpu_ms_median: gpu,
             gpu_ms_min: gpu,
             gpu_ms_quartiles: gpu.map(|ms| (ms * 0.9, ms * 1.1)),
+            cpu_step_ms: gpu.map(|ms| ms * 0.25),
             cpu_ms: 12.5,
             metrics: ErrorMetrics {
                 mae: 0.0234567,

@@ -468,6 +468,8 @@ pub struct MarkdownRow {
     pub ms: f64,
     /// First and third quartiles of the time per frame, ms (GPU timestamps only).
     pub ms_quartiles: Option<(f64, f64)>,
+    /// Median ms per frame of the CPU work inside the frame (a paper's CPU step), part of `ms`.
+    pub cpu_step_ms: Option<f64>,
     /// The headline error against the ground truth ([`ErrorAxis::Mae`]).
     pub mae: f64,
     /// The ground truth's own error over the same pixels, when known.
@@ -491,12 +493,12 @@ pub struct MarkdownRow {
 pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
     let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
     text.push_str(
-        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations | CPU step ms |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for row in rows {
         let point = if row.point.is_empty() { "defaults" } else { &row.point };
         text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} |\n",
+            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} | {} |\n",
             row.scene,
             row.technique,
             row.ms,
@@ -505,7 +507,8 @@ pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows:
             row.mae_penumbra,
             row.psnr,
             crate::work::cell(row.texel_reads),
-            crate::work::cell(row.invocations)
+            crate::work::cell(row.invocations),
+            row.cpu_step_ms.map_or_else(|| "-".to_owned(), |ms| format!("{ms:.2}"))
         ));
     }
     text
@@ -678,6 +681,7 @@ mod tests {
             point: String::new(),
             ms: 12.345,
             ms_quartiles: Some((12.0, 12.5)),
+            cpu_step_ms: None,
             mae: 0.02345,
             truth_noise: Some(0.00123),
             mae_penumbra: 0.01234,
@@ -690,7 +694,7 @@ mod tests {
         assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
         assert_eq!(
             lines[4],
-            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 |"
+            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 | - |"
         );
         assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }

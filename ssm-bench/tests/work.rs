@@ -206,3 +206,48 @@ fn a_sweep_with_cost_work_counts_every_point_and_plots_error_against_work() {
         let _ = std::fs::remove_dir_all(dir);
     }
 }
+
+/// The CPU work a paper puts inside the frame has its own column: PVSM's kd-tree and read-back
+/// (its `cpu_step_ms`, part of its frame time), and nothing for a technique without any. Seen red
+/// with the column filled from the frame's GPU passes instead of its CPU scopes.
+#[test]
+fn the_papers_cpu_step_has_its_own_column() {
+    let out = scratch("cpu-step");
+    let cache = out.join("cache");
+    let dir = out.display().to_string();
+    let output = ssm(
+        &[
+            "sweep",
+            "--scene",
+            "parallel-square",
+            "--vary",
+            "pvsm",
+            "--vary",
+            "hard",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--frames",
+            "3",
+            "--out",
+            &dir,
+        ],
+        &cache,
+    );
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let rows = parse_csv(&std::fs::read_to_string(out.join("sweep.csv")).unwrap()).unwrap();
+    for row in rows.iter().filter(|row| row.light.is_none()) {
+        match row.technique.as_str() {
+            "pvsm" => {
+                let cpu = row.cpu_step_ms.unwrap_or_else(|| panic!("pvsm has a CPU step: {row:?}"));
+                let frame = row.gpu_ms_median.unwrap();
+                assert!(cpu > 0.0 && cpu < frame, "pvsm's CPU step {cpu} ms, inside its frame's {frame} ms");
+            }
+            "hard" => assert_eq!(row.cpu_step_ms, None, "hard has no CPU step"),
+            other => panic!("unexpected technique {other}"),
+        }
+    }
+    let table = std::fs::read_to_string(out.join("sweep.md")).unwrap();
+    assert!(table.lines().nth(2).is_some_and(|header| header.ends_with("| CPU step ms |")), "{table}");
+}

@@ -318,6 +318,7 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 point: point.join(" "),
                 ms: sweep::time_of(row),
                 ms_quartiles: row.gpu_ms_quartiles,
+                cpu_step_ms: row.cpu_step_ms,
                 mae: row.metrics.mae,
                 truth_noise: row.metrics.truth_noise,
                 mae_penumbra: row.metrics.mae_penumbra,
