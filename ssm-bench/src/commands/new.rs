@@ -430,7 +430,7 @@ fn write_in_tree(name: &TechniqueName, checkout: &Checkout, plan: &InTreePlan) -
         checkout.root.display()
     );
     say!("  cargo build --release --bin ssm        (Cargo.lock gains the crate: commit it with the two folders)");
-    say!("  target/release/ssm render --scene parallel-square --technique {} --width 160 --height 120 --out /tmp/{}", name.name, name.name);
+    say!("  target/release/ssm render --scene parallel-square --technique {} --width 160 --height 120 --out out/{}", name.name, name.name);
     say!("  cargo test -p {}", name.crate_name);
     say!(
         "then replace the filter with your paper's method in {} and {}, and the README's sections with its description.",
