@@ -473,6 +473,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "gpu_ms_q1",
     "gpu_ms_q3",
     "cpu_step_ms",
+    "read_bytes",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -632,6 +633,8 @@ impl Row {
         .chain(self.work_fields())
         .chain([number(Some(m.mae), 6), number(m.truth_noise, 6), number(m.truth_noise_penumbra, 6), m.shadowed_pixels.to_string()])
         .chain([number(self.gpu_ms_quartiles.map(|q| q.0), 4), number(self.gpu_ms_quartiles.map(|q| q.1), 4), number(self.cpu_step_ms, 4)])
+        // Derived from `passes_work` (each pass's `read_bytes`), which the CSV reads back.
+        .chain([self.work.as_ref().map_or_else(String::new, |work| crate::work::field(crate::work::Totals::of(work).read_bytes))])
         .collect()
     }
 
@@ -712,6 +715,7 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         "fragment_invocations": totals.and_then(|t| t.fragment_invocations),
         "compute_invocations": totals.and_then(|t| t.compute_invocations),
         "texel_reads": totals.and_then(|t| t.texel_reads),
+        "read_bytes": totals.and_then(|t| t.read_bytes),
         "passes_work": row.work.as_ref().map(FrameWork::passes_column),
         // Every pass's counts, and whether the invocations (pipeline_statistics) and the texel
         // reads (shader_counts) were counted at all.
@@ -964,7 +968,7 @@ fn markdown_work(context: &ReportContext<'_>, rows: &[Row]) -> String {
         return String::new();
     }
     let techniques = counted(rows);
-    let table = |header: &[&str], cells: Vec<[String; 12]>| {
+    let table = |header: &[&str], cells: Vec<[String; 13]>| {
         let mut out = format!("| {} |\n|---|{}\n", header.join(" | "), "---:|".repeat(header.len() - 1));
         for row in cells {
             let _ = writeln!(out, "| {} |", row.join(" | "));
@@ -990,7 +994,7 @@ fn html_work(context: &ReportContext<'_>, rows: &[Row]) -> String {
         return String::new();
     }
     let techniques = counted(rows);
-    let table = |id: &str, header: &[&str], cells: Vec<[String; 12]>| {
+    let table = |id: &str, header: &[&str], cells: Vec<[String; 13]>| {
         let mut out = format!("<table id=\"{id}\">\n<tr>");
         for name in header {
             let _ = write!(out, "<th>{}</th>", escape(name));
@@ -1129,6 +1133,7 @@ pub fn viewer_data(
                     ("fragment_invocations", totals.fragment_invocations),
                     ("compute_invocations", totals.compute_invocations),
                     ("texel_reads", totals.texel_reads),
+                    ("read_bytes", totals.read_bytes),
                     ("atomics", totals.atomics),
                     ("target_bytes", Some(totals.target_bytes)),
                     ("storage_bytes", totals.storage_bytes),
@@ -1160,7 +1165,7 @@ pub fn viewer_data(
         "work_columns": rows.iter().any(|r| r.work.is_some()).then(|| serde_json::json!([
             ["technique", "technique"], ["light", "light"], ["vertex_invocations", "vertex inv."],
             ["fragment_invocations", "fragment inv."], ["compute_invocations", "compute inv."], ["texel_reads", "texel reads"],
-            ["atomics", "atomics"], ["target_bytes", "target bytes"], ["storage_bytes", "storage bytes"],
+            ["read_bytes", "bytes read"], ["atomics", "atomics"], ["target_bytes", "target bytes"], ["storage_bytes", "storage bytes"],
             ["mae", "MAE"], ["passes_work", "passes: reads, invocations"],
         ])),
     });

@@ -480,6 +480,8 @@ pub struct MarkdownRow {
     pub psnr: f64,
     /// Counted texel reads per frame (`--count-work`); `None` when not counted.
     pub texel_reads: Option<u64>,
+    /// The bytes those reads fetched; `None` when not counted.
+    pub read_bytes: Option<u64>,
     /// Counted vertex, fragment and compute invocations per frame; `None` when not counted.
     pub invocations: Option<u64>,
 }
@@ -493,12 +495,12 @@ pub struct MarkdownRow {
 pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
     let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
     text.push_str(
-        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations | CPU step ms |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations | CPU step ms | bytes read |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for row in rows {
         let point = if row.point.is_empty() { "defaults" } else { &row.point };
         text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} | {} |\n",
+            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} | {} | {} |\n",
             row.scene,
             row.technique,
             row.ms,
@@ -508,7 +510,8 @@ pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows:
             row.psnr,
             crate::work::cell(row.texel_reads),
             crate::work::cell(row.invocations),
-            row.cpu_step_ms.map_or_else(|| "-".to_owned(), |ms| format!("{ms:.2}"))
+            row.cpu_step_ms.map_or_else(|| "-".to_owned(), |ms| format!("{ms:.2}")),
+            crate::work::cell(row.read_bytes)
         ));
     }
     text
@@ -687,6 +690,7 @@ mod tests {
             mae_penumbra: 0.01234,
             psnr: 31.25,
             texel_reads: None,
+            read_bytes: None,
             invocations: Some(3456),
         };
         let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
@@ -694,7 +698,7 @@ mod tests {
         assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
         assert_eq!(
             lines[4],
-            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 | - |"
+            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 | - | - |"
         );
         assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
     }

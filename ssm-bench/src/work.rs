@@ -60,6 +60,9 @@ pub struct Totals {
     pub target_bytes: u64,
     /// Texel reads (the technique's shaders).
     pub texel_reads: Option<u64>,
+    /// Bytes those reads fetched (the technique's shaders): known where every pass that reads
+    /// counted its bytes too.
+    pub read_bytes: Option<u64>,
     /// Atomic operations (the technique's shaders).
     pub atomics: Option<u64>,
     /// Bytes written to storage (the technique's shaders).
@@ -87,6 +90,7 @@ impl Totals {
             clipped_primitives: statistics(|p| p.clipped_primitives),
             target_bytes: sum(|p| p.target_bytes),
             texel_reads: shaders(|p| p.texel_reads),
+            read_bytes: shaders(|p| p.read_bytes).filter(|_| passes.iter().all(|p| p.texel_reads == 0 || p.read_bytes > 0)),
             atomics: shaders(|p| p.atomics),
             storage_bytes: shaders(|p| p.storage_bytes),
         }
@@ -146,6 +150,7 @@ pub fn parse_passes_column(text: &str) -> anyhow::Result<Vec<PassWork>> {
                     "target_bytes" => &mut work.target_bytes,
                     "counted_invocations" => &mut work.counted_invocations,
                     "texel_reads" => &mut work.texel_reads,
+                    "read_bytes" => &mut work.read_bytes,
                     "atomics" => &mut work.atomics,
                     "storage_bytes" => &mut work.storage_bytes,
                     other => bail!("passes_work: unknown count `{other}`"),
@@ -210,7 +215,7 @@ pub enum Cost {
 }
 
 /// The header of [`frame_table`].
-pub const FRAME_HEADER: [&str; 12] = [
+pub const FRAME_HEADER: [&str; 13] = [
     "technique",
     "vertex inv.",
     "fragment inv.",
@@ -218,6 +223,7 @@ pub const FRAME_HEADER: [&str; 12] = [
     "primitives",
     "clipped",
     "texel reads",
+    "bytes read",
     "reads / pixel",
     "atomics",
     "target bytes",
@@ -226,7 +232,7 @@ pub const FRAME_HEADER: [&str; 12] = [
 ];
 
 /// The header of [`pass_table`].
-pub const PASS_HEADER: [&str; 12] = [
+pub const PASS_HEADER: [&str; 13] = [
     "technique",
     "pass",
     "runs",
@@ -236,6 +242,7 @@ pub const PASS_HEADER: [&str; 12] = [
     "primitives",
     "clipped",
     "texel reads",
+    "bytes read",
     "atomics",
     "target bytes",
     "storage bytes",
@@ -243,7 +250,7 @@ pub const PASS_HEADER: [&str; 12] = [
 
 /// One row per technique: its frame's totals, `pixels` the image's pixel count (for reads per pixel).
 #[must_use]
-pub fn frame_table(techniques: &[(&str, &FrameWork)], pixels: u64) -> Vec<[String; 12]> {
+pub fn frame_table(techniques: &[(&str, &FrameWork)], pixels: u64) -> Vec<[String; 13]> {
     techniques
         .iter()
         .map(|(name, work)| {
@@ -256,6 +263,7 @@ pub fn frame_table(techniques: &[(&str, &FrameWork)], pixels: u64) -> Vec<[Strin
                 cell(totals.primitives),
                 cell(totals.clipped_primitives),
                 cell(totals.texel_reads),
+                cell(totals.read_bytes),
                 totals.texel_reads.map_or_else(|| "-".to_owned(), |reads| format!("{:.2}", reads as f64 / pixels.max(1) as f64)),
                 cell(totals.atomics),
                 totals.target_bytes.to_string(),
@@ -268,7 +276,7 @@ pub fn frame_table(techniques: &[(&str, &FrameWork)], pixels: u64) -> Vec<[Strin
 
 /// One row per pass of each technique, as first recorded.
 #[must_use]
-pub fn pass_table(techniques: &[(&str, &FrameWork)]) -> Vec<[String; 12]> {
+pub fn pass_table(techniques: &[(&str, &FrameWork)]) -> Vec<[String; 13]> {
     let mut rows = Vec::new();
     for (name, work) in techniques {
         for pass in &work.passes {
@@ -283,6 +291,7 @@ pub fn pass_table(techniques: &[(&str, &FrameWork)]) -> Vec<[String; 12]> {
                 cell(totals.primitives),
                 cell(totals.clipped_primitives),
                 cell(totals.texel_reads),
+                cell(totals.read_bytes),
                 cell(totals.atomics),
                 totals.target_bytes.to_string(),
                 cell(totals.storage_bytes),
@@ -365,9 +374,22 @@ mod tests {
         let no_statistics = work(false, true);
         assert_eq!((Totals::of(&no_statistics).fragment_invocations, WorkUnit::TexelReads.of(&no_statistics)), (None, Some(900.0)));
         let rows = frame_table(&[("x", &no_shaders)], 100);
-        assert_eq!((rows[0][6].as_str(), rows[0][7].as_str(), rows[0][1].as_str()), ("-", "-", "6"));
+        assert_eq!((rows[0][6].as_str(), rows[0][7].as_str(), rows[0][8].as_str(), rows[0][1].as_str()), ("-", "-", "-", "6"));
         assert_eq!(notes(&[("x", &no_shaders)]).len(), 1);
         assert_eq!(notes(&[("x", &no_statistics)]).len(), 1);
+    }
+
+    /// The bytes read are known only where every pass that reads counted them: a technique that
+    /// counts reads but not (all) their bytes has unknown bytes, not a partial sum.
+    #[test]
+    fn bytes_read_are_known_only_where_every_reading_pass_counts_them() {
+        let mut counted = work(true, true);
+        assert_eq!(Totals::of(&counted).read_bytes, None, "reads without bytes");
+        counted.passes[1].read_bytes = 3600;
+        assert_eq!(Totals::of(&counted).read_bytes, Some(3600), "the map pass reads nothing");
+        counted.passes[0].texel_reads = 10;
+        assert_eq!(Totals::of(&counted).read_bytes, None, "a reading pass without bytes");
+        assert_eq!(Totals::of(&work(true, false)).read_bytes, None);
     }
 
     #[test]

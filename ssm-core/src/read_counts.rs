@@ -89,8 +89,8 @@ impl ReadCounts {
     }
 
     /// The counters' totals over the last frame as each pass's [`ShaderWork`]: a counter whose
-    /// unit is `reads` gives texel reads, `atomics` atomics, `storage_bytes` bytes written to
-    /// storage; counters of other units, such as sssm's `rows`, are diagnostics only and make no
+    /// unit is `reads` gives texel reads, `read_bytes` the bytes they fetched, `atomics` atomics,
+    /// `storage_bytes` bytes written to storage; counters of other units, such as sssm's `rows`, are diagnostics only and make no
     /// pass. A pass's invocations are the most pixels any of its counters counted. `None` when
     /// not counting.
     ///
@@ -104,7 +104,7 @@ impl ReadCounts {
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let mut work: Vec<ShaderWork> = Vec::new();
         for ((name, unit), buckets) in self.counters.iter().zip(words.chunks_exact(2 * READ_COUNT_BUCKETS)) {
-            if !matches!(*unit, "reads" | "atomics" | "storage_bytes") {
+            if !matches!(*unit, "reads" | "read_bytes" | "atomics" | "storage_bytes") {
                 continue;
             }
             let invocations: u64 = buckets.chunks_exact(2).map(|pair| u64::from(pair[0])).sum();
@@ -120,6 +120,7 @@ impl ReadCounts {
             pass.invocations = pass.invocations.max(invocations);
             match *unit {
                 "reads" => pass.texel_reads += counted,
+                "read_bytes" => pass.read_bytes += counted,
                 "atomics" => pass.atomics += counted,
                 _ => pass.storage_bytes += counted,
             }

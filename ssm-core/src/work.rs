@@ -52,6 +52,9 @@ pub struct ShaderWork {
     /// Texels read from textures or from storage arrays of texels: a load or a nearest sample
     /// is one, a bilinear sample or a gather four.
     pub texel_reads: u64,
+    /// Bytes those reads fetched: each texel read times its format's size (an `Rgba32Float`
+    /// texel 16, an `R32Float` depth 4); 0 where the technique counts reads but not their bytes.
+    pub read_bytes: u64,
     /// Atomic operations on storage.
     pub atomics: u64,
     /// Bytes written to storage buffers and storage textures.
@@ -82,6 +85,8 @@ pub struct PassWork {
     pub counted_invocations: u64,
     /// Texel reads the technique's shaders counted.
     pub texel_reads: u64,
+    /// Bytes those reads fetched, as the technique's shaders counted.
+    pub read_bytes: u64,
     /// Atomic operations the technique's shaders counted.
     pub atomics: u64,
     /// Bytes written to storage, as the technique's shaders counted.
@@ -103,6 +108,7 @@ impl PassWork {
             ("target_bytes", self.target_bytes),
             ("counted_invocations", self.counted_invocations),
             ("texel_reads", self.texel_reads),
+            ("read_bytes", self.read_bytes),
             ("atomics", self.atomics),
             ("storage_bytes", self.storage_bytes),
         ]
@@ -172,6 +178,7 @@ impl FrameWork {
             let pass = self.pass_named(&counted.pass);
             pass.counted_invocations += counted.invocations;
             pass.texel_reads += counted.texel_reads;
+            pass.read_bytes += counted.read_bytes;
             pass.atomics += counted.atomics;
             pass.storage_bytes += counted.storage_bytes;
         }
@@ -320,14 +327,14 @@ mod tests {
             ..FrameWork::default()
         };
         work.add_shader_work(&[
-            ShaderWork { pass: "x_filter".into(), invocations: 90, texel_reads: 900, atomics: 0, storage_bytes: 0 },
-            ShaderWork { pass: "x_cpu_side".into(), invocations: 1, texel_reads: 0, atomics: 3, storage_bytes: 8 },
+            ShaderWork { pass: "x_filter".into(), invocations: 90, texel_reads: 900, read_bytes: 3600, atomics: 0, storage_bytes: 0 },
+            ShaderWork { pass: "x_cpu_side".into(), invocations: 1, texel_reads: 0, read_bytes: 0, atomics: 3, storage_bytes: 8 },
         ]);
         assert!(work.shader_counts);
         assert_eq!(work.total(|p| p.texel_reads), 900);
         assert_eq!(
             work.passes_column(),
-            "x_filter:runs=2,fragment_invocations=100,counted_invocations=90,texel_reads=900;x_cpu_side:counted_invocations=1,atomics=3,storage_bytes=8"
+            "x_filter:runs=2,fragment_invocations=100,counted_invocations=90,texel_reads=900,read_bytes=3600;x_cpu_side:counted_invocations=1,atomics=3,storage_bytes=8"
         );
     }
 }

@@ -99,7 +99,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
     let counted: Vec<(&str, &ssm_core::FrameWork)> = measured.iter().filter_map(|m| m.work.as_ref().map(|w| (m.info.name, w))).collect();
     if !counted.is_empty() {
         let pixels = u64::from(args.size.width) * u64::from(args.size.height);
-        let lines = |header: &[&str], rows: Vec<[String; 12]>| -> Vec<String> {
+        let lines = |header: &[&str], rows: Vec<[String; 13]>| -> Vec<String> {
             std::iter::once(header.join("\t")).chain(rows.iter().map(|row| row.join("\t"))).collect()
         };
         say!("counted work per frame (every light):");

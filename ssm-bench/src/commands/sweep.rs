@@ -324,6 +324,7 @@ pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied
                 mae_penumbra: row.metrics.mae_penumbra,
                 psnr: row.metrics.psnr,
                 texel_reads: totals.and_then(|t| t.texel_reads),
+                read_bytes: totals.and_then(|t| t.read_bytes),
                 invocations: totals.and_then(|t| t.invocations()),
             }
         })
