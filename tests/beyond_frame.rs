@@ -179,3 +179,27 @@ fn side_faces_draw_the_penumbra_past_the_frame() {
     }
     assert!(checked > 0, "no registered technique answers past the frame with side faces of its own");
 }
+
+/// The pass's counted work (`--count-work`) in the enclosure, after vssm: one invocation per pixel
+/// (96 × 72 is whole 8 × 8 groups), each reading the G-buffer's position and normal (Rgba32Float,
+/// 16 bytes each), and, at each pixel it answers (the diagnostic [`BEYOND_FRAME_DIAGNOSTIC`] of
+/// the same frame), one side face's texel (R32Float, 4 bytes) and one R32Float visibility stored.
+#[test]
+fn the_pass_counts_its_reads_with_their_bytes() {
+    let gpu = gpu();
+    let scene = enclosure();
+    let info = registry().get("vssm").unwrap();
+    let params = info.params_from([("shadow_map_size", "256")]).unwrap();
+    let needs = info.needs(&params).unwrap().union(Requirements { gbuffer: true, ..Requirements::NONE });
+    let mut renderer = Renderer::new(&gpu, &scene, SIZE.0, SIZE.1, &needs).unwrap();
+    let work = renderer.count_work(info, &params).unwrap();
+    println!("{}", work.passes_column());
+    let answered = work.diagnostics.iter().find(|(key, _)| key == BEYOND_FRAME_DIAGNOSTIC).map(|(_, v)| *v as u64).unwrap();
+    let pixels = u64::from(SIZE.0 * SIZE.1);
+    assert!(answered > pixels / 5, "{answered} pixels answered past the frame");
+    let pass = work.passes.iter().find(|p| p.name == ssm_core::beyond_frame_label(info.name)).unwrap();
+    assert_eq!(
+        (pass.runs, pass.counted_invocations, pass.texel_reads, pass.read_bytes, pass.storage_bytes),
+        (1, pixels, 2 * pixels + answered, 2 * 16 * pixels + 4 * answered, 4 * answered)
+    );
+}

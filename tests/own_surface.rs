@@ -365,3 +365,26 @@ fn faces_whose_plane_holds_the_lights_centre_get_the_share_alone() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The share's counted work (`--count-work`) on the sphere and the box alone under a large light,
+/// after vssm: one invocation per pixel (160 × 120 is whole 8 × 8 groups), each reading the
+/// G-buffer's position and normal (Rgba32Float, 16 bytes each), and, at the straddling pixels
+/// with the light's centre in front of the plane, the technique's visibility (R32Float, 4 bytes)
+/// that it scales; every straddling pixel stores one R32Float (4 bytes), so at least those.
+#[test]
+fn the_share_counts_its_reads_with_their_bytes() {
+    let gpu = gpu();
+    let scene = ssm_testing::scene_from_manifest(ALONE_UNDER_A_LARGE_LIGHT);
+    let info = registry().get("vssm").unwrap();
+    let settings = [("shadow_map_size", "256")];
+    let mut rendered = render(&gpu, &scene, info, &settings, SIZE.0, SIZE.1).unwrap();
+    let params = info.params_from(settings).unwrap();
+    let work = rendered.renderer.count_work(info, &params).unwrap();
+    println!("{}", work.passes_column());
+    let share = work.passes.iter().find(|p| p.name == ssm_core::own_surface_share_label(info.name)).unwrap();
+    let pixels = u64::from(SIZE.0 * SIZE.1);
+    let scaled = share.texel_reads - 2 * pixels;
+    assert!(scaled > 300, "{scaled} pixels read the technique's visibility: the case must have them");
+    assert_eq!((share.counted_invocations, share.read_bytes), (pixels, 2 * 16 * pixels + 4 * scaled));
+    assert!(share.storage_bytes % 4 == 0 && share.storage_bytes >= 4 * scaled, "{} bytes stored", share.storage_bytes);
+}

@@ -2,8 +2,8 @@
 //! ([`Renderer::count_work`]) gives each pass's invocations from pipeline statistics (lavapipe has
 //! them, so they must be there) and, for every technique of the workspace, the texel reads its
 //! shaders count (the framework's own-surface share pass included, after every technique that
-//! samples the light from its centre); and it leaves the same visibility as a timed frame:
-//! counting changes no result.
+//! samples the light from its centre, with the bytes its reads fetched); and it leaves the same
+//! visibility as a timed frame: counting changes no result.
 //! Where the work is known by hand it is asserted exactly.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
@@ -18,6 +18,9 @@ const WIDTH: u32 = 64;
 const HEIGHT: u32 = 48;
 /// How far two renders of the same inputs may differ (tests/multi_light.rs's tolerance).
 const RERENDER_TOLERANCE: f32 = 1e-5;
+/// The techniques whose every pass that reads texels counts the bytes they fetched, the
+/// framework's passes after them included: every technique of the workspace.
+const COUNT_READ_BYTES: &[&str] = &["atty", "hard", "multi-sm", "pcss", "pvsm", "sssm", "vssm", "wedges"];
 
 #[test]
 fn every_technique_counts_its_passes_and_counting_changes_no_result() {
@@ -53,14 +56,28 @@ fn every_technique_counts_its_passes_and_counting_changes_no_result() {
         if MUST_RUN_ON_LAVAPIPE.contains(&info.name) && !(work.shader_counts && work.total(|p| p.texel_reads) > 0) {
             failures.push(format!("{}: its shaders count no texel reads", info.name));
         }
+        // Techniques whose every pass that reads counts the bytes it read too: the frame's bytes
+        // read are known.
+        if COUNT_READ_BYTES.contains(&info.name) {
+            for pass in work.passes.iter().filter(|p| p.texel_reads > 0 && p.read_bytes == 0) {
+                failures.push(format!("{}: {} reads {} texels but counts no bytes", info.name, pass.name, pass.texel_reads));
+            }
+        }
         // The framework's own-surface share follows every technique that samples the light from
         // its centre, once per light, with its reads counted (two G-buffer texels per pixel at
-        // least), and no other.
+        // least) and their bytes (parallel-square has no closed mesh: the two Rgba32Float
+        // G-buffer texels alone, 16 bytes each), and no other.
         let share = work.passes.iter().find(|p| p.name == own_surface_share_label(info.name));
         match (info.gets_own_surface_share(), share) {
             (true, Some(pass)) => {
-                if pass.runs != 1 || (work.shader_counts && pass.texel_reads < 2 * u64::from(WIDTH * HEIGHT)) {
-                    failures.push(format!("{}: own-surface share ran {} times, {} texel reads", info.name, pass.runs, pass.texel_reads));
+                if pass.runs != 1
+                    || (work.shader_counts
+                        && (pass.texel_reads < 2 * u64::from(WIDTH * HEIGHT) || pass.read_bytes != 16 * pass.texel_reads))
+                {
+                    failures.push(format!(
+                        "{}: own-surface share ran {} times, {} texel reads of {} bytes",
+                        info.name, pass.runs, pass.texel_reads, pass.read_bytes
+                    ));
                 }
             }
             (true, None) => failures.push(format!("{}: no own-surface share pass in {}", info.name, work.passes_column())),
@@ -84,7 +101,8 @@ fn every_technique_counts_its_passes_and_counting_changes_no_result() {
 /// hard's work by hand: its shadow-map pass draws the scene's vertices once per light (4
 /// triangles, no index reuse), and its lookup is one full-screen triangle that shades every pixel
 /// and stores one R32Float texel per pixel; the shadow map stores one R32Float texel per texel;
-/// the framework's own-surface share after it reads two G-buffer texels per pixel.
+/// the framework's own-surface share after it reads two G-buffer texels per pixel (Rgba32Float, 16
+/// bytes each).
 /// Fragment invocations are at least one per pixel: Vulkan lets an implementation count helper
 /// invocations (lavapipe reports 3,456 for 64x48 = 3,072 pixels), so no upper bound is exact.
 #[test]
@@ -117,6 +135,9 @@ fn hard_shadow_mapping_work_is_counted_exactly() {
     // is read or stored.
     let share = pass(&own_surface_share_label("hard"));
     let pixels = u64::from(WIDTH * HEIGHT);
-    assert_eq!((share.runs, share.compute_invocations, share.texel_reads, share.storage_bytes), (1, pixels, 2 * pixels, 0));
+    assert_eq!(
+        (share.runs, share.compute_invocations, share.texel_reads, share.read_bytes, share.storage_bytes),
+        (1, pixels, 2 * pixels, 2 * 16 * pixels, 0)
+    );
     assert_eq!(work.uncounted_passes, 0);
 }

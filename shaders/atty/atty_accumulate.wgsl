@@ -20,8 +20,13 @@
 // receiver map itself.
 @group(1) @binding(1) var receivers: texture_2d<f32>;
 @group(1) @binding(2) var<uniform> settings: AttySettings;
-// This side's accumulation counter (atty_counts.wgsl): 0, texel reads (one receiver texel per fragment).
+// This side's accumulation counters (atty_counts.wgsl): 0, texel reads (one receiver texel per
+// fragment); 1, the bytes they fetched.
 @group(1) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Bytes of one texel of `receivers` (the pipeline sets it from the receiver map's format: R32Float,
+// or Rgba32Float planes with receiver_plane).
+override RECEIVER_TEXEL_BYTES: u32;
 
 struct MicroPatch {
     @builtin(position) clip: vec4<f32>,
@@ -66,6 +71,7 @@ fn atty_patch_fragment(in: MicroPatch) -> @location(0) f32 {
     let texel = vec2<i32>(in.clip.xy);
     let receiver = textureLoad(receivers, texel, 0);
     record_count(0u, texel, 1u);
+    record_count(1u, texel, RECEIVER_TEXEL_BYTES);
     let receiver_depth = receiver.x;
     // No receiver here, or the receiver is not behind this patch (beyond the tolerance that keeps a
     // surface in both maps from shadowing itself): nothing hidden.

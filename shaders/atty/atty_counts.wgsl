@@ -2,8 +2,11 @@
 // texels, does atomics or writes storage binds its own slice of the technique's counters as
 // `read_counts` (ssm-techniques/atty's CounterPlan), so its counters are 0, 1, ... whichever side
 // or pyramid it runs for. Conventions: a textureLoad is one texel read (Atty reads no texel any
-// other way); a textureStore to a storage texture writes its format's texel size; a micro-patch
-// record 32 bytes. The counting code is compiled out unless COUNT_READS.
+// other way), and fetches its texture's texel size in bytes (unit read_bytes, beside every pass's
+// reads: each shader's `*_TEXEL_BYTES` overrides, which the pipelines set from the textures'
+// formats, since the receiver map and the soft shadow maps change format with the settings); a
+// textureStore to a storage texture writes its format's texel size; a micro-patch record 32 bytes.
+// The counting code is compiled out unless COUNT_READS.
 
 // #import common/read_counts.wgsl
 

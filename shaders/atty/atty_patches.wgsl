@@ -20,12 +20,20 @@
 @group(1) @binding(4) var<storage, read_write> patches: array<MicroPatchRecord>;
 // The accumulation's indirect draw: (4 vertices, patch count, 0, 0).
 @group(1) @binding(5) var<storage, read_write> draw_arguments: array<atomic<u32>, 4>;
-// This pass's counters (atty_counts.wgsl): 0, texel reads; 1, atomics (one per patch listed);
-// 2, bytes written to storage (one 32-byte record per patch listed).
+// This pass's counters (atty_counts.wgsl): 0, texel reads; 1, the bytes they fetched; 2, atomics
+// (one per patch listed); 3, bytes written to storage (one 32-byte record per patch listed).
 @group(1) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Texel reads of this invocation (textureLoad calls), for the counts.
+// Bytes of one texel read (the pipeline sets them from the formats: src/lib.rs's
+// patches_pipeline): of the occluder map (R32Float), of the receiver map's max-pyramid (R32Float)
+// and of the occluder map's min-max pyramid (Rg32Float).
+override OCCLUDER_TEXEL_BYTES: u32;
+override BOUNDS_TEXEL_BYTES: u32;
+override MERGE_TEXEL_BYTES: u32;
+
+// Texel reads of this invocation (textureLoad calls), and the bytes they fetched, for the counts.
 var<private> reads: u32;
+var<private> read_bytes: u32;
 
 // The deepest receiver among the SSM texels whose centres lie in the rectangle [low, high] (SSM
 // coordinates, [-1, 1]), from the max-pyramid at the finest level where the texels span at most
@@ -52,6 +60,7 @@ fn deepest_receiver(low: vec2<f32>, high: vec2<f32>) -> f32 {
     let a = min(first >> vec2<u32>(level), level_last);
     let b = min(last >> vec2<u32>(level), level_last);
     reads += 4u;
+    read_bytes += 4u * BOUNDS_TEXEL_BYTES;
     let lower = max(textureLoad(receiver_bounds, a, level).x, textureLoad(receiver_bounds, vec2<i32>(b.x, a.y), level).x);
     let upper = max(textureLoad(receiver_bounds, vec2<i32>(a.x, b.y), level).x, textureLoad(receiver_bounds, b, level).x);
     return max(lower, upper);
@@ -82,6 +91,7 @@ fn merged_block(texel: vec2<u32>, depth: f32) -> vec2<f32> {
         }
         let range = textureLoad(patch_merge, vec2<i32>(block), i32(level + 1u)).xy;
         reads += 1u;
+        read_bytes += MERGE_TEXEL_BYTES;
         let width = 2.0 * range.x * tan_half / settings.occluder_map_size;
         if (range.y >= NO_SURFACE || range.y - range.x > settings.merge_tolerance * width) {
             break;
@@ -103,6 +113,7 @@ fn neighbour_depth(texel: vec2<i32>) -> f32 {
     }
     let depth = textureLoad(occluder_map, texel, 0).x;
     reads += 1u;
+    read_bytes += OCCLUDER_TEXEL_BYTES;
     return select(depth, -1.0, depth >= NO_SURFACE);
 }
 
@@ -131,14 +142,16 @@ fn atty_patches(@builtin(global_invocation_id) id: vec3<u32>) {
     let listed = u32(list_patch(id.xy));
     let texel = vec2<i32>(id.xy);
     record_count(0u, texel, reads);
-    record_count(1u, texel, listed);
-    record_count(2u, texel, 32u * listed);
+    record_count(1u, texel, read_bytes);
+    record_count(2u, texel, listed);
+    record_count(3u, texel, 32u * listed);
 }
 
 // The micro-patch of occluder texel `texel`: appends it to the list, and says whether it did.
 fn list_patch(texel: vec2<u32>) -> bool {
     let depth = textureLoad(occluder_map, vec2<i32>(texel), 0).x;
     reads = 1u;
+    read_bytes = OCCLUDER_TEXEL_BYTES;
     if (depth >= NO_SURFACE || depth <= 0.0) {
         return false;
     }

@@ -15,11 +15,20 @@
 // (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the receiver map.
 @group(2) @binding(2) var receiver_map: texture_2d<f32>;
 @group(2) @binding(3) var<uniform> settings: AttySettings;
-// The projection's counter (atty_counts.wgsl): 0, texel reads.
+// The projection's counters (atty_counts.wgsl): 0, texel reads; 1, the bytes they fetched.
 @group(2) @binding(4) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Texel reads of this invocation (textureLoad calls), for the counts.
+// Bytes of one texel read (the pipeline sets them from the formats: src/lib.rs's projection): of
+// the G-buffer's position and normal (Rgba32Float), of the receiver map (R32Float, or Rgba32Float
+// planes with receiver_plane) and of the soft shadow maps (R32Float, or R16Float with
+// accumulation = f16).
+override GBUFFER_TEXEL_BYTES: u32;
+override RECEIVER_TEXEL_BYTES: u32;
+override SOFT_SHADOW_TEXEL_BYTES: u32;
+
+// Texel reads of this invocation (textureLoad calls), and the bytes they fetched, for the counts.
 var<private> reads: u32;
+var<private> read_bytes: u32;
 
 // Bilinear interpolation of an unfilterable float texture (R32Float needs a feature to be
 // filtered) that leaves out the texels whose receiver lies at another depth than the lookup's
@@ -44,8 +53,10 @@ fn receiver_bilinear(map: texture_2d<f32>, uv: vec2<f32>, depth: f32, tolerance:
         total += weight;
     }
     reads += 8u;
+    read_bytes += 4u * (RECEIVER_TEXEL_BYTES + SOFT_SHADOW_TEXEL_BYTES);
     if (total <= 1e-6) {
         reads += 1u;
+        read_bytes += SOFT_SHADOW_TEXEL_BYTES;
         return textureLoad(map, clamp(vec2<i32>(uv * size), vec2<i32>(0), limit), 0).x;
     }
     return sum / total;
@@ -63,6 +74,7 @@ const PLANE_MARGIN_TEXELS: f32 = 0.05;
 fn texel_plane_depth(texel: vec2<i32>, q: vec2<f32>) -> f32 {
     let receiver = textureLoad(receiver_map, texel, 0);
     reads += 1u;
+    read_bytes += RECEIVER_TEXEL_BYTES;
     if (receiver.x >= NO_SURFACE) {
         return NO_SURFACE;
     }
@@ -94,6 +106,7 @@ fn plane_bilinear(uvd: vec3<f32>, tolerance: f32) -> f32 {
         let gap = abs(texel_plane_depth(texel, q) - uvd.z);
         let value = vec2<f32>(textureLoad(soft_shadow_front, texel, 0).x, textureLoad(soft_shadow_back, texel, 0).x);
         reads += 2u;
+        read_bytes += 2u * SOFT_SHADOW_TEXEL_BYTES;
         let weights = select(1.0 - t, t, vec2<bool>(step == vec2<i32>(1)));
         let weight = select(0.0, weights.x * weights.y, gap <= tolerance);
         sum += weight * value;
@@ -111,6 +124,7 @@ fn plane_bilinear(uvd: vec3<f32>, tolerance: f32) -> f32 {
 fn atty_project(in: FullscreenVertex) -> @location(0) f32 {
     let visibility = project(in);
     record_count(0u, vec2<i32>(in.clip.xy), reads);
+    record_count(1u, vec2<i32>(in.clip.xy), read_bytes);
     return visibility;
 }
 
@@ -119,6 +133,7 @@ fn project(in: FullscreenVertex) -> f32 {
     let point = screen_point(in);
     // The G-buffer's position and normal.
     reads = 2u;
+    read_bytes = 2u * GBUFFER_TEXEL_BYTES;
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         return trivial;
@@ -153,6 +168,7 @@ fn project(in: FullscreenVertex) -> f32 {
     // count it as in umbra, as a hard shadow would.
     let nearest = shadow_map_depth(receiver_map, uvd.xy);
     reads += 1u;
+    read_bytes += RECEIVER_TEXEL_BYTES;
     // Depths within this of the lookup's count as the same receiver: a constant bias plus
     // `receiver_tolerance` texel footprints of the receiver map at this depth.
     let tolerance = scene_length(frame, settings.receiver_bias) + settings.receiver_tolerance * shadow_texel_size(frame, receiver_map, uvd.z);

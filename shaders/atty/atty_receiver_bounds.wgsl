@@ -8,8 +8,15 @@
 
 @group(0) @binding(0) var finer: texture_2d<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d<r32float, write>;
-// This pyramid's counters (atty_counts.wgsl): 0, texel reads; 1, bytes stored (4 per R32Float texel).
+// This pyramid's counters (atty_counts.wgsl): 0, texel reads; 1, the bytes they fetched; 2, bytes
+// stored (4 per R32Float texel).
 @group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Bytes of one texel read (the pipelines set them from the formats: DepthPyramid in src/lib.rs):
+// of the map level 0 is built from (the receiver map: R32Float, or Rgba32Float planes with
+// receiver_plane), and of this pyramid's levels (R32Float).
+override MAP_TEXEL_BYTES: u32;
+override PYRAMID_TEXEL_BYTES: u32;
 
 // Level 0 from the receiver map (`finer`): NO_SURFACE becomes 0, below every patch.
 @compute @workgroup_size(8, 8, 1)
@@ -21,7 +28,8 @@ fn atty_bounds_base(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(finer, vec2<i32>(id.xy), 0).x;
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(select(depth, 0.0, depth >= NO_SURFACE)));
     record_count(0u, vec2<i32>(id.xy), 1u);
-    record_count(1u, vec2<i32>(id.xy), 4u);
+    record_count(1u, vec2<i32>(id.xy), MAP_TEXEL_BYTES);
+    record_count(2u, vec2<i32>(id.xy), 4u);
 }
 
 // One level from the one below (`finer`). Mip sizes halve rounding down, so the last texel of a
@@ -44,6 +52,8 @@ fn atty_bounds_reduce(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(deepest));
     let block = last - first + 1;
-    record_count(0u, vec2<i32>(id.xy), u32(block.x * block.y));
-    record_count(1u, vec2<i32>(id.xy), 4u);
+    let reads = u32(block.x * block.y);
+    record_count(0u, vec2<i32>(id.xy), reads);
+    record_count(1u, vec2<i32>(id.xy), reads * PYRAMID_TEXEL_BYTES);
+    record_count(2u, vec2<i32>(id.xy), 4u);
 }

@@ -1,7 +1,7 @@
 // Texture reads per pixel, counted per pass (ssm-core/src/read_counts.rs): each pass's
 // (pixels, reads) pairs spread over READ_COUNT_BUCKETS buckets chosen by pixel.
 
-const READ_COUNT_BUCKETS: u32 = 64u;
+const READ_COUNT_BUCKETS: u32 = 256u;
 
 // Whether the pipeline counts reads (ReadCounts::pipeline_constants): a constant of the pipeline,
 // so that without it the counting code is compiled out rather than skipped at run time.

@@ -19,11 +19,18 @@
 // #import common/pixel_work.wgsl
 
 @group(2) @binding(0) var visibility: texture_storage_2d<r32float, read_write>;
-// Counters 0 (texel reads) and 1 (storage bytes), (invocations, count) per bucket
-// (common/read_counts.wgsl); written only with COUNT_READS (a counting frame). Each textureLoad is
-// one texel: the G-buffer's two per invocation inside the target, the technique's visibility
-// where it is scaled; a store writes one r32float, 4 bytes.
+// Counters 0 (texel reads), 1 (storage bytes) and 2 (the bytes the reads fetched), (invocations,
+// count) per bucket (common/read_counts.wgsl); written only with COUNT_READS (a counting frame).
+// Each textureLoad is one texel: the G-buffer's two per invocation inside the target (Rgba32Float,
+// 16 bytes each), the technique's visibility where it is scaled (r32float, 4 bytes); a store
+// writes one r32float, 4 bytes.
 @group(2) @binding(1) var<storage, read_write> read_counts: array<atomic<u32>>;
+
+// Bytes of one texel of the G-buffer's position and normal (GBuffer::POSITION_FORMAT and
+// NORMAL_FORMAT, Rgba32Float) and of the visibility (VISIBILITY_FORMAT, R32Float); a test in
+// ssm-core's own_surface.rs reads these lines.
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
+const VISIBILITY_TEXEL_BYTES: u32 = 4u;
 
 // How far in front of the plane, as a fraction of the scene's diagonal, the light's centre must be
 // for the technique's value to count: the G-buffer's positions' rounding at the scene's scale.
@@ -38,6 +45,7 @@ fn own_surface_share(@builtin(global_invocation_id) id: vec3<u32>) {
     let texel = vec2<i32>(id.xy);
     let point = screen_point_at(texel);
     var reads = 2u;
+    var read_bytes = 2u * GBUFFER_TEXEL_BYTES;
     var stored = 0u;
     if (point.closed && point.covered && !unlit_by_rule(point)) {
         let share = light_share_in_front(frame, point.position, point.normal);
@@ -46,10 +54,11 @@ fn own_surface_share(@builtin(global_invocation_id) id: vec3<u32>) {
             if (light_centre_height(frame, point.position, point.normal) > scene_length(frame, CENTRE_ON_PLANE)) {
                 with_share = share * textureLoad(visibility, texel).x;
                 reads += 1u;
+                read_bytes += VISIBILITY_TEXEL_BYTES;
             }
             textureStore(visibility, texel, vec4<f32>(with_share, 0.0, 0.0, 0.0));
-            stored = 4u;
+            stored = VISIBILITY_TEXEL_BYTES;
         }
     }
-    record_pixel_work(0u, 1u, texel, reads, stored);
+    record_pixel_work_and_read_bytes(0u, 1u, 2u, texel, reads, stored, read_bytes);
 }

@@ -36,7 +36,7 @@ struct PcssSettings {
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;
-// Pass 0: (pixels, reads) per bucket (common/read_counts.wgsl).
+// Counter 0: (pixels, reads), counter 1: (pixels, bytes read) per bucket (common/read_counts.wgsl).
 @group(2) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 // Texel reads of this invocation, each a textureLoad of one texel (nearest, no sampler): the
@@ -46,6 +46,13 @@ struct PcssSettings {
 // shadow_map_depth fetches nothing there), or in the tiled pass the texels an invocation loaded
 // into the tile instead of the taps that read the tile.
 var<private> reads: u32 = 0u;
+// The bytes those reads fetched, each texel its format's size: the G-buffer's position and normal
+// are Rgba32Float (ssm-core's GBuffer::POSITION_FORMAT, NORMAL_FORMAT), the shadow map's linear
+// depth R32Float (LightDepthMap::FORMAT; a tap past the border, counted as a read, counts a
+// texel's bytes too). A tap read from the tiled pass's workgroup memory is no read and no bytes.
+var<private> read_bytes: u32 = 0u;
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
+const SHADOW_MAP_TEXEL_BYTES: u32 = 4u;
 
 // A pixel's lookup, prepared before its taps.
 struct PcssPixel {
@@ -113,7 +120,7 @@ fn record_pcss_reads(texel: vec2<i32>) {
     record_pcss_reads_of(texel, 1u);
 }
 
-// Records `pixels` (0 or 1) and this invocation's reads: 0 for an invocation of the tiled pass past
+// Records `pixels` (0 or 1) and this invocation's reads and their bytes: 0 for an invocation of the tiled pass past
 // the screen's edge, which only loaded its share of the tile, so that the invocations counted are
 // the screen's pixels in both passes.
 fn record_pcss_reads_of(texel: vec2<i32>, pixels: u32) {
@@ -121,5 +128,8 @@ fn record_pcss_reads_of(texel: vec2<i32>, pixels: u32) {
         let word = read_count_word(0u, texel);
         atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(1u, texel);
+        atomicAdd(&read_counts[bytes_word], pixels);
+        atomicAdd(&read_counts[bytes_word + 1u], read_bytes);
     }
 }

@@ -34,7 +34,8 @@
 @group(2) @binding(2) var face_minus_u: texture_2d<f32>;
 @group(2) @binding(3) var face_plus_v: texture_2d<f32>;
 @group(2) @binding(4) var face_minus_v: texture_2d<f32>;
-// Counters 0 (texel reads) and 1 (storage bytes) of a counting frame (common/read_counts.wgsl).
+// Counters 0 (texel reads), 1 (storage bytes) and 2 (bytes read) of a counting frame
+// (common/read_counts.wgsl).
 @group(2) @binding(5) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 struct PcssSideFaceSettings {
@@ -51,6 +52,12 @@ struct PcssSideFaceSettings {
 
 // Texel reads of this invocation: the G-buffer's two, and one per tap inside a face's map.
 var<private> reads: u32 = 0u;
+// The bytes those reads fetched, each texel its format's size: the G-buffer's position and normal
+// are Rgba32Float (ssm-core's GBuffer::POSITION_FORMAT, NORMAL_FORMAT), the faces' linear depth
+// R32Float (SideFaceMaps, LightDepthMap::FORMAT).
+var<private> read_bytes: u32 = 0u;
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
+const FACE_TEXEL_BYTES: u32 = 4u;
 
 // Every face's size in texels.
 fn face_size() -> vec2<f32> {
@@ -63,6 +70,7 @@ fn face_depth(face: u32, uv: vec2<f32>) -> f32 {
         return NO_SURFACE;
     }
     reads += 1u;
+    read_bytes += FACE_TEXEL_BYTES;
     switch face {
         case 0u: { return shadow_map_depth(face_plus_u, uv); }
         case 1u: { return shadow_map_depth(face_minus_u, uv); }
@@ -205,6 +213,7 @@ fn pcss_side_faces(@builtin(global_invocation_id) id: vec3<u32>) {
     let texel = vec2<i32>(id.xy);
     let point = screen_point_at(texel);
     reads = 2u;
+    read_bytes = 2u * GBUFFER_TEXEL_BYTES;
     var stored = 0u;
     let offset = point.position - frame.centre.xyz;
     if (point.covered && !unlit_by_rule(point) && past_the_frame(frame, offset)) {
@@ -212,5 +221,5 @@ fn pcss_side_faces(@builtin(global_invocation_id) id: vec3<u32>) {
         textureStore(visibility, texel, vec4<f32>(clamp(answer, 0.0, 1.0), 0.0, 0.0, 0.0));
         stored = 4u;
     }
-    record_pixel_work(0u, 1u, texel, reads, stored);
+    record_pixel_work_and_read_bytes(0u, 1u, 2u, texel, reads, stored, read_bytes);
 }

@@ -26,6 +26,7 @@ var<private> tiled: bool;
 fn tap_depth(uv: vec2<f32>) -> f32 {
     if (!tiled || any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) {
         reads += 1u;
+        read_bytes += SHADOW_MAP_TEXEL_BYTES;
         return shadow_map_depth(shadow_map, uv);
     }
     // The texel shadow_map_depth reads, inside the union by construction.
@@ -72,6 +73,7 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         for (var index = i32(local); index < extent.x * extent.y; index += 64) {
             tile[index] = textureLoad(shadow_map, low + vec2<i32>(index % extent.x, index / extent.x), 0).x;
             reads += 1u;
+            read_bytes += SHADOW_MAP_TEXEL_BYTES;
         }
     }
     workgroupBarrier();
@@ -85,6 +87,7 @@ fn pcss_filter_tiled(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     }
     // The G-buffer's two texels, read at every pixel of the screen, trivial ones included.
     reads += 2u;
+    read_bytes += 2u * GBUFFER_TEXEL_BYTES;
     var visibility = trivial;
     if (trivial < 0.0) {
         visibility = soft_visibility(pixel);

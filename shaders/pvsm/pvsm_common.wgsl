@@ -67,6 +67,14 @@ struct Kernel {
     _pad: f32,
 };
 
+// Bytes of one Kernel record, an element of the kernels array (a read of a pixel's record fetches
+// them all; src/lib.rs's KernelRecord, checked by a test of the crate).
+const KERNEL_RECORD_BYTES: u32 = 48u;
+
+// Bytes of one G-buffer texel read: the position and the normal are Rgba32Float (ssm-core's
+// GBuffer::POSITION_FORMAT and NORMAL_FORMAT, checked by a test of the crate).
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
+
 // The pixel has a filter to evaluate.
 const KERNEL_ACTIVE: u32 = 1u;
 // No blocker in the conservative map's search region: fully lit, nothing more to do (Sec. 5.2).

@@ -37,7 +37,8 @@ struct TileSettings {
 @group(2) @binding(4) var<storage, read_write> capped: array<u32>;
 // COUNTER_* of pvsm_common.wgsl (the resolve pass adds the capped and uncovered pixels).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
-// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_FILTER.
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_FILTER and its bytes, the walk's
+// reads, and READ_COUNTER_RESOLVE and its bytes.
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
@@ -49,11 +50,25 @@ struct TileSettings {
 @group(3) @binding(4) var tile_near_counts: texture_2d<u32>;
 
 // The ReadCounts counters of this pass and the resolve (READ_COUNTERS in src/lib.rs): every read of
-// every invocation of pvsm_tile_filter; the walk's reads per filter evaluation (the texels filtered,
-// a diagnostic, not a pass); every read of pvsm_resolve.
-const READ_COUNTER_TILE_FILTER: u32 = 6u;
-const READ_COUNTER_TILE_FILTER_WALK: u32 = 7u;
-const READ_COUNTER_RESOLVE: u32 = 8u;
+// every invocation of pvsm_tile_filter, and the bytes they fetched; the walk's reads per filter
+// evaluation (the texels filtered, a diagnostic, not a pass); every read of pvsm_resolve, and its
+// bytes.
+const READ_COUNTER_TILE_FILTER: u32 = 10u;
+const READ_COUNTER_TILE_FILTER_READ_BYTES: u32 = 11u;
+const READ_COUNTER_TILE_FILTER_WALK: u32 = 12u;
+const READ_COUNTER_RESOLVE: u32 = 13u;
+const READ_COUNTER_RESOLVE_READ_BYTES: u32 = 14u;
+
+// Bytes of one read (src/lib.rs's formats and buffers, checked by a test of the crate): a texel of
+// the tile map, R32Float (ssm-core's LightDepthMap::FORMAT); of its pyramid, Rgba32Float
+// (TILE_PYRAMID_FORMAT); of its near counts, Rgba32Uint (TILE_PYRAMID_COUNTS_FORMAT); a pixel's
+// accumulated sums, a vec2<f32>; its capped flag, a u32. (A kernel record is KERNEL_RECORD_BYTES, a
+// G-buffer texel GBUFFER_TEXEL_BYTES: pvsm_common.wgsl.)
+const TILE_MAP_TEXEL_BYTES: u32 = 4u;
+const TILE_PYRAMID_TEXEL_BYTES: u32 = 16u;
+const TILE_PYRAMID_COUNTS_TEXEL_BYTES: u32 = 16u;
+const ACCUMULATED_BYTES: u32 = 8u;
+const CAPPED_BYTES: u32 = 4u;
 
 // Smallest half-axis of a filter, in texels of the tile (see texel_filter).
 const MIN_HALF_TEXELS: f32 = 1e-3;
@@ -88,14 +103,15 @@ struct TexelFilter {
     y_high: f32,
 };
 
-// What a walk returns, in texel areas: Σ c·o, Σ c, whether it hit MAX_WALK_STEPS, and the texels
+// What a walk returns, in texel areas: Σ c·o, Σ c, whether it hit MAX_WALK_STEPS, the texels
 // it read (each textureLoad of the tile map or of its pyramid is one: ssm-core's ReadCounts
-// convention, one texel fetched).
+// convention, one texel fetched) and the bytes they fetched (each its texture's texel size).
 struct FilterSums {
     visible: f32,
     covered: f32,
     capped: bool,
     reads: u32,
+    bytes: u32,
 };
 
 // Shadow-map coordinates of texel position `texel` of the tile (a texel's centre is its index + 0.5).
@@ -267,7 +283,7 @@ fn compared_bounds(receiver: TapPlane, uv_low: vec2<f32>, uv_high: vec2<f32>) ->
 // `stride` > 1 every stride-th texel, each standing for a stride×stride block (filter_texels =
 // predicted, not the paper's); with point_samples, classic PCF. At most MAX_WALK_STEPS texels.
 fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride: vec2<f32>) -> FilterSums {
-    var sums = FilterSums(0.0, 0.0, false, 0u);
+    var sums = FilterSums(0.0, 0.0, false, 0u, 0u);
     var steps = 0u;
     var column = floor(shape.x_low / stride.x) * stride.x;
     // One loop over columns and their rows, a texel or a new column per iteration (see
@@ -318,6 +334,7 @@ fn walk_texels(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>, stride:
         if (height > 0.0) {
             let z = textureLoad(tile_map, vec2<i32>(min(texel, tile.size - vec2<f32>(0.5))), 0).x;
             sums.reads += 1u;
+            sums.bytes += TILE_MAP_TEXEL_BYTES;
             let compared = tap_plane_depth(receiver, tile_uv(texel, scale));
             let area = select(width, stride.x, settings.point_samples != 0u) * height;
             // o(t) = 1 when the receiver is no farther than the texel's occluder (Eq. 2); the
@@ -382,7 +399,7 @@ fn settle_child(shape: TexelFilter, child: vec2<u32>, level: u32, near: u32) -> 
 // parent's (climbing while it is the fourth child), so that the state is one block and its level,
 // and per level which children of the block last descended from are walked.
 fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> FilterSums {
-    var sums = FilterSums(0.0, 0.0, false, 0u);
+    var sums = FilterSums(0.0, 0.0, false, 0u, 0u);
     var steps = 0u;
     let first = vec2<u32>(vec2<f32>(floor(shape.x_low), floor(shape.y_low)));
     let last = vec2<u32>(vec2<f32>(ceil(shape.x_high), ceil(shape.y_high))) - 1u;
@@ -455,7 +472,6 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
             }
             settling = true;
         }
-        sums.reads += 1u;
         // (nearest, farthest) depth of the block's texels, and the bounds of what they are compared
         // with; a texel is a block whose bounds are its own test's values, never mixed. Loads are
         // clamped to the texture: a real walk never leaves it. (A mip's size from the base's:
@@ -480,17 +496,23 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
                 continue;
             }
             quadrants = textureLoad(tile_near_counts, pyramid_texel, i32(mip));
+            sums.reads += 1u;
+            sums.bytes += TILE_PYRAMID_COUNTS_TEXEL_BYTES;
             straddling = true;
         } else {
             var depths: vec4<f32>;
             var compared: vec2<f32>;
             if (level == 0u) {
                 let z = textureLoad(tile_map, min(vec2<i32>(block), vec2<i32>(tile.size) - 1), 0).x;
+                sums.reads += 1u;
+                sums.bytes += TILE_MAP_TEXEL_BYTES;
                 // A texel is one layer (near_max = far_min).
                 depths = vec4<f32>(z);
                 compared = vec2<f32>(tap_plane_depth(receiver, tile_uv(lo + 0.5, scale)));
             } else {
                 depths = textureLoad(tile_pyramid, pyramid_texel, i32(mip));
+                sums.reads += 1u;
+                sums.bytes += TILE_PYRAMID_TEXEL_BYTES;
                 compared = compared_bounds(receiver, tile_uv(lo + 0.5, scale), tile_uv(hi - 0.5, scale));
             }
             if (compared.y <= depths.x) {
@@ -506,6 +528,7 @@ fn walk_hierarchy(shape: TexelFilter, receiver: TapPlane, scale: vec2<f32>) -> F
                 // cluster's are lit. Its near counts per child: one more read.
                 quadrants = textureLoad(tile_near_counts, pyramid_texel, i32(mip));
                 sums.reads += 1u;
+                sums.bytes += TILE_PYRAMID_COUNTS_TEXEL_BYTES;
                 if (inside_filter(shape, lo, hi)) {
                     // Inside the filter each texel weighs one, so the lit area is the far cluster's
                     // texel count.
@@ -562,7 +585,7 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
     let scale = tile.size / (tile.uv_max - tile.uv_min);
     let shape = texel_filter(centre, u, v_height, scale);
     if (shape.x_low >= shape.x_high) {
-        return FilterSums(0.0, 0.0, false, 0u);
+        return FilterSums(0.0, 0.0, false, 0u, 0u);
     }
     // What each texel is compared with (the settings' receiver model), prepared once.
     let receiver = receiver_tap_plane(frame, position, normal, depth, settings.receiver_plane != 0u);
@@ -581,15 +604,20 @@ fn integrate(centre: vec2<f32>, u: vec2<f32>, v_height: f32, depth: f32, positio
 }
 
 // Records one invocation's texel reads (with COUNT_READS, the settings' count_reads), one per
-// textureLoad or per element of a per-pixel storage array (ReadCounts' convention): every
-// invocation reads its pixel's kernel record (step 3's output); one that filters (`filtered`) also
-// the G-buffer's two texels, its accumulated sums (the tiles' before it) and the walk's
-// `walk_reads`, which the walk counter keeps apart (pvsm_texels_filtered).
-fn record_filter_reads(pixel: vec2<u32>, walk_reads: u32, filtered: bool) {
+// textureLoad or per element of a per-pixel storage array (ReadCounts' convention), and the bytes
+// they fetched: every invocation reads its pixel's kernel record (step 3's output); one that
+// filters (`filtered`) also the G-buffer's two texels, its accumulated sums (the tiles' before it)
+// and the walk's `walk_reads` (of `walk_bytes`), which the walk counter keeps apart
+// (pvsm_texels_filtered).
+fn record_filter_reads(pixel: vec2<u32>, walk_reads: u32, walk_bytes: u32, filtered: bool) {
     if (COUNT_READS) {
         let word = read_count_word(READ_COUNTER_TILE_FILTER, vec2<i32>(pixel));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], select(1u, 4u + walk_reads, filtered));
+        let filtered_bytes = KERNEL_RECORD_BYTES + 2u * GBUFFER_TEXEL_BYTES + ACCUMULATED_BYTES + walk_bytes;
+        let bytes_word = read_count_word(READ_COUNTER_TILE_FILTER_READ_BYTES, vec2<i32>(pixel));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], select(KERNEL_RECORD_BYTES, filtered_bytes, filtered));
         if (filtered) {
             let walk_word = read_count_word(READ_COUNTER_TILE_FILTER_WALK, vec2<i32>(pixel));
             atomicAdd(&read_counts[walk_word], 1u);
@@ -607,7 +635,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.y * size.x + id.x;
     let kernel = kernels[index];
     if (kernel.flags != KERNEL_ACTIVE) {
-        record_filter_reads(id.xy, 0u, false);
+        record_filter_reads(id.xy, 0u, 0u, false);
         return;
     }
     let point = screen_point_at(vec2<i32>(id.xy));
@@ -630,7 +658,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
         if (sums.capped) {
             capped[index] = 1u;
         }
-        record_filter_reads(id.xy, sums.reads, true);
+        record_filter_reads(id.xy, sums.reads, sums.bytes, true);
         return;
     }
     // Screen-space supersampling (Fig. 11's comparison): k×k points of the pixel's tangent plane,
@@ -638,6 +666,7 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
     var sum = vec2<f32>(0.0);
     var any_capped = false;
     var reads = 0u;
+    var bytes = 0u;
     for (var j = 0u; j < k; j++) {
         for (var i = 0u; i < k; i++) {
             let pixel = vec2<f32>(id.xy) + (vec2<f32>(f32(i), f32(j)) + 0.5) / f32(k);
@@ -651,13 +680,14 @@ fn pvsm_tile_filter(@builtin(global_invocation_id) id: vec3<u32>) {
             sum += vec2<f32>(sums.visible, sums.covered);
             any_capped = any_capped || sums.capped;
             reads += sums.reads;
+            bytes += sums.bytes;
         }
     }
     accumulated[index] += sum;
     if (any_capped) {
         capped[index] = 1u;
     }
-    record_filter_reads(id.xy, reads, true);
+    record_filter_reads(id.xy, reads, bytes, true);
 }
 
 // The final visibility (Sec. 5.2's merge: V = Σ V·A / Σ A) into the framework's target.
@@ -674,9 +704,13 @@ fn pvsm_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     var value = 1.0;
     if (COUNT_READS) {
         // The pixel's kernel record, and a filtered pixel's sums and capped flag.
+        let filtered = kernel.flags == KERNEL_ACTIVE;
         let word = read_count_word(READ_COUNTER_RESOLVE, vec2<i32>(id.xy));
         atomicAdd(&read_counts[word], 1u);
-        atomicAdd(&read_counts[word + 1u], select(1u, 3u, kernel.flags == KERNEL_ACTIVE));
+        atomicAdd(&read_counts[word + 1u], select(1u, 3u, filtered));
+        let bytes_word = read_count_word(READ_COUNTER_RESOLVE_READ_BYTES, vec2<i32>(id.xy));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], select(KERNEL_RECORD_BYTES, KERNEL_RECORD_BYTES + ACCUMULATED_BYTES + CAPPED_BYTES, filtered));
     }
     if (kernel.flags == KERNEL_DARK) {
         value = 0.0;

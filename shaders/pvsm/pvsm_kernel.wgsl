@@ -21,14 +21,20 @@
 // COUNTER_* of pvsm_common.wgsl.
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>, COUNTERS>;
 // ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_KERNEL_SHAPE (texel reads),
-// READ_COUNTER_KERNEL_SHAPE_ATOMICS (atomic operations) and READ_COUNTER_PREDICTED_TEXELS (a
-// diagnostic: the texels the pixel's own predicted resolution puts under its filter).
+// READ_COUNTER_KERNEL_SHAPE_READ_BYTES (the bytes they fetched), READ_COUNTER_KERNEL_SHAPE_ATOMICS
+// (atomic operations) and READ_COUNTER_PREDICTED_TEXELS (a diagnostic: the texels the pixel's own
+// predicted resolution puts under its filter).
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
-const READ_COUNTER_KERNEL_SHAPE: u32 = 1u;
-const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 2u;
-const READ_COUNTER_PREDICTED_TEXELS: u32 = 9u;
+// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+const READ_COUNTER_KERNEL_SHAPE: u32 = 2u;
+const READ_COUNTER_KERNEL_SHAPE_READ_BYTES: u32 = 3u;
+const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 4u;
+const READ_COUNTER_PREDICTED_TEXELS: u32 = 15u;
+
+// Bytes of one texel of the low-resolution map's levels: R32Float (ssm-core's
+// LightDepthMap::FORMAT, checked by a test of the crate).
+const LOW_RES_TEXEL_BYTES: u32 = 4u;
 
 // Most texels one pixel's count below adds: keeps a 32-bit bucket from overflowing at a large
 // viewport under a filter many thousand predicted texels wide (a cost no prediction asks for).
@@ -49,13 +55,17 @@ fn record_predicted_texels(pixel: vec2<u32>, u: vec2<f32>, v_height: f32, texel:
 }
 
 // Records one pixel's texel reads (one per textureLoad, ReadCounts' convention: the G-buffer's two
-// at every pixel, trivial ones included, and the low-resolution map's) and atomics, with
+// at every pixel, trivial ones included, and the low-resolution map's), the bytes they fetched
+// (`read_bytes`: GBUFFER_TEXEL_BYTES and LOW_RES_TEXEL_BYTES a texel) and atomics, with
 // COUNT_READS (the settings' count_reads).
-fn record_kernel_work(pixel: vec2<u32>, reads: u32, atomics: u32) {
+fn record_kernel_work(pixel: vec2<u32>, reads: u32, read_bytes: u32, atomics: u32) {
     if (COUNT_READS) {
         let word = read_count_word(READ_COUNTER_KERNEL_SHAPE, vec2<i32>(pixel));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(READ_COUNTER_KERNEL_SHAPE_READ_BYTES, vec2<i32>(pixel));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], read_bytes);
         let atomics_word = read_count_word(READ_COUNTER_KERNEL_SHAPE_ATOMICS, vec2<i32>(pixel));
         atomicAdd(&read_counts[atomics_word], 1u);
         atomicAdd(&read_counts[atomics_word + 1u], atomics);
@@ -99,7 +109,7 @@ fn in_cone(uv: vec2<f32>, depth: f32, uvd: vec3<f32>, slack: vec2<f32>) -> bool 
 }
 
 // What cone_samples found: the blockers' depth sum, their count and the nearest (the receiver's
-// depth where none), and the texels it read.
+// depth where none), and the texels it read (each a texel of the low-resolution map's level 0).
 struct ConeSamples {
     sum: f32,
     count: f32,
@@ -185,7 +195,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         kernel.flags = select(0u, KERNEL_DARK, trivial == 0.0);
         kernels[index] = kernel;
         // The G-buffer's two texels.
-        record_kernel_work(id.xy, 2u, 0u);
+        record_kernel_work(id.xy, 2u, 2u * GBUFFER_TEXEL_BYTES, 0u);
         return;
     }
     let uvd = light_uv_depth(frame, point.position);
@@ -212,8 +222,9 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     // edge still finds it (the parallel-square test's penumbra error rises from 0.0175 to 0.0197
     // without it).
     let nearest = textureLoad(low_res_map, vec2<i32>(0), i32(levels - 1u)).x;
-    // The G-buffer's two texels and this one.
+    // The G-buffer's two texels and this one, and the bytes the reads fetched.
     var reads = 3u;
+    var read_bytes = 2u * GBUFFER_TEXEL_BYTES + LOW_RES_TEXEL_BYTES;
     let search = light_half_extent_uv(frame, clamp(0.98 * nearest, frame.projection.z, d), d);
     let n = max(settings.blocker_kernel, 1u);
     let span = max(2.0 * search * base_size, vec2<f32>(1.0));
@@ -262,6 +273,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = max(low.x, 0); x <= min(high.x, limit.x); x++) {
             let depth = textureLoad(low_res_map, vec2<i32>(x, y), i32(level)).x;
             reads += 1u;
+            read_bytes += LOW_RES_TEXEL_BYTES;
             let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / level_size;
             if (depth < tap_plane_depth(receiver, uv) - coarse_tolerance) {
                 coarse_sum += depth;
@@ -282,6 +294,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var x = fine_low.x; x <= fine_high.x; x++) {
                 let depth = textureLoad(low_res_map, vec2<i32>(x, y), 0).x;
                 reads += 1u;
+                read_bytes += LOW_RES_TEXEL_BYTES;
                 let uv = (vec2<f32>(f32(x), f32(y)) + 0.5) / base_size;
                 if (depth < tap_plane_depth(receiver, uv) - fine_tolerance && (!cone_search || in_cone(uv, depth, uvd, 0.5 / base_size))) {
                     let area = texel_area_in(region, vec2<i32>(x, y));
@@ -296,7 +309,9 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
                 let uv = uvd.xy + vec2<f32>(grid_offset(i, n), grid_offset(j, n)) * search;
                 let depth = shadow_map_depth(low_res_map, uv);
                 // shadow_map_depth reads a texel only inside the map.
-                reads += select(0u, 1u, all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)));
+                let inside = all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0));
+                reads += select(0u, 1u, inside);
+                read_bytes += select(0u, LOW_RES_TEXEL_BYTES, inside);
                 if (depth < tap_plane_depth(receiver, uv) - fine_tolerance && (!cone_search || in_cone(uv, depth, uvd, 0.5 / base_size))) {
                     sum += depth;
                     count += 1.0;
@@ -316,6 +331,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var attempt = 0u; attempt < RETRY_REGIONS && count == 0.0; attempt++) {
             let found = cone_samples(uvd, search * shrink, n, receiver, fine_tolerance, 0.5 / base_size);
             reads += found.reads;
+            read_bytes += found.reads * LOW_RES_TEXEL_BYTES;
             sum = found.sum;
             count = found.count;
             nearest_found = found.nearest;
@@ -346,6 +362,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
                     }
                     let depth = textureLoad(low_res_map, child, i32(descent_level)).x;
                     reads += 1u;
+                    read_bytes += LOW_RES_TEXEL_BYTES;
                     let uv = (vec2<f32>(child) + 0.5) / size;
                     let plane = tap_plane_depth(receiver, uv);
                     let in_front = depth < plane - select(level_tolerance, fine_tolerance, descent_level == 0u);
@@ -383,6 +400,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let found = cone_samples(uvd, implied, n, receiver, fine_tolerance, 0.5 / base_size);
             reads += found.reads;
+            read_bytes += found.reads * LOW_RES_TEXEL_BYTES;
             if (found.count == 0.0) {
                 break;
             }
@@ -398,7 +416,7 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
         kernel.flags = KERNEL_LIT;
         kernels[index] = kernel;
         atomicAdd(&counters[COUNTER_LIT], 1u);
-        record_kernel_work(id.xy, reads, 1u);
+        record_kernel_work(id.xy, reads, read_bytes, 1u);
         return;
     }
     // With prediction = fixed the pixel is still filtered (the single map decides), with no penumbra
@@ -467,6 +485,6 @@ fn pvsm_kernel(@builtin(global_invocation_id) id: vec3<u32>) {
     kernel.flags = KERNEL_ACTIVE;
     kernels[index] = kernel;
     atomicAdd(&counters[COUNTER_FILTERED], 1u);
-    record_kernel_work(id.xy, reads, atomics);
+    record_kernel_work(id.xy, reads, read_bytes, atomics);
     record_predicted_texels(id.xy, kernel.u_axis, kernel.v_height, texel_size);
 }

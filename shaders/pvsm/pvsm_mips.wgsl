@@ -8,11 +8,17 @@
 
 @group(0) @binding(0) var finer: texture_2d<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d<r32float, write>;
-// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_LOW_RES_MIPS.
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_LOW_RES_MIPS (texel reads) and
+// READ_COUNTER_LOW_RES_MIPS_READ_BYTES (the bytes they fetched).
 @group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counter of this pass (PvsmReadCounter in src/lib.rs).
+// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
 const READ_COUNTER_LOW_RES_MIPS: u32 = 0u;
+const READ_COUNTER_LOW_RES_MIPS_READ_BYTES: u32 = 1u;
+
+// Bytes of one texel of the low-resolution map's levels: R32Float (ssm-core's
+// LightDepthMap::FORMAT, checked by a test of the crate).
+const LOW_RES_TEXEL_BYTES: u32 = 4u;
 
 @compute @workgroup_size(8, 8)
 fn pvsm_low_res_mip(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -33,10 +39,15 @@ fn pvsm_low_res_mip(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     textureStore(coarser, vec2<i32>(id.xy), vec4<f32>(nearest));
     if (COUNT_READS) {
-        // One read per textureLoad (ReadCounts' convention), the first texel's twice as the code reads it.
+        // One read per textureLoad (ReadCounts' convention), the first texel's twice as the code
+        // reads it; every one a texel of the finer level.
         let span = high - low + 1;
+        let reads = 1u + u32(span.x * span.y);
         let word = read_count_word(READ_COUNTER_LOW_RES_MIPS, vec2<i32>(id.xy));
         atomicAdd(&read_counts[word], 1u);
-        atomicAdd(&read_counts[word + 1u], 1u + u32(span.x * span.y));
+        atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(READ_COUNTER_LOW_RES_MIPS_READ_BYTES, vec2<i32>(id.xy));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], reads * LOW_RES_TEXEL_BYTES);
     }
 }

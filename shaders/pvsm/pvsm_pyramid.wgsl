@@ -17,11 +17,17 @@ struct PyramidSettings {
 @group(0) @binding(1) var<storage, read> grid: array<u32>;
 // Every level, level 0 first, as resolutions along u and v.
 @group(0) @binding(2) var<storage, read_write> pyramid: array<vec2<f32>>;
-// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_SMTG_PYRAMID.
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_SMTG_PYRAMID (cells read) and
+// READ_COUNTER_SMTG_PYRAMID_READ_BYTES (the bytes they fetched).
 @group(0) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counter of this pass (PvsmReadCounter in src/lib.rs).
-const READ_COUNTER_SMTG_PYRAMID: u32 = 3u;
+// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+const READ_COUNTER_SMTG_PYRAMID: u32 = 5u;
+const READ_COUNTER_SMTG_PYRAMID_READ_BYTES: u32 = 6u;
+
+// Bytes of one cell read: a grid cell's two u32 (its resolutions along u and v) or a pyramid cell's
+// vec2<f32> (src/lib.rs sizes both buffers at 8 bytes a cell, checked by a test of the crate).
+const SMTG_CELL_BYTES: u32 = 8u;
 
 const THREADS: u32 = 256u;
 
@@ -57,5 +63,8 @@ fn pvsm_pyramid(@builtin(local_invocation_index) thread: u32) {
         let word = read_count_word(READ_COUNTER_SMTG_PYRAMID, vec2<i32>(i32(thread), 0));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(READ_COUNTER_SMTG_PYRAMID_READ_BYTES, vec2<i32>(i32(thread), 0));
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], reads * SMTG_CELL_BYTES);
     }
 }

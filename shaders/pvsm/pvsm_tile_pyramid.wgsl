@@ -47,16 +47,25 @@ struct PyramidLevel {
 // The level below: the tile map (depth in x), or (nearest, farthest, near_max, far_min).
 @group(1) @binding(1) var finer: texture_2d<f32>;
 @group(1) @binding(2) var coarser: texture_storage_2d<rgba32float, write>;
-// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_PYRAMID (reads) and
-// READ_COUNTER_TILE_PYRAMID_BYTES (bytes written).
+// ReadCounts (ssm-core), with COUNT_READS: READ_COUNTER_TILE_PYRAMID (reads),
+// READ_COUNTER_TILE_PYRAMID_READ_BYTES (the bytes they fetched) and
+// READ_COUNTER_TILE_PYRAMID_STORAGE_BYTES (bytes written).
 @group(1) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 // The level below's near counts per quadrant (unread when it is the map), and this level's.
 @group(1) @binding(4) var finer_counts: texture_2d<u32>;
 @group(1) @binding(5) var coarser_counts: texture_storage_2d<rgba32uint, write>;
 
-// The ReadCounts counters of this pass (PvsmReadCounter in src/lib.rs).
-const READ_COUNTER_TILE_PYRAMID: u32 = 4u;
-const READ_COUNTER_TILE_PYRAMID_BYTES: u32 = 5u;
+// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+const READ_COUNTER_TILE_PYRAMID: u32 = 7u;
+const READ_COUNTER_TILE_PYRAMID_READ_BYTES: u32 = 8u;
+const READ_COUNTER_TILE_PYRAMID_STORAGE_BYTES: u32 = 9u;
+
+// Bytes of one texel read (src/lib.rs's formats, checked by a test of the crate): the tile map's
+// R32Float (ssm-core's LightDepthMap::FORMAT), the pyramid's Rgba32Float (TILE_PYRAMID_FORMAT) and
+// its near counts' Rgba32Uint (TILE_PYRAMID_COUNTS_FORMAT).
+const TILE_MAP_TEXEL_BYTES: u32 = 4u;
+const TILE_PYRAMID_TEXEL_BYTES: u32 = 16u;
+const TILE_PYRAMID_COUNTS_TEXEL_BYTES: u32 = 16u;
 
 // Texels of the region at `level`: ceil(size / 2^level) along each axis.
 fn level_size(level: u32) -> vec2<u32> {
@@ -92,6 +101,9 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
     var farthest = -NO_SURFACE;
     var total = 0u;
     var reads = 0u;
+    // The bytes those reads fetched: a child is a texel of the map at level 1, of the pyramid above.
+    var read_bytes = 0u;
+    let child_bytes = select(TILE_PYRAMID_TEXEL_BYTES, TILE_MAP_TEXEL_BYTES, pyramid_level.from_map != 0u);
     for (var dy = 0u; dy < 2u; dy++) {
         for (var dx = 0u; dx < 2u; dx++) {
             let texel = 2u * id.xy + vec2<u32>(dx, dy);
@@ -101,6 +113,7 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let child = textureLoad(finer, vec2<i32>(texel), 0);
             reads += 1u;
+            read_bytes += child_bytes;
             let owner = dx + 2u * dy;
             owners[intervals] = owner;
             owners[intervals + 1u] = owner;
@@ -121,6 +134,7 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
             if (child.z < child.w) {
                 let quadrants = textureLoad(finer_counts, vec2<i32>(texel), 0);
                 reads += 1u;
+                read_bytes += TILE_PYRAMID_COUNTS_TEXEL_BYTES;
                 let near_count = quadrants.x + quadrants.y + quadrants.z + quadrants.w;
                 lows[intervals] = child.x;
                 highs[intervals] = child.z;
@@ -173,11 +187,14 @@ fn pvsm_tile_pyramid(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(coarser_counts, vec2<i32>(id.xy), quadrants);
     if (COUNT_READS) {
         // Texel reads as ReadCounts counts them (one per textureLoad: a child's depths, and its
-        // near counts where it is two layers); 32 bytes written per texel (16 + 16).
+        // near counts where it is two layers) and their bytes; 32 bytes written per texel (16 + 16).
         let word = read_count_word(READ_COUNTER_TILE_PYRAMID, vec2<i32>(id.xy));
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
-        let bytes_word = read_count_word(READ_COUNTER_TILE_PYRAMID_BYTES, vec2<i32>(id.xy));
+        let read_bytes_word = read_count_word(READ_COUNTER_TILE_PYRAMID_READ_BYTES, vec2<i32>(id.xy));
+        atomicAdd(&read_counts[read_bytes_word], 1u);
+        atomicAdd(&read_counts[read_bytes_word + 1u], read_bytes);
+        let bytes_word = read_count_word(READ_COUNTER_TILE_PYRAMID_STORAGE_BYTES, vec2<i32>(id.xy));
         atomicAdd(&read_counts[bytes_word], 1u);
         atomicAdd(&read_counts[bytes_word + 1u], 32u);
     }

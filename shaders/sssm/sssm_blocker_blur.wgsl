@@ -53,7 +53,7 @@ fn penumbra_texels(sum_count: vec2<f32>, d: f32) -> f32 {
 // weight compares.
 fn load_horizontal_source(texel: vec2<i32>) -> BlurSource {
     let packed = textureLoad(blur_source, texel, 0);
-    reads += 1u;
+    count_screen_target_read();
     return unpack_blur_source(packed_hard_value(packed), packed);
 }
 
@@ -86,7 +86,7 @@ fn blocker_search(point: ScreenPoint, own: vec4<f32>) -> BlockerSearch {
         var no_data = false;
         if (from_screen) {
             let other = textureLoad(horizontal_blocker, clamped_texel(screen.xy), 0);
-            reads += 1u;
+            count_screen_target_read();
             no_data = other.x < 0.0;
             reuse = !no_data && abs(d - other.x) < scene_length(frame, settings.alpha);
             if (reuse) {

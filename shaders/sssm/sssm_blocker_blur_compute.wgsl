@@ -38,11 +38,12 @@ fn sssm_blocker_blur_rows(
     var axes = BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
     segment_line = texel.y;
     reads = 0u;
+    read_bytes = 0u;
     if (inside) {
         point = screen_point_at(texel);
         own = textureLoad(horizontal_blocker, texel, 0);
         // The G-buffer's two texels and step 1's, read at every pixel of the screen.
-        reads = 3u;
+        count_own_texels(true);
         if (own.x < 0.0) {
             result = vec4<f32>(own.w, 0.0, 0.0, -1.0);
         } else {

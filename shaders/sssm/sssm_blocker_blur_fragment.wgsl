@@ -22,7 +22,7 @@ fn sssm_blocker_blur(in: FullscreenVertex) -> BlockerBlurOutput {
     let point = screen_point(in);
     let own = textureLoad(horizontal_blocker, point.texel, 0);
     // The G-buffer's two texels and step 1's, read at every pixel.
-    reads = 3u;
+    count_own_texels(true);
     if (own.x < 0.0) {
         store_penumbra_error(point.texel);
         record_reads(1u, point.texel);

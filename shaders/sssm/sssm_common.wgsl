@@ -54,7 +54,8 @@ fn blur_along_light() -> bool {
 @group(2) @binding(1) var<uniform> settings: SssmSettings;
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
 // Per pass (0 horizontal blocker, 1 blocker and horizontal blur, 2 vertical blur): (pixels,
-// reads) per bucket (common/read_counts.wgsl).
+// reads) per bucket (common/read_counts.wgsl); then the failed rows' counters
+// (FAILED_ROW_COUNTERS) and each pass's (pixels, bytes read) (READ_BYTES_COUNTERS).
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 // Texel reads of this invocation so far, each a textureLoad of one texel (nearest, no sampler):
@@ -65,6 +66,35 @@ fn blur_along_light() -> bool {
 // rows and blur taps read, and in the compute passes the texels of the shared segment this
 // invocation loaded (a tap that reads workgroup memory is not a texel read).
 var<private> reads: u32 = 0u;
+
+// The bytes those reads fetched, each texel its format's size: a G-buffer texel (position or
+// normal: Rgba32Float, ssm-core's GBuffer::POSITION_FORMAT, NORMAL_FORMAT) 16, a texel of the
+// passes' own screen targets (horizontal_blocker, blur_source, horizontal_blur,
+// vertical_tap_source: Rgba32Float, sssm's SCREEN_TARGET_FORMAT) 16, a shadow-map depth
+// (R32Float, LightDepthMap::FORMAT; a tap past the border, counted as a read, counts a texel's
+// bytes too) 4. A tap read from a shared segment's workgroup memory is no read and no bytes.
+var<private> read_bytes: u32 = 0u;
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
+const SCREEN_TARGET_TEXEL_BYTES: u32 = 16u;
+const SHADOW_MAP_TEXEL_BYTES: u32 = 4u;
+
+// A pixel's own G-buffer texels (position and normal) and, in steps 2 and 3, its own texel of the
+// previous step's target: the reads at every pixel of the screen.
+fn count_own_texels(previous_step: bool) {
+    reads = 2u + select(0u, 1u, previous_step);
+    read_bytes = 2u * GBUFFER_TEXEL_BYTES + select(0u, SCREEN_TARGET_TEXEL_BYTES, previous_step);
+}
+
+// One texel read of a shadow map, and one of a screen target, counted with their bytes.
+fn count_shadow_map_read() {
+    reads += 1u;
+    read_bytes += SHADOW_MAP_TEXEL_BYTES;
+}
+
+fn count_screen_target_read() {
+    reads += 1u;
+    read_bytes += SCREEN_TARGET_TEXEL_BYTES;
+}
 
 // Rows of this invocation's kernel that failed their reuse test (α in step 2, β in step 3), by
 // cause, when counting: the row's pixel lies off the screen (with CLAMP_EDGE_ROWS, only a
@@ -80,6 +110,8 @@ var<private> failed_rows_depth: u32;
 // The counters after the three passes' read counts (sssm's COUNTED): the causes of step 2's
 // failed blocker rows at 3-5, of step 3's failed blur rows at 6-8.
 const FAILED_ROW_COUNTERS: u32 = 3u;
+// The first pass's bytes-read counter, after the failed rows' (sssm's COUNTED): pass k's at 9 + k.
+const READ_BYTES_COUNTERS: u32 = 9u;
 
 // Counts a kernel row that failed its reuse test, by cause (see failed_rows_off_screen), when counting.
 fn count_failed_row(off_screen: bool, no_data: bool) {
@@ -96,7 +128,7 @@ fn record_reads(pass_index: u32, texel: vec2<i32>) {
     record_reads_of(pass_index, texel, 1u);
 }
 
-// Adds `pixels` (0 or 1) and this invocation's reads to pass `pass_index`'s counts, when counting:
+// Adds `pixels` (0 or 1) and this invocation's reads and their bytes to pass `pass_index`'s counts, when counting:
 // 0 for a compute invocation past the screen's edge, which only loaded its share of a workgroup's
 // shared segment, so that the invocations counted are the screen's pixels in every variant.
 fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
@@ -104,6 +136,9 @@ fn record_reads_of(pass_index: u32, texel: vec2<i32>, pixels: u32) {
         let word = read_count_word(pass_index, texel);
         atomicAdd(&read_counts[word], pixels);
         atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(READ_BYTES_COUNTERS + pass_index, texel);
+        atomicAdd(&read_counts[bytes_word], pixels);
+        atomicAdd(&read_counts[bytes_word + 1u], read_bytes);
     }
 }
 
@@ -138,7 +173,7 @@ fn blocker_row(row_uv: vec2<f32>, half_width: f32, receiver: TapPlane, n: u32) -
     for (var i = 0u; i < n; i++) {
         let tap = row_uv + vec2<f32>(grid_offset(i, n) * half_width, 0.0);
         let depth = tap_depth(tap);
-        reads += 1u;
+        count_shadow_map_read();
         if (depth < tap_plane_depth(receiver, tap)) {
             sum += depth;
             count += 1.0;
@@ -231,7 +266,7 @@ fn tap_visibility(world: vec3<f32>, offset: vec3<f32>) -> f32 {
         return 0.0;
     }
     let uvd = light_uv_depth(frame, world + offset);
-    reads += 1u;
+    count_shadow_map_read();
     return select(0.0, 1.0, uvd.z <= tap_depth(uvd.xy));
 }
 

@@ -18,7 +18,7 @@ struct HorizontalBlockerOutput {
 fn sssm_horizontal_blocker(in: FullscreenVertex) -> HorizontalBlockerOutput {
     let point = screen_point(in);
     // The G-buffer's two texels, read at every pixel.
-    reads = 2u;
+    count_own_texels(false);
     let trivial = trivial_visibility(point);
     if (trivial >= 0.0) {
         record_reads(0u, point.texel);
@@ -34,7 +34,7 @@ fn partial_blocker(point: ScreenPoint) -> vec4<f32> {
     let uvd = light_uv_depth(frame, lookup);
     let receiver = compared_plane(lookup, point.normal, uvd.z);
     let hard = select(0.0, 1.0, uvd.z <= tap_depth(uvd.xy));
-    reads += 1u;
+    count_shadow_map_read();
     // The search window: the light back-projected through the near plane (every blocker lies beyond it), as in PCSS.
     let search = light_half_extent_uv(frame, frame.projection.z, uvd.z);
     let partial = blocker_row(uvd.xy, search.x, receiver, max(settings.blocker_kernel, 1u));

@@ -17,7 +17,7 @@
 // A blur tap's pixel read from step 2's vertical_tap_source: its horizontal result, and what the
 // β test and the bilateral weight compare.
 fn load_vertical_source(texel: vec2<i32>) -> BlurSource {
-    reads += 1u;
+    count_screen_target_read();
     return unpack_vertical_tap_source(textureLoad(vertical_tap_source, texel, 0));
 }
 

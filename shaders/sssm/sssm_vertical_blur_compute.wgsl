@@ -35,12 +35,13 @@ fn sssm_vertical_blur_columns(@builtin(workgroup_id) group: vec3<u32>, @builtin(
     var axes = BlurAxes(vec2<f32>(0.0), vec2<f32>(0.0));
     segment_line = texel.x;
     reads = 0u;
+    read_bytes = 0u;
     if (inside) {
         point = screen_point_at(texel);
         // (first blur, blockers' light depth or 0, the pixel's light depth, blocker rows reused or -1).
         own = textureLoad(horizontal_blur, texel, 0);
         // The G-buffer's two texels and step 2's, read at every pixel of the screen.
-        reads = 3u;
+        count_own_texels(true);
         if (own.w >= 0.0) {
             computed = true;
             axes = step_2_axes(point, own);

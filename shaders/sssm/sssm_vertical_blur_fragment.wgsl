@@ -20,7 +20,7 @@ fn sssm_vertical_blur(in: FullscreenVertex) -> VerticalBlurOutput {
     // (first blur, blockers' light depth or 0, the pixel's light depth, blocker rows reused or -1).
     let own = textureLoad(horizontal_blur, point.texel, 0);
     // The G-buffer's two texels and step 2's, read at every pixel.
-    reads = 3u;
+    count_own_texels(true);
     if (own.w < 0.0) {
         record_reads(2u, point.texel);
         return VerticalBlurOutput(own.x, -1.0);

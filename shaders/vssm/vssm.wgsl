@@ -40,17 +40,23 @@ struct VssmSettings {
 @group(2) @binding(1) var<uniform> settings: VssmSettings;
 // The depth map the table was built from, for its size and the normal offset's texel.
 @group(2) @binding(2) var shadow_map: texture_2d<f32>;
-// Counter 4 (after vssm_sat.wgsl's four): vssm_filter's (pixels, texel reads) per bucket
-// (common/read_counts.wgsl), written only with COUNT_READS (a counting frame,
-// TechniqueSetup::count_work).
+// Counters 6 and 7 (after vssm_sat.wgsl's six): vssm_filter's (pixels, texel reads) and (pixels,
+// bytes those fetched) per bucket (common/read_counts.wgsl), written only with COUNT_READS (a
+// counting frame, TechniqueSetup::count_work).
 @group(2) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
 // Texel reads of this invocation, each a textureLoad (1 texel, of 16 bytes in the table): the
 // G-buffer's two at every pixel, and every table entry loaded (table_at; an entry before the
 // table's first row or column is 0 and not loaded). The normal offset reads none (it takes the
 // map's size only). With one sub-region a query loads 16 entries (four columns of four),
-// neighbouring sub-regions share their columns: 8(k + 1) a row of k.
+// neighbouring sub-regions share their columns: 8(k + 1) a row of k. `read_bytes`: the bytes
+// those fetched, each texel at its format's size.
 var<private> reads: u32 = 0u;
+var<private> read_bytes: u32 = 0u;
+
+// Bytes of one texel of the G-buffer's position and normal (Rgba32Float: ssm-core's
+// GBuffer::POSITION_FORMAT and NORMAL_FORMAT).
+const GBUFFER_TEXEL_BYTES: u32 = 16u;
 
 // The table at texel (i, j): the moments' sums over [0, i] × [0, j]; 0 for i or j below 0.
 fn table_at(i: i32, j: i32) -> vec4<u32> {
@@ -59,6 +65,7 @@ fn table_at(i: i32, j: i32) -> vec4<u32> {
     }
     let last = i32(settings.size) - 1;
     reads += 1u;
+    read_bytes += TABLE_TEXEL_BYTES;
     return textureLoad(moment_table, vec2<i32>(min(i, last), min(j, last)), 0);
 }
 
@@ -253,11 +260,15 @@ fn blocker_search(uvd: vec3<f32>, extent: vec2<f32>, k: u32, receiver: TapPlane,
 fn vssm_filter(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
     reads = 2u;
+    read_bytes = 2u * GBUFFER_TEXEL_BYTES;
     let visibility = vssm_visibility(point);
     if (COUNT_READS) {
-        let word = read_count_word(4u, point.texel);
+        let word = read_count_word(6u, point.texel);
         atomicAdd(&read_counts[word], 1u);
         atomicAdd(&read_counts[word + 1u], reads);
+        let bytes_word = read_count_word(7u, point.texel);
+        atomicAdd(&read_counts[bytes_word], 1u);
+        atomicAdd(&read_counts[bytes_word + 1u], read_bytes);
     }
     return visibility;
 }

@@ -7,6 +7,10 @@
 // 4096² = 2^24 texels of moments below 2^27 sum to below 2^51, and 2^24 texels count below 2^26.
 // So the difference of two entries, taken modulo 2^128, holds each field of a region exactly.
 
+// Bytes of one texel of the table (Rgba32Uint: ssm-techniques/vssm's TABLE_FORMAT), for the
+// counted work's bytes read.
+const TABLE_TEXEL_BYTES: u32 = 16u;
+
 // Fixed-point scale of a moment in [0, 1]: a multiple of 8 just below 2^27 (f32 holds it exactly).
 const MOMENT_SCALE: f32 = 134217712.0;
 // The linear depth of a texel with no surface (common/shadow_map.wgsl's NO_SURFACE).

@@ -20,21 +20,30 @@
 @group(1) @binding(3) var table_out: texture_storage_2d<rgba32uint, write>;
 // Both passes: (threads, count) per bucket (common/read_counts.wgsl), written only with
 // COUNT_READS (a counting frame, TechniqueSetup::count_work). Counters: 0 the rows pass's texel
-// reads, 1 its storage bytes, 2 and 3 the columns pass's. Each thread loads one texel (a
-// textureLoad) and stores one rgba32uint texel (16 bytes) per texel of its row or column.
+// reads, 1 the bytes they fetched, 2 its storage bytes, 3 to 5 the columns pass's. Each thread
+// loads one texel (a textureLoad: an r32float depth of 4 bytes in the rows pass, an rgba32uint
+// row sum of 16 in the columns pass) and stores one rgba32uint texel (16 bytes) per texel of its
+// row or column.
 @group(1) @binding(4) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// Adds one thread's `texels` loaded and stored to the counters from `counter` (reads) on; the
-// bucket is chosen by the thread's row or column.
-fn record_sat_work(counter: u32, line: u32, texels: u32) {
+// Bytes of one texel of the depth map (R32Float: ssm-core's LightDepthMap::FORMAT).
+const DEPTH_TEXEL_BYTES: u32 = 4u;
+
+// Adds one counter's `amount` for the thread of row or column `line` (its bucket).
+fn record_sat_count(counter: u32, line: u32, amount: u32) {
     if (COUNT_READS) {
-        let reads_word = read_count_word(counter, vec2<i32>(0, i32(line)));
-        atomicAdd(&read_counts[reads_word], 1u);
-        atomicAdd(&read_counts[reads_word + 1u], texels);
-        let bytes_word = read_count_word(counter + 1u, vec2<i32>(0, i32(line)));
-        atomicAdd(&read_counts[bytes_word], 1u);
-        atomicAdd(&read_counts[bytes_word + 1u], 16u * texels);
+        let word = read_count_word(counter, vec2<i32>(0, i32(line)));
+        atomicAdd(&read_counts[word], 1u);
+        atomicAdd(&read_counts[word + 1u], amount);
     }
+}
+
+// Adds one thread's `texels` loaded, of `texel_bytes` each, and stored to the counters from
+// `counter` (reads) on.
+fn record_sat_work(counter: u32, line: u32, texels: u32, texel_bytes: u32) {
+    record_sat_count(counter, line, texels);
+    record_sat_count(counter + 1u, line, texel_bytes * texels);
+    record_sat_count(counter + 2u, line, TABLE_TEXEL_BYTES * texels);
 }
 
 @compute @workgroup_size(64)
@@ -49,7 +58,7 @@ fn vssm_sat_rows(@builtin(global_invocation_id) id: vec3<u32>) {
         sums = add_sums(sums, texel_value(textureLoad(depth_map, texel, 0).x, frame.projection.w));
         textureStore(row_sums_out, texel, sums);
     }
-    record_sat_work(0u, id.x, size.x);
+    record_sat_work(0u, id.x, size.x, DEPTH_TEXEL_BYTES);
 }
 
 @compute @workgroup_size(64)
@@ -64,5 +73,5 @@ fn vssm_sat_columns(@builtin(global_invocation_id) id: vec3<u32>) {
         sums = add_sums(sums, textureLoad(row_sums, texel, 0));
         textureStore(table_out, texel, sums);
     }
-    record_sat_work(2u, id.x, size.y);
+    record_sat_work(3u, id.x, size.y, TABLE_TEXEL_BYTES);
 }

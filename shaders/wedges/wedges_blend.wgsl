@@ -40,8 +40,10 @@
 // Blending modes.
 const BLENDING_NONE: u32 = 0u;
 
-// Texels this invocation read and bytes it stored, for the counts (wedges_counts.wgsl).
+// Texels this invocation read, the bytes they fetched and the bytes it stored, for the counts
+// (wedges_counts.wgsl).
 var<private> reads: u32;
+var<private> read_bytes: u32;
 var<private> stored: u32;
 
 // A rectangle (xmin, xmax, ymin, ymax) from its stored form (1 - xmin, xmax, 1 - ymin, ymax);
@@ -78,6 +80,7 @@ fn fill(area: f32, rect: vec4<f32>) -> f32 {
 // Radial part `part`'s stored rectangle at `pixel` in the final buffer.
 fn final_rectangle(part: u32, pixel: u32) -> vec4<f32> {
     reads += 1u;
+    read_bytes += FINAL_ELEMENT_BYTES;
     switch (part) {
         case 0u: {
             return final_rectangles0[pixel];
@@ -117,11 +120,13 @@ fn blend(texel: vec2<i32>, umbra: bool) {
     let inner01 = textureLoad(silhouette_inner01, texel, 0);
     let inner23 = textureLoad(silhouette_inner23, texel, 0);
     reads += 3u;
+    read_bytes += 3u * SILHOUETTE_TEXEL_BYTES;
     if (!umbra && max(max(area.x, area.y), max(area.z, area.w)) <= 0.0) {
         return;
     }
     // The four rectangles and the final areas.
     reads += 5u;
+    read_bytes += 4u * SILHOUETTE_TEXEL_BYTES + FINAL_ELEMENT_BYTES;
     var rects = array<vec4<f32>, 4>(
         textureLoad(silhouette_rect0, texel, 0),
         textureLoad(silhouette_rect1, texel, 0),
@@ -180,11 +185,12 @@ fn wedges_blend(@builtin(global_invocation_id) id: vec3<u32>) {
     if (shaded > 0u) {
         fragment_counts[id.y * size.x + id.x] += shaded;
         reads += 1u;
+        read_bytes += FRAGMENT_COUNT_BYTES;
         stored += 4u;
     }
     blend(texel, textureLoad(umbra_mask, texel, 0).x > 0.5);
     // The shaded count and the umbra mask, besides what the blend read.
-    record_count(COUNTER_BLEND_READS, texel, reads + 2u);
+    record_reads(COUNTER_BLEND_READS, texel, reads + 2u, read_bytes + SHADED_COUNT_TEXEL_BYTES + UMBRA_MASK_TEXEL_BYTES);
     record_count(COUNTER_BLEND_STORAGE_BYTES, texel, stored);
 }
 
@@ -200,7 +206,8 @@ fn wedges_resolve(in: FullscreenVertex) -> @location(0) f32 {
     let point = screen_point(in);
     let trivial = trivial_visibility(point);
     // The G-buffer's two texels, and the final areas where the pixel needs them.
-    record_count(COUNTER_RESOLVE_READS, point.texel, select(3u, 2u, trivial >= 0.0));
+    let texels = select(3u, 2u, trivial >= 0.0);
+    record_reads(COUNTER_RESOLVE_READS, point.texel, texels, 2u * GBUFFER_TEXEL_BYTES + (texels - 2u) * FINAL_ELEMENT_BYTES);
     if (trivial >= 0.0) {
         return trivial;
     }

@@ -26,7 +26,9 @@ fn wedges_depth_copy(in: FullscreenVertex) -> @builtin(frag_depth) f32 {
     let depth = textureLoad(gbuffer_depth, texel, 0);
     let position = textureLoad(gbuffer_position, texel, 0);
     // The depth and the position, and the normal where a surface covers the pixel.
-    record_count(COUNTER_DEPTH_COPY_READS, texel, select(2u, 3u, position.w >= 0.5));
+    let covered = position.w >= 0.5;
+    let bytes = GBUFFER_DEPTH_BYTES + select(1u, 2u, covered) * GBUFFER_TEXEL_BYTES;
+    record_reads(COUNTER_DEPTH_COPY_READS, texel, select(2u, 3u, covered), bytes);
     if (position.w < 0.5) {
         return depth;
     }

@@ -323,7 +323,8 @@ fn wedge_fragment(in: WedgeVarying) -> WedgeTargets {
     let texel = vec2<i32>(in.clip.xy);
     let position = textureLoad(gbuffer_position, texel, 0);
     // The position, and the normal where a surface covers the pixel.
-    record_count(COUNTER_WEDGE_READS, texel, select(1u, 2u, position.w >= 0.5));
+    let reads = select(1u, 2u, position.w >= 0.5);
+    record_reads(COUNTER_WEDGE_READS, texel, reads, reads * GBUFFER_TEXEL_BYTES);
     if (position.w < 0.5) {
         discard;
     }

@@ -249,5 +249,5 @@ fn the_papers_cpu_step_has_its_own_column() {
         }
     }
     let table = std::fs::read_to_string(out.join("sweep.md")).unwrap();
-    assert!(table.lines().nth(2).is_some_and(|header| header.ends_with("| CPU step ms |")), "{table}");
+    assert!(table.lines().nth(2).is_some_and(|header| header.contains("| CPU step ms |")), "{table}");
 }

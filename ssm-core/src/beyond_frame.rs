@@ -43,8 +43,10 @@ pub const BEYOND_FRAME_DIAGNOSTIC: &str = "pixels_beyond_frame";
 /// unclamped at grazing angles).
 const SIDE_FACE_RECEIVER_BIAS_TEXELS: f32 = 0.75;
 
-/// What the pass counts in a counting frame, in the order its shader indexes them.
-const COUNTERS: &[(&str, &str)] = &[(BEYOND_FRAME_PASS, "reads"), (BEYOND_FRAME_PASS, "storage_bytes")];
+/// What the pass counts in a counting frame, in the order its shader indexes them: its texel reads,
+/// the bytes it stores, and the bytes its reads fetched (the G-buffer's Rgba32Float texels, 16
+/// bytes each, and a side face's R32Float, 4).
+const COUNTERS: &[(&str, &str)] = &[(BEYOND_FRAME_PASS, "reads"), (BEYOND_FRAME_PASS, "storage_bytes"), (BEYOND_FRAME_PASS, "read_bytes")];
 
 /// The label of the beyond-frame pass run after technique `technique`: `<technique>_beyond_frame`.
 #[must_use]
@@ -191,5 +193,26 @@ impl BeyondFrame {
             pass.pass.clone_from(&self.label);
         }
         Ok(work)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{GBuffer, LightDepthMap, VISIBILITY_FORMAT};
+
+    /// The shader counts each texel it reads at its format's size (the side faces are
+    /// [`LightDepthMap`]s).
+    #[test]
+    fn the_shaders_texel_bytes_are_the_formats_sizes() {
+        for (constant, format) in [
+            ("GBUFFER_TEXEL_BYTES", GBuffer::POSITION_FORMAT),
+            ("GBUFFER_TEXEL_BYTES", GBuffer::NORMAL_FORMAT),
+            ("SIDE_FACE_TEXEL_BYTES", LightDepthMap::FORMAT),
+            ("VISIBILITY_TEXEL_BYTES", VISIBILITY_FORMAT),
+        ] {
+            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
+            let line = format!("const {constant}: u32 = {bytes}u;");
+            assert!(ssm_shaders::core::BEYOND_FRAME.contains(&line), "beyond_frame.wgsl lacks `{line}` ({format:?})");
+        }
     }
 }

@@ -34,8 +34,10 @@ pub fn own_surface_share_label(technique: &str) -> String {
 }
 
 /// What the pass counts in a counting frame, in the order its shader indexes them (renamed after
-/// the technique when read back).
-const COUNTERS: &[(&str, &str)] = &[(OWN_SURFACE_SHARE_PASS, "reads"), (OWN_SURFACE_SHARE_PASS, "storage_bytes")];
+/// the technique when read back): its texel reads, the bytes it stores, and the bytes its reads
+/// fetched (the G-buffer's Rgba32Float texels, 16 bytes each, and the visibility's R32Float, 4).
+const COUNTERS: &[(&str, &str)] =
+    &[(OWN_SURFACE_SHARE_PASS, "reads"), (OWN_SURFACE_SHARE_PASS, "storage_bytes"), (OWN_SURFACE_SHARE_PASS, "read_bytes")];
 
 /// The pass, built for one technique's visibility targets.
 pub(crate) struct OwnSurfaceShare {
@@ -118,5 +120,24 @@ impl OwnSurfaceShare {
             pass.pass.clone_from(&self.label);
         }
         Ok(work)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{GBuffer, VISIBILITY_FORMAT};
+
+    /// The shader counts each texel it reads at its format's size.
+    #[test]
+    fn the_shaders_texel_bytes_are_the_formats_sizes() {
+        for (constant, format) in [
+            ("GBUFFER_TEXEL_BYTES", GBuffer::POSITION_FORMAT),
+            ("GBUFFER_TEXEL_BYTES", GBuffer::NORMAL_FORMAT),
+            ("VISIBILITY_TEXEL_BYTES", VISIBILITY_FORMAT),
+        ] {
+            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
+            let line = format!("const {constant}: u32 = {bytes}u;");
+            assert!(ssm_shaders::core::OWN_SURFACE_SHARE.contains(&line), "own_surface_share.wgsl lacks `{line}` ({format:?})");
+        }
     }
 }

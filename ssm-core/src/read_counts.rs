@@ -9,8 +9,9 @@
 //! `count_reads` parameter asks, and build their pipelines with
 //! [`ReadCounts::pipeline_constants`], so that otherwise the counting code is
 //! compiled out). Each pass's counts are spread over [`READ_COUNT_BUCKETS`]
-//! pairs, chosen by pixel, so that a 32-bit read count
-//! holds a 4K frame's 2,522 reads per pixel and the atomics contend less.
+//! pairs, chosen by pixel, so that a 32-bit count holds the bytes of a 4K
+//! frame's 2,522 four-byte reads per pixel over three lights (about 10⁹ a
+//! bucket) and the atomics contend less.
 //! Cleared at the first light of each frame, so the figures cover one
 //! frame's lights.
 //!
@@ -22,7 +23,7 @@ use crate::work::ShaderWork;
 use crate::{Frame, GpuContext};
 
 /// Buckets (pairs of pixel and read counts) per pass.
-pub const READ_COUNT_BUCKETS: usize = 64;
+pub const READ_COUNT_BUCKETS: usize = 256;
 
 /// Per-pass (pixels, reads) counters in one storage buffer: pass `k`, bucket `b` at words
 /// `2(k·B + b)` and `2(k·B + b) + 1`, B = [`READ_COUNT_BUCKETS`].

@@ -263,12 +263,13 @@ const COUNTER_BYTES: u64 = READ_COUNT_BUCKETS as u64 * 8;
 /// pass that did not run).
 struct CounterPlan {
     counters: Vec<(&'static str, &'static str)>,
-    /// The receiver map's max-pyramid: reads, storage bytes (when it runs).
+    /// The receiver map's max-pyramid: reads, their bytes, storage bytes (when it runs).
     receiver_bounds: Option<u32>,
-    /// Per side: its occluder map's min-max pyramid (reads, storage bytes; when merging), its list
-    /// pass (reads, atomics, storage bytes) and its accumulation (reads).
+    /// Per side: its occluder map's min-max pyramid (reads, their bytes, storage bytes; when
+    /// merging), its list pass (reads, their bytes, atomics, storage bytes) and its accumulation
+    /// (reads, their bytes).
     sides: Vec<SideCounters>,
-    /// The projection: reads.
+    /// The projection: reads, their bytes.
     project: u32,
 }
 
@@ -280,10 +281,18 @@ struct SideCounters {
 }
 
 /// Counters of a pyramid pass, a list pass and an accumulation or projection pass, in their
-/// shaders' order.
-const PYRAMID_UNITS: &[&str] = &["reads", "storage_bytes"];
-const PATCHES_UNITS: &[&str] = &["reads", "atomics", "storage_bytes"];
-const READS_ONLY: &[&str] = &["reads"];
+/// shaders' order: every pass that counts its texel reads counts the bytes they fetched beside
+/// them (each read its texture's texel size, from the formats: [`texel_bytes`]).
+const PYRAMID_UNITS: &[&str] = &["reads", "read_bytes", "storage_bytes"];
+const PATCHES_UNITS: &[&str] = &["reads", "read_bytes", "atomics", "storage_bytes"];
+const READS: &[&str] = &["reads", "read_bytes"];
+
+/// Bytes of one texel of `format`: what a read of it fetches, as the shaders count it (their
+/// `*_TEXEL_BYTES` overrides, set from the textures' formats since the receiver map and the soft
+/// shadow maps change format with the settings).
+fn texel_bytes(format: wgpu::TextureFormat) -> f64 {
+    f64::from(format.block_copy_size(None).unwrap_or(0))
+}
 
 impl CounterPlan {
     fn new(settings: &AttySettings, sides: &[Side]) -> Self {
@@ -299,10 +308,10 @@ impl CounterPlan {
             .map(|side| SideCounters {
                 patch_merge: (settings.merge_tolerance > 0.0).then(|| add(side.patch_merge, PYRAMID_UNITS)),
                 patches: add(side.patches, PATCHES_UNITS),
-                accumulate: add(side.accumulate, READS_ONLY),
+                accumulate: add(side.accumulate, READS),
             })
             .collect();
-        let project = add(PROJECT_LABEL, READS_ONLY);
+        let project = add(PROJECT_LABEL, READS);
         Self { counters, receiver_bounds, sides, project }
     }
 }
@@ -368,12 +377,13 @@ const RECEIVER_BOUNDS: PyramidKind = PyramidKind {
 };
 
 impl DepthPyramid {
-    /// The pyramid of `kind` over `map`, `size`² texels at level 0 (1 where it is bound but not read),
-    /// counting into `counts` (its slice of `read_counts`: reads, storage bytes).
+    /// The pyramid of `kind` over `map` (of format `map_format`), `size`² texels at level 0 (1
+    /// where it is bound but not read), counting into `counts` (its slice of `read_counts`: reads,
+    /// their bytes, storage bytes).
     fn new(
         setup: &TechniqueSetup<'_>,
         (kind, label): (&PyramidKind, &'static str),
-        map: &wgpu::TextureView,
+        (map, map_format): (&wgpu::TextureView, wgpu::TextureFormat),
         size: u32,
         (read_counts, counts): (&ReadCounts, wgpu::BindingResource<'_>),
     ) -> Result<Self> {
@@ -419,7 +429,9 @@ impl DepthPyramid {
             })
             .collect();
         let module = create_shader_with_imports(setup.gpu, &format!("{}_shader", kind.label), kind.shader, LOCAL_SHADERS)?;
-        let constants = read_counts.pipeline_constants();
+        // The bytes a texel read fetches: level 0 reads the map, each level above the one below.
+        let [count_reads] = read_counts.pipeline_constants();
+        let constants = [count_reads, ("MAP_TEXEL_BYTES", texel_bytes(map_format)), ("PYRAMID_TEXEL_BYTES", texel_bytes(kind.format))];
         let base = compute_pipeline(device, &format!("{}_pipeline", kind.base), &module, kind.base, &[&layout], &constants);
         let reduce = compute_pipeline(device, &format!("{}_pipeline", kind.reduce), &module, kind.reduce, &[&layout], &constants);
         let messages = setup.gpu.take_errors();
@@ -466,6 +478,14 @@ impl ReceiverMap {
         match self {
             Self::Depth(map) => &map.linear_depth_view,
             Self::Planes(map) => &map.view,
+        }
+    }
+
+    /// The format of [`ReceiverMap::view`]'s texture.
+    const fn format(&self) -> wgpu::TextureFormat {
+        match self {
+            Self::Depth(_) => LightDepthMap::FORMAT,
+            Self::Planes(_) => ReceiverPlaneMap::FORMAT,
         }
     }
 
@@ -609,11 +629,11 @@ impl SoftShadowMaps {
         let plan = CounterPlan::new(&settings, sides);
         let read_counts = ReadCounts::with_units(&setup.gpu.device, "atty_read_counts", &plan.counters, setup.count_work);
         // Unbounded, the accumulation still binds a pyramid, of one texel, that it never reads (nor
-        // builds: its counter slice is the first two counters, never written by it).
+        // builds: its counter slice is the first counters, never written by it).
         let receiver_bounds = DepthPyramid::new(
             setup,
             (&RECEIVER_BOUNDS, RECEIVER_BOUNDS.label),
-            receiver_map.view(),
+            (receiver_map.view(), receiver_map.format()),
             if bounded { settings.ssm_size } else { 1 },
             (&read_counts, counter_slice(&read_counts, plan.receiver_bounds.unwrap_or(0), PYRAMID_UNITS.len())),
         )?;
@@ -623,10 +643,15 @@ impl SoftShadowMaps {
             (receiver_map.view(), &receiver_bounds.view),
             (&settings_buffer, &read_counts),
         )?;
-        let accumulate_pipeline = Self::accumulate_pipeline(setup, settings.accumulation, &read_counts)?;
+        let accumulate_pipeline = Self::accumulate_pipeline(setup, (settings.accumulation, receiver_map.format()), &read_counts)?;
         let patches_pipeline = Self::patches_pipeline(setup, &read_counts)?;
-        let (project, project_group) =
-            Self::projection(setup, &accumulations, &receiver_map, &settings_buffer, (&read_counts, plan.project))?;
+        let (project, project_group) = Self::projection(
+            setup,
+            (&accumulations, settings.accumulation),
+            &receiver_map,
+            &settings_buffer,
+            (&read_counts, plan.project),
+        )?;
         Ok(Self {
             receiver_map,
             receiver_bounds: bounded.then_some(receiver_bounds),
@@ -659,12 +684,12 @@ impl SoftShadowMaps {
                     unbiased_depth_map(setup, side.occluder_map, settings.occluder_map_size, Geometry::Occluders, (side.cull, farthest))?;
                 let merging = settings.merge_tolerance > 0.0;
                 // Without merging, the accumulation still binds a pyramid, of one texel, that it
-                // never reads (nor builds: its counter slice is the first two counters, never
-                // written by it).
+                // never reads (nor builds: its counter slice is the first counters, never written
+                // by it).
                 let patch_merge = DepthPyramid::new(
                     setup,
                     (&PATCH_MERGE, side.patch_merge),
-                    &occluder_map.linear_depth_view,
+                    (&occluder_map.linear_depth_view, LightDepthMap::FORMAT),
                     if merging { settings.occluder_map_size } else { 1 },
                     (read_counts, counter_slice(read_counts, counters.patch_merge.unwrap_or(0), PYRAMID_UNITS.len())),
                 )?;
@@ -713,7 +738,7 @@ impl SoftShadowMaps {
                         patches.as_entire_binding(),
                         wgpu::BindingResource::TextureView(receivers),
                         settings_buffer.as_entire_binding(),
-                        counter_slice(read_counts, counters.accumulate, READS_ONLY.len()),
+                        counter_slice(read_counts, counters.accumulate, READS.len()),
                     ],
                 );
                 Ok(SideAccumulation {
@@ -758,13 +783,21 @@ impl SoftShadowMaps {
     fn patches_pipeline(setup: &TechniqueSetup<'_>, read_counts: &ReadCounts) -> Result<wgpu::ComputePipeline> {
         let device = &setup.gpu.device;
         let module = create_shader_with_imports(setup.gpu, "atty_patches_shader", PATCHES_SHADER, LOCAL_SHADERS)?;
+        // The bytes a texel read fetches: of the occluder map and of the two pyramids.
+        let [count_reads] = read_counts.pipeline_constants();
+        let constants = [
+            count_reads,
+            ("OCCLUDER_TEXEL_BYTES", texel_bytes(LightDepthMap::FORMAT)),
+            ("BOUNDS_TEXEL_BYTES", texel_bytes(RECEIVER_BOUNDS.format)),
+            ("MERGE_TEXEL_BYTES", texel_bytes(PATCH_MERGE.format)),
+        ];
         let pipeline = compute_pipeline(
             device,
             "atty_patches_pipeline",
             &module,
             "atty_patches",
             &[setup.gpu.uniform_layout(), &Self::patches_layout(device)],
-            &read_counts.pipeline_constants(),
+            &constants,
         );
         let messages = setup.gpu.take_errors();
         if !messages.is_empty() {
@@ -774,13 +807,16 @@ impl SoftShadowMaps {
     }
 
     /// The instanced micro-patch pipeline: one quad per occluder texel, summed by additive
-    /// blending into the float SSM (Sec. 4.1).
+    /// blending into the float SSM (Sec. 4.1), reading the receiver map (of `receiver_format`).
     fn accumulate_pipeline(
         setup: &TechniqueSetup<'_>,
-        accumulation: Accumulation,
+        (accumulation, receiver_format): (Accumulation, wgpu::TextureFormat),
         read_counts: &ReadCounts,
     ) -> Result<wgpu::RenderPipeline> {
         let device = &setup.gpu.device;
+        // The bytes a fragment's receiver texel fetches.
+        let [count_reads] = read_counts.pipeline_constants();
+        let constants = [count_reads, ("RECEIVER_TEXEL_BYTES", texel_bytes(receiver_format))];
         let module = create_shader_with_imports(setup.gpu, "atty_accumulate_shader", ACCUMULATE_SHADER, LOCAL_SHADERS)?;
         let layout = Self::accumulate_layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -808,10 +844,7 @@ impl SoftShadowMaps {
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("atty_patch_fragment"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &read_counts.pipeline_constants(),
-                    ..Default::default()
-                },
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 targets: &[Some(wgpu::ColorTargetState {
                     format: accumulation.format(),
                     blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
@@ -823,10 +856,11 @@ impl SoftShadowMaps {
         }))
     }
 
-    /// The projection of the SSM (the larger occlusion of both sides) onto the screen.
+    /// The projection of the SSM (the larger occlusion of both sides, summed in `accumulation`'s
+    /// format) onto the screen.
     fn projection(
         setup: &TechniqueSetup<'_>,
-        accumulations: &[SideAccumulation],
+        (accumulations, accumulation): (&[SideAccumulation], Accumulation),
         receiver_map: &ReceiverMap,
         settings_buffer: &wgpu::Buffer,
         (read_counts, first_counter): (&ReadCounts, u32),
@@ -851,19 +885,21 @@ impl SoftShadowMaps {
                 wgpu::BindingResource::TextureView(back),
                 wgpu::BindingResource::TextureView(receiver_map.view()),
                 settings_buffer.as_entire_binding(),
-                counter_slice(read_counts, first_counter, READS_ONLY.len()),
+                counter_slice(read_counts, first_counter, READS.len()),
             ],
         );
         let module = create_shader_with_imports(setup.gpu, "atty_project_shader", PROJECT_SHADER, LOCAL_SHADERS)?;
-        let project = ScreenPass::new(
-            setup,
-            NAME,
-            PROJECT_LABEL,
-            (&module, "atty_project"),
-            Some(&layout),
-            VISIBILITY_FORMAT.into(),
-            &read_counts.pipeline_constants(),
-        )?;
+        // The bytes a texel read fetches: of the G-buffer (its normal has its position's format:
+        // a test below), the receiver map and the soft shadow maps.
+        let [count_reads] = read_counts.pipeline_constants();
+        let constants = [
+            count_reads,
+            ("GBUFFER_TEXEL_BYTES", texel_bytes(ssm_core::GBuffer::POSITION_FORMAT)),
+            ("RECEIVER_TEXEL_BYTES", texel_bytes(receiver_map.format())),
+            ("SOFT_SHADOW_TEXEL_BYTES", texel_bytes(accumulation.format())),
+        ];
+        let project =
+            ScreenPass::new(setup, NAME, PROJECT_LABEL, (&module, "atty_project"), Some(&layout), VISIBILITY_FORMAT.into(), &constants)?;
         Ok((project, group))
     }
 }
@@ -1125,5 +1161,26 @@ mod tests {
         assert!(requirements(&params).unwrap().features.is_empty(), "f16 blends on any device");
         params.set("occluder_map_size", "2048").unwrap();
         assert_eq!(requirements(&params).unwrap().max_texture_size, 2048);
+    }
+
+    /// The bytes a read fetches are its texture's texel size: the projection counts the G-buffer's
+    /// normal at its position's, which is the same format; the receiver map and the soft shadow
+    /// maps follow the settings.
+    #[test]
+    fn the_texel_sizes_are_the_formats() {
+        assert_eq!(ssm_core::GBuffer::POSITION_FORMAT, ssm_core::GBuffer::NORMAL_FORMAT);
+        assert_eq!(texel_bytes(ssm_core::GBuffer::POSITION_FORMAT), 16.0);
+        assert_eq!((texel_bytes(Accumulation::F32.format()), texel_bytes(Accumulation::F16.format())), (4.0, 2.0));
+        assert_eq!((texel_bytes(LightDepthMap::FORMAT), texel_bytes(ReceiverPlaneMap::FORMAT)), (4.0, 16.0));
+        assert_eq!((texel_bytes(RECEIVER_BOUNDS.format), texel_bytes(PATCH_MERGE.format)), (4.0, 8.0));
+    }
+
+    /// Every pass that counts its texel reads counts their bytes, in the order its shader
+    /// records them (reads first, their bytes next).
+    #[test]
+    fn every_counter_of_reads_has_one_of_bytes_after_it() {
+        for units in [PYRAMID_UNITS, PATCHES_UNITS, READS] {
+            assert_eq!(&units[..2], ["reads", "read_bytes"], "{units:?}");
+        }
     }
 }

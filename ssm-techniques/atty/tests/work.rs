@@ -1,8 +1,12 @@
 //! Atty's counted work (`--count-work`, issue #40) against counts made by hand on
 //! `parallel-square`, where every quantity is known: the occluder square's texels in the
 //! occluder map, the pyramids' sizes, and which pixels show the receiver. Conventions
-//! (`shaders/atty/atty_counts.wgsl`): a textureLoad is one texel read, a storage-texture store its
-//! format's texel size, a listed micro-patch one atomic and a 32-byte record.
+//! (`shaders/atty/atty_counts.wgsl`): a textureLoad is one texel read, which fetches its format's
+//! texel size (bytes read: the G-buffer's Rgba32Float 16; the occluder map's and the plain receiver
+//! map's R32Float 4, the receiver planes' Rgba32Float 16; the receiver bounds' R32Float 4, the merge
+//! pyramid's Rg32Float 8; the soft shadow maps' R32Float 4, or R16Float 2 with f16 accumulation), a
+//! storage-texture store its format's texel size, a listed micro-patch one atomic and a 32-byte
+//! record.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -22,6 +26,11 @@ fn counted(settings: &[(&str, &str)]) -> (Rendered, FrameWork) {
     let work = rendered.renderer.count_work(&ssm_atty::INFO, &params).unwrap();
     println!("{}", work.passes_column());
     assert!(work.shader_counts && work.pipeline_statistics, "atty counts in its shaders, and lavapipe has pipeline statistics");
+    // Every pass that reads counts the bytes it read, so the frame's bytes read are known
+    // (ssm-bench's Totals::read_bytes: only where every reading pass counts them).
+    for p in work.passes.iter().filter(|p| p.texel_reads > 0) {
+        assert!(p.read_bytes > 0, "{} reads {} texels and counts no bytes", p.name, p.texel_reads);
+    }
     (rendered, work)
 }
 
@@ -114,7 +123,8 @@ fn reduce_texels(n: u32) -> u64 {
 /// reads one occluder texel per texel and lists one patch per occluder texel, which the
 /// accumulation draws as a 4-vertex strip (two primitives, by the pipeline statistics: a count
 /// independent of the shader's) covering its penumbra rectangle ([`accumulation_fragments`]);
-/// each accumulation fragment reads one receiver texel. (lavapipe's pipeline statistics count
+/// each accumulation fragment reads one receiver texel; every read here is of an R32Float texel, 4
+/// bytes (the occluder map, the plain receiver map). (lavapipe's pipeline statistics count
 /// more fragment invocations than that, 4,352 against 1,024 here: it counts helper invocations of
 /// partly covered quads, many for rectangles a few texels wide.)
 #[test]
@@ -126,11 +136,13 @@ fn the_paper_mode_lists_one_patch_per_occluder_texel_and_reads_one_texel_per_fra
     let patches = pass(&work, "atty_accumulate_patches");
     assert_eq!(patches.counted_invocations, u64::from(n * n), "one invocation per occluder-map texel");
     assert_eq!(patches.texel_reads, u64::from(n * n), "each reads its own texel only");
+    assert_eq!(patches.read_bytes, 4 * u64::from(n * n), "an R32Float texel each");
     assert_eq!((patches.atomics, patches.storage_bytes), (texels, 32 * texels), "one patch per occluder texel");
     let accumulate = pass(&work, "atty_accumulate");
     assert_eq!((accumulate.primitives, accumulate.vertex_invocations), (2 * texels, 4 * texels), "one strip per patch");
     let fragments = accumulation_fragments(n, s);
     assert_eq!((accumulate.counted_invocations, accumulate.texel_reads), (fragments, fragments), "one receiver texel per fragment");
+    assert_eq!(accumulate.read_bytes, 4 * fragments, "the receiver map's R32Float texels");
     assert!(fragments <= accumulate.fragment_invocations, "the pipeline statistics count helper invocations too");
     for unbuilt in ["atty_patch_merge", "atty_receiver_bounds"] {
         assert!(work.passes.iter().all(|p| p.name != unbuilt), "{unbuilt} does not run in this mode");
@@ -143,6 +155,10 @@ fn the_paper_mode_lists_one_patch_per_occluder_texel_and_reads_one_texel_per_fra
 /// receiver (none left to the shared rules here: nothing is closed, everything is in front of the
 /// light and inside its frame, and no receiver lies behind another) one receiver-map texel for
 /// the hidden test and, for each of the four bilinear texels, its plane and both soft shadow maps.
+/// In bytes: the merge pyramid's base reads the occluder map (R32Float, 4) and its reduce levels
+/// Rg32Float texels (8); the bounds' base reads the receiver planes (Rgba32Float, 16) and its reduce
+/// levels R32Float texels (4); the projection's P pixels 2·16 and its R receiver pixels 16 + 4·(16 +
+/// 2·4) with f32 soft shadow maps: 32·P + 112·R; each accumulation fragment one plane, 16.
 #[test]
 fn the_pyramids_and_the_projection_read_what_their_sizes_and_the_receiver_pixels_say() {
     let (n, s) = (64u32, 128u32);
@@ -152,11 +168,13 @@ fn the_pyramids_and_the_projection_read_what_their_sizes_and_the_receiver_pixels
     assert_eq!(merge.counted_invocations, merge_texels);
     assert_eq!(merge.texel_reads, u64::from(n * n) + 4 * reduce_texels(n));
     assert_eq!(merge.storage_bytes, 8 * merge_texels, "one Rg32Float texel per pyramid texel");
+    assert_eq!(merge.read_bytes, 4 * u64::from(n * n) + 8 * 4 * reduce_texels(n));
     let bounds = pass(&work, "atty_receiver_bounds");
     let bounds_texels = u64::from(s * s) + reduce_texels(s);
     assert_eq!(bounds.counted_invocations, bounds_texels);
     assert_eq!(bounds.texel_reads, u64::from(s * s) + 4 * reduce_texels(s));
     assert_eq!(bounds.storage_bytes, 4 * bounds_texels, "one R32Float texel per pyramid texel");
+    assert_eq!(bounds.read_bytes, 16 * u64::from(s * s) + 4 * 4 * reduce_texels(s), "planes at the base");
 
     let pixels = u64::from(SIZE.0 * SIZE.1);
     let receiver_pixels =
@@ -165,13 +183,50 @@ fn the_pyramids_and_the_projection_read_what_their_sizes_and_the_receiver_pixels
     let project = pass(&work, "atty_project");
     assert_eq!(project.counted_invocations, pixels);
     assert_eq!(project.texel_reads, 2 * pixels + (1 + 4 * 3) * receiver_pixels);
+    assert_eq!(project.read_bytes, 2 * 16 * pixels + (16 + 4 * (16 + 2 * 4)) * receiver_pixels);
     assert_eq!((project.atomics, project.storage_bytes), (0, 0), "the projection writes its render target only");
 
     // Merged patches are fewer than the occluder's texels, and still one strip each.
     let patches = pass(&work, "atty_accumulate_patches");
     let listed = patches.atomics;
     assert!(listed > 0 && listed < occluder_texels(n), "{listed} merged patches for {} texels", occluder_texels(n));
-    assert_eq!(pass(&work, "atty_accumulate").primitives, 2 * listed);
+    let accumulate = pass(&work, "atty_accumulate");
+    assert_eq!(accumulate.primitives, 2 * listed);
+    assert_eq!(accumulate.read_bytes, 16 * accumulate.texel_reads, "one receiver plane per fragment");
+}
+
+/// The bytes follow the formats the settings choose. With f16 accumulation the projection reads
+/// R16Float soft shadow maps (2 bytes a texel): 32·P + (16 + 4·(16 + 2·2))·R. Without receiver
+/// planes the receiver map is R32Float: the bounds' base reads 4 bytes a texel, each accumulation
+/// fragment 4, and the projection at a receiver pixel its receiver texel and, for each soft shadow
+/// map, four receiver texels and four soft shadow texels (and one more soft shadow texel where no
+/// receiver texel of the four is the point's): 32·P + (4 + 2·4·(4 + 2))·R + 2·(reads − 2P − 17·R).
+#[test]
+fn the_bytes_follow_the_formats_the_settings_choose() {
+    let (n, s) = (64u32, 128u32);
+    let sizes = [("occluder_map_size", n.to_string()), ("ssm_size", s.to_string())];
+    let with = |more: &[(&str, &str)]| {
+        let mut settings: Vec<(&str, &str)> = sizes.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        settings.extend_from_slice(more);
+        counted(&settings)
+    };
+    let (rendered, f16) = with(&[("accumulation", "f16")]);
+    let pixels = u64::from(SIZE.0 * SIZE.1);
+    let receiver_pixels =
+        rendered.coverage().iter().zip(rendered.receivers()).filter(|(covered, receives)| **covered && *receives).count() as u64;
+    let project = pass(&f16, "atty_project");
+    assert_eq!(project.texel_reads, 2 * pixels + 13 * receiver_pixels);
+    assert_eq!(project.read_bytes, 2 * 16 * pixels + (16 + 4 * (16 + 2 * 2)) * receiver_pixels, "R16Float soft shadow maps");
+
+    let (_, depth) = with(&[("accumulation", "f16"), ("receiver_plane", "false"), ("penumbra_bound", "receivers")]);
+    let bounds = pass(&depth, "atty_receiver_bounds");
+    assert_eq!(bounds.read_bytes, 4 * u64::from(s * s) + 4 * 4 * reduce_texels(s), "an R32Float receiver map");
+    let accumulate = pass(&depth, "atty_accumulate");
+    assert_eq!(accumulate.read_bytes, 4 * accumulate.texel_reads);
+    let project = pass(&depth, "atty_project");
+    let fallbacks = project.texel_reads - 2 * pixels - 17 * receiver_pixels;
+    assert!(fallbacks <= 2 * receiver_pixels, "{fallbacks} fallback reads");
+    assert_eq!(project.read_bytes, 2 * 16 * pixels + (4 + 2 * 4 * (4 + 2)) * receiver_pixels + 2 * fallbacks);
 }
 
 /// Two-sided (Sec. 3.5): each side has its own list, accumulation and merge pyramid, counted

@@ -49,8 +49,11 @@ pub const NAME: &str = "hard";
 
 /// The lookup shader.
 const SHADER: &str = ssm_shaders::hard::HARD;
-/// The lookup pass's label, and its read counter's.
+/// The lookup pass's label, and its read counters'.
 const LOOKUP_PASS: &str = "hard_lookup";
+/// What the lookup counts in a counting frame, in the order its shader indexes them: its texel
+/// reads and the bytes they fetched.
+const COUNTERS: &[(&str, &str)] = &[(LOOKUP_PASS, "reads"), (LOOKUP_PASS, "read_bytes")];
 
 /// Settings of [`HardShadowMapping`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]
@@ -84,7 +87,7 @@ pub struct HardShadowMapping {
     depth_map: LightDepthMap,
     lookup: ScreenPass,
     map_bind_group: wgpu::BindGroup,
-    /// The lookup's texel reads, counted in a counting frame only ([`TechniqueSetup::count_work`]).
+    /// The lookup's texel reads and their bytes, counted in a counting frame only ([`TechniqueSetup::count_work`]).
     read_counts: ReadCounts,
 }
 
@@ -99,8 +102,8 @@ impl HardShadowMapping {
         let depth_map = settings.bias.depth_map(setup, "hard_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "hard_settings_uniform", &HardSettingsUniform::from(&settings));
         // The shadow-map pass reads no texel (it rasterises the scene); the lookup reads the
-        // G-buffer and the map (shaders/hard/hard.wgsl says what it counts).
-        let read_counts = ReadCounts::new(device, "hard_read_counts", &[LOOKUP_PASS], setup.count_work);
+        // G-buffer and the map (shaders/hard/hard.wgsl says what it counts, in texels and bytes).
+        let read_counts = ReadCounts::with_units(device, "hard_read_counts", COUNTERS, setup.count_work);
         let map_layout = bind_group_layout(device, "hard_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,

@@ -94,7 +94,10 @@ fn every_builtin_scene_matches_its_exact_hard_shadow_up_to_the_edges() {
 /// G-buffer texels, and every covered pixel one shadow-map texel, as none is left to the shared
 /// rules on `parallel-square` (no closed mesh, every surface in front of the light); the normal
 /// offset reads none. One invocation per pixel: the full-screen triangle shades each once, and a
-/// helper invocation's atomics do nothing. The shadow-map pass reads no texel.
+/// helper invocation's atomics do nothing. The shadow-map pass reads no texel. In bytes, each
+/// texel costs its format's size (ssm-core's formats, not the shader's constants): with G the
+/// G-buffer's position and normal texels together (`Rgba32Float` each, 32 bytes) and D a depth
+/// texel of the map (`R32Float`, 4), G·P + D·C bytes, exactly.
 #[test]
 fn the_lookup_reads_two_gbuffer_texels_per_pixel_and_one_map_texel_per_covered_pixel() {
     let (width, height) = (96u32, 72u32);
@@ -112,6 +115,15 @@ fn the_lookup_reads_two_gbuffer_texels_per_pixel_and_one_map_texel_per_covered_p
     let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
     let lookup = pass("hard_lookup");
     assert_eq!((lookup.counted_invocations, lookup.texel_reads), (pixels, 2 * pixels + covered));
+    let size = |format: Option<u32>| u64::from(format.expect("a format with a texel size"));
+    let gbuffer =
+        size(ssm_core::GBuffer::POSITION_FORMAT.block_copy_size(None)) + size(ssm_core::GBuffer::NORMAL_FORMAT.block_copy_size(None));
+    let depth = size(ssm_core::LightDepthMap::FORMAT.block_copy_size(None));
+    assert_eq!(lookup.read_bytes, gbuffer * pixels + depth * covered, "bytes read");
+    // Every pass that reads counts its bytes, the framework's after hard's included.
+    for pass in work.passes.iter().filter(|pass| pass.texel_reads > 0) {
+        assert!(pass.read_bytes > 0, "{} reads {} texels and counts no bytes", pass.name, pass.texel_reads);
+    }
     assert_eq!((lookup.atomics, lookup.storage_bytes), (0, 0), "the lookup writes its render target only");
     assert_eq!(pass("hard_shadow_map").texel_reads, 0);
 }

@@ -55,8 +55,9 @@ const SHADER: &str = ssm_shaders::multi_sm::MULTI_SM;
 /// The accumulation pass's label.
 const ACCUMULATE_PASS: &str = "multi_sm_accumulate";
 /// What the accumulation counts in a counting frame, in the order its shader indexes them: texel
-/// reads and bytes stored (the clears and the K shadow-map passes read no texel).
-const COUNTERS: &[(&str, &str)] = &[(ACCUMULATE_PASS, "reads"), (ACCUMULATE_PASS, "storage_bytes")];
+/// reads, bytes stored and the bytes the reads fetched (the clears and the K shadow-map passes
+/// read no texel).
+const COUNTERS: &[(&str, &str)] = &[(ACCUMULATE_PASS, "reads"), (ACCUMULATE_PASS, "storage_bytes"), (ACCUMULATE_PASS, "read_bytes")];
 
 /// Settings of [`MultiShadowMaps`]: its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Settings)]

@@ -73,7 +73,11 @@ fn on_parallel_planes_k_maps_compute_the_midpoint_rule() {
 /// bytes): each of the K dispatches runs one invocation per pixel, which loads its two G-buffer
 /// texels and the visibility's running sum, and stores the sum; a covered pixel also loads one
 /// shadow-map texel, as none is left to the shared rules on `parallel-square` (no closed mesh,
-/// every surface in front of every sample). The K shadow-map passes read no texel.
+/// every surface in front of every sample). The K shadow-map passes read no texel. In bytes, each
+/// texel costs its format's size (ssm-core's formats, not the shader's constants): with G the
+/// G-buffer's position and normal texels together (`Rgba32Float` each, 32 bytes), V the
+/// visibility's (`R32Float`, 4) and D a shadow-map depth (`R32Float`, 4), K·((G + V)·P + D·C)
+/// bytes read, exactly.
 #[test]
 fn the_accumulation_counts_k_times_its_reads_and_stores_per_pixel() {
     let (width, height) = (96u32, 72u32);
@@ -96,6 +100,16 @@ fn the_accumulation_counts_k_times_its_reads_and_stores_per_pixel() {
         (k * pixels, k * (3 * pixels + covered), k * 4 * pixels)
     );
     assert_eq!(accumulate.atomics, 0);
+    let size = |format: Option<u32>| u64::from(format.expect("a format with a texel size"));
+    let gbuffer =
+        size(ssm_core::GBuffer::POSITION_FORMAT.block_copy_size(None)) + size(ssm_core::GBuffer::NORMAL_FORMAT.block_copy_size(None));
+    let visibility = size(ssm_core::VISIBILITY_FORMAT.block_copy_size(None));
+    let depth = size(ssm_core::LightDepthMap::FORMAT.block_copy_size(None));
+    assert_eq!(accumulate.read_bytes, k * ((gbuffer + visibility) * pixels + depth * covered), "bytes read");
+    // Every pass of multi-sm's that reads counts its bytes.
+    for pass in work.passes.iter().filter(|pass| pass.texel_reads > 0) {
+        assert!(pass.read_bytes > 0, "{} reads {} texels and counts no bytes", pass.name, pass.texel_reads);
+    }
     assert_eq!(pass("multi_sm_shadow_map").texel_reads, 0);
 }
 

@@ -66,6 +66,9 @@ const TILED_SHADER: &str = ssm_shaders::pcss::PCSS_TILED;
 const LOCAL_SHADERS: &[(&str, &str)] = &[("pcss/pcss_common.wgsl", COMMON_SHADER)];
 /// The label of the pass (both implementations), and of its read counts.
 const PASS: &str = "pcss_blocker_search_and_filter";
+/// What the pass counts, in the order its shaders index them (`record_pcss_reads_of` in
+/// `shaders/pcss/pcss_common.wgsl`): its texel reads and the bytes they fetched.
+const COUNTERS: &[(&str, &str)] = &[(PASS, "reads"), (PASS, "read_bytes")];
 
 /// Where a tap's depth comes from (the same texels, so the same pixels, either way).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Choice)]
@@ -164,7 +167,7 @@ impl Pcss {
         let depth_map = settings.bias.depth_map(setup, "pcss_shadow_map", settings.shadow_map_size)?;
         let settings_buffer = uniform_buffer(device, "pcss_settings_uniform", &PcssSettingsUniform::from(&settings));
         // Counting pipelines for count_reads, and for the framework's counting frame (--count-work).
-        let read_counts = ReadCounts::new(device, "pcss_read_counts", &[PASS], settings.count_reads || setup.count_work);
+        let read_counts = ReadCounts::with_units(device, "pcss_read_counts", COUNTERS, settings.count_reads || setup.count_work);
         let map_layout = bind_group_layout(device, "pcss_map_layout", &[texture_entry(0), uniform_entry(1), ReadCounts::layout_entry(2)]);
         let map_bind_group = bind_group(
             device,
@@ -266,7 +269,8 @@ impl ShadowTechnique for Pcss {
     /// The pass's texel reads and invocations, when built for counting: one invocation per pixel
     /// of the screen, each reading the G-buffer's two texels (trivial pixels included), and a
     /// computed pixel one texel per shadow-map tap; in the tiled pass a tap read from workgroup
-    /// memory is not a texel read, and the tile's loads are (one per texel of the union).
+    /// memory is not a texel read, and the tile's loads are (one per texel of the union). Each
+    /// read's bytes too: 16 per G-buffer texel (`Rgba32Float`), 4 per shadow-map texel (`R32Float`).
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ssm_core::ShaderWork>>> {
         let Some(mut work) = self.read_counts.work(gpu)? else {
             return Ok(None);

@@ -15,8 +15,9 @@ use crate::PcssSettings;
 /// The label of the pass, and of its read counts.
 pub const SIDE_FACES_PASS: &str = "pcss_side_faces";
 
-/// What the pass counts in a counting frame, in the order its shader indexes them.
-const COUNTERS: &[(&str, &str)] = &[(SIDE_FACES_PASS, "reads"), (SIDE_FACES_PASS, "storage_bytes")];
+/// What the pass counts in a counting frame, in the order its shader indexes them: texel reads,
+/// bytes stored, and the bytes the reads fetched.
+const COUNTERS: &[(&str, &str)] = &[(SIDE_FACES_PASS, "reads"), (SIDE_FACES_PASS, "storage_bytes"), (SIDE_FACES_PASS, "read_bytes")];
 
 /// A tap is a blocker where it is nearer the light's centre than the receiver's tangent plane by
 /// more than this share of the plane's depth (the maps' own bias is a hundred-thousandth of the

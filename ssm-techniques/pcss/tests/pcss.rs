@@ -166,7 +166,11 @@ fn workgroup_tiles_give_the_fragment_passes_pixels() {
 /// above it), and only those pixels filter, with one tap: a filter narrower than a texel is the
 /// texel at the lookup, not m² taps of it. So, with P pixels, C covered and Z covered at
 /// visibility 0: 2P + n²C + Z reads, P invocations, exactly. The tiled pass counts the same
-/// invocations (its tile's loads, not its taps, are its reads).
+/// invocations (its tile's loads, not its taps, are its reads). In bytes, each texel costs its
+/// format's size (ssm-core's formats, not the shader's constants): with G the G-buffer's position
+/// and normal texels together (`Rgba32Float` each, 32 bytes) and D a shadow-map depth (`R32Float`,
+/// 4), G·P + D·(n²C + Z) bytes; in the tiled pass, whose reads past the G-buffer's 2P are all
+/// shadow-map texels (taps or the tile's loads), G·P + D·(R − 2P) for its R reads, exactly.
 #[test]
 fn reads_are_two_gbuffer_texels_per_pixel_and_n2_plus_one_per_shadowed_pixel_under_a_point_light() {
     let (width, height, n) = (96u32, 72u32, 3u64);
@@ -195,7 +199,52 @@ fn reads_are_two_gbuffer_texels_per_pixel_and_n2_plus_one_per_shadowed_pixel_und
         (pixels, 2 * pixels + n * n * covered + shadowed),
         "(invocations, texel reads)"
     );
+    let (gbuffer, depth) = texel_bytes();
+    assert_eq!(texture.read_bytes, gbuffer * pixels + depth * (n * n * covered + shadowed), "bytes read");
     let (_, tiled) = work_of("workgroup_tile");
     assert_eq!(tiled.counted_invocations, pixels, "the tiled pass counts the screen's pixels, not its workgroups' threads");
     assert!(tiled.texel_reads > 2 * pixels, "the G-buffer's texels and the tiles' loads: {}", tiled.texel_reads);
+    assert_eq!(tiled.read_bytes, gbuffer * pixels + depth * (tiled.texel_reads - 2 * pixels), "tiled: bytes read");
+}
+
+/// The bytes of one texel of the G-buffer's position and normal together, and of a light depth
+/// map's (the shadow map's, a side face's), from ssm-core's formats.
+fn texel_bytes() -> (u64, u64) {
+    let size = |format: Option<u32>| u64::from(format.expect("a format with a texel size"));
+    let gbuffer =
+        size(ssm_core::GBuffer::POSITION_FORMAT.block_copy_size(None)) + size(ssm_core::GBuffer::NORMAL_FORMAT.block_copy_size(None));
+    (gbuffer, size(ssm_core::LightDepthMap::FORMAT.block_copy_size(None)))
+}
+
+/// The side-faces pass (`pcss_side_faces`, past the light frame's widest angle: a light resting on
+/// the floor) counts its reads' bytes as the frame's pass does: each of its P invocations (one per
+/// pixel of the screen) reads the G-buffer's two texels, G bytes together, and each of its other
+/// reads is a tap of a face's `R32Float` map, D bytes: G·P + D·(R − 2P) for its R reads, exactly.
+/// Every pass that reads counts its bytes, the framework's after pcss's included.
+#[test]
+fn the_side_faces_count_the_bytes_of_their_reads() {
+    let (width, height) = (96u32, 72u32);
+    let scene = ssm_testing::scene_from_manifest(
+        "[camera]\nposition = [0.0, 4.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[light]]\ncentre = [0.0, 0.01, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [1.0, 1.0]\n\
+         [[object]]\nprimitive = \"plane\"\nsize = [10.0, 10.0]\nrole = \"receiver\"\n\
+         [[object]]\nprimitive = \"box\"\nsize = [0.4, 0.4, 0.4]\ntranslate = [1.5, 0.2, 0.0]\nrole = \"both\"\n",
+    );
+    let settings = [("shadow_map_size", "256"), ("blocker_kernel", "3"), ("pcf_kernel", "5")];
+    let gpu = gpu();
+    let mut rendered = render(&gpu, &scene, &ssm_pcss::INFO, &settings, width, height).unwrap();
+    let params = ssm_pcss::INFO.params_from(settings).unwrap();
+    let work = rendered.renderer.count_work(&ssm_pcss::INFO, &params).unwrap();
+    println!("{}", work.passes_column());
+    let pixels = u64::from(width * height);
+    let (gbuffer, depth) = texel_bytes();
+    let side_faces = work.passes.iter().find(|p| p.name == ssm_pcss::SIDE_FACES_PASS).expect("the case reaches past the frame");
+    assert_eq!(side_faces.counted_invocations, pixels);
+    assert!(side_faces.texel_reads > 2 * pixels, "no tap of a face: {}", side_faces.texel_reads);
+    assert_eq!(side_faces.read_bytes, gbuffer * pixels + depth * (side_faces.texel_reads - 2 * pixels), "side faces: bytes read");
+    let reading: Vec<_> = work.passes.iter().filter(|pass| pass.texel_reads > 0).collect();
+    assert!(reading.len() >= 2, "the frame's pass and the side faces' read");
+    for pass in reading {
+        assert!(pass.read_bytes > 0, "{} reads {} texels and counts no bytes", pass.name, pass.texel_reads);
+    }
 }

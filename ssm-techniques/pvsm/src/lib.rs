@@ -94,21 +94,30 @@ const TILE_PYRAMID_SHADER: &str = ssm_shaders::pvsm::PVSM_TILE_PYRAMID;
 /// The work the passes count with `count_reads` ([`ReadCounts`]), in the order the shaders index
 /// them: `(WGSL constant, shader, pass, unit)`. A texel read is one texel fetched (a `textureLoad`,
 /// or one element of a storage array read as a map's texel or a pixel's record), every read of
-/// every invocation, the G-buffer's two texels included. `pvsm_tile_filter_walk` is no pass: the
+/// every invocation, the G-buffer's two texels included; beside each pass's reads, the bytes they
+/// fetched (unit `read_bytes`): each read its texture's texel size or its storage element's size
+/// (`*_BYTES` constants of the shaders, checked against the formats and records here by
+/// `the_shaders_byte_sizes_are_the_formats_and_records`). `pvsm_tile_filter_walk` is no pass: the
 /// filter's walk's reads alone per filter evaluation (unit `texels`, a diagnostic only), whose total
 /// is `pvsm_texels_filtered`. The tile maps' texels rendered are the `pvsm_texels_rendered`
 /// diagnostic, counted on the CPU from the tiles' sizes; the bytes the render passes store to
 /// them the framework counts as target bytes.
-const READ_COUNTERS: [(&str, &str, &str, &str); 10] = [
+const READ_COUNTERS: [(&str, &str, &str, &str); 16] = [
     ("READ_COUNTER_LOW_RES_MIPS", MIPS_SHADER, "pvsm_low_res_mips", "reads"),
+    ("READ_COUNTER_LOW_RES_MIPS_READ_BYTES", MIPS_SHADER, "pvsm_low_res_mips", "read_bytes"),
     ("READ_COUNTER_KERNEL_SHAPE", KERNEL_SHADER, "pvsm_kernel_shape", "reads"),
+    ("READ_COUNTER_KERNEL_SHAPE_READ_BYTES", KERNEL_SHADER, "pvsm_kernel_shape", "read_bytes"),
     ("READ_COUNTER_KERNEL_SHAPE_ATOMICS", KERNEL_SHADER, "pvsm_kernel_shape", "atomics"),
     ("READ_COUNTER_SMTG_PYRAMID", PYRAMID_SHADER, "pvsm_smtg_pyramid", "reads"),
+    ("READ_COUNTER_SMTG_PYRAMID_READ_BYTES", PYRAMID_SHADER, "pvsm_smtg_pyramid", "read_bytes"),
     ("READ_COUNTER_TILE_PYRAMID", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "reads"),
-    ("READ_COUNTER_TILE_PYRAMID_BYTES", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "storage_bytes"),
+    ("READ_COUNTER_TILE_PYRAMID_READ_BYTES", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "read_bytes"),
+    ("READ_COUNTER_TILE_PYRAMID_STORAGE_BYTES", TILE_PYRAMID_SHADER, "pvsm_tile_pyramid", "storage_bytes"),
     ("READ_COUNTER_TILE_FILTER", FILTER_SHADER, "pvsm_tile_filter", "reads"),
+    ("READ_COUNTER_TILE_FILTER_READ_BYTES", FILTER_SHADER, "pvsm_tile_filter", "read_bytes"),
     ("READ_COUNTER_TILE_FILTER_WALK", FILTER_SHADER, "pvsm_tile_filter_walk", "texels"),
     ("READ_COUNTER_RESOLVE", FILTER_SHADER, "pvsm_resolve", "reads"),
+    ("READ_COUNTER_RESOLVE_READ_BYTES", FILTER_SHADER, "pvsm_resolve", "read_bytes"),
     ("READ_COUNTER_PREDICTED_TEXELS", KERNEL_SHADER, "pvsm_predicted", "texels_under_filter"),
 ];
 
@@ -438,6 +447,13 @@ const COUNTER_BYTES: u64 = COUNTER_NAMES.len() as u64 * 4;
 
 /// Bytes of one [`KernelRecord`].
 const KERNEL_BYTES: u64 = std::mem::size_of::<KernelRecord>() as u64;
+/// Bytes of one pixel's accumulated sums, (Σ c·o, Σ c) as a `vec2<f32>`.
+const ACCUMULATED_BYTES: u64 = 8;
+/// Bytes of one pixel's capped flag, a `u32`.
+const CAPPED_BYTES: u64 = 4;
+/// Bytes of one cell of the tile grid (its resolutions along u and v, two u32) and of its pyramid
+/// (the same, as a `vec2<f32>`).
+const SMTG_CELL_BYTES: u64 = 8;
 
 /// The uniforms of one tile of one light, written when the kd-tree has decided it.
 struct TileSlot {
@@ -789,12 +805,12 @@ impl PredictedVirtualShadowMaps {
         let cells = u64::from(settings.grid_size).pow(2);
         Buffers {
             kernels: storage_buffer(device, "pvsm_kernel_buffer", pixels * KERNEL_BYTES),
-            accumulated: storage_buffer(device, "pvsm_accumulated_buffer", pixels * 8),
-            capped: storage_buffer(device, "pvsm_capped_buffer", pixels * 4),
-            grid: storage_buffer(device, "pvsm_smtg_buffer", cells * 8),
+            accumulated: storage_buffer(device, "pvsm_accumulated_buffer", pixels * ACCUMULATED_BYTES),
+            capped: storage_buffer(device, "pvsm_capped_buffer", pixels * CAPPED_BYTES),
+            grid: storage_buffer(device, "pvsm_smtg_buffer", cells * SMTG_CELL_BYTES),
             counters: storage_buffer(device, "pvsm_counters_buffer", COUNTER_BYTES),
-            pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * 8),
-            pyramid_readback: readback_buffer(device, "pvsm_smtg_pyramid_readback", pyramid_cells * 8),
+            pyramid: storage_buffer(device, "pvsm_smtg_pyramid_buffer", pyramid_cells * SMTG_CELL_BYTES),
+            pyramid_readback: readback_buffer(device, "pvsm_smtg_pyramid_readback", pyramid_cells * SMTG_CELL_BYTES),
             pyramid_cells,
             culled_indices: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pvsm_tile_culled_indices"),
@@ -947,7 +963,7 @@ impl PredictedVirtualShadowMaps {
             0,
             &self.buffers.pyramid_readback,
             0,
-            self.buffers.pyramid_cells * 8,
+            self.buffers.pyramid_cells * SMTG_CELL_BYTES,
         );
         let bytes = frame.read_back("pvsm_smtg_readback", &self.buffers.pyramid_readback)?;
         let values: Vec<Vec2> = bytemuck::pod_collect_to_vec::<u8, [f32; 2]>(&bytes).into_iter().map(Vec2::from_array).collect();
@@ -1618,6 +1634,52 @@ mod tests {
         for (index, (name, shader, _, _)) in super::READ_COUNTERS.iter().enumerate() {
             let line = format!("const {name}: u32 = {index}u;");
             assert!(shader.contains(&line), "the shader counting {name} lacks `{line}`");
+        }
+    }
+
+    /// Every pass that counts its reads counts their bytes too.
+    #[test]
+    fn every_pass_that_counts_reads_counts_their_bytes() {
+        for (_, _, pass, unit) in super::READ_COUNTERS {
+            if unit == "reads" {
+                let bytes = super::READ_COUNTERS.iter().filter(|(_, _, p, u)| *p == pass && *u == "read_bytes").count();
+                assert_eq!(bytes, 1, "{pass} counts reads, and {bytes} read_bytes counters");
+            }
+        }
+    }
+
+    /// The bytes the shaders count per read are the sizes of what they read: the textures' texel
+    /// sizes (their formats here and in ssm-core) and the storage elements' (the records and cells
+    /// the buffers are sized by).
+    #[test]
+    fn the_shaders_byte_sizes_are_the_formats_and_records() {
+        use super::{FILTER_SHADER, KERNEL_SHADER, LOCAL_SHADERS, MIPS_SHADER, PYRAMID_SHADER, TILE_PYRAMID_SHADER};
+        let texel = |format: wgpu::TextureFormat| u64::from(format.block_copy_size(None).unwrap());
+        let low_res = texel(ssm_core::LightDepthMap::FORMAT);
+        let tile_map = texel(ssm_core::LightDepthMap::FORMAT);
+        let pyramid = texel(super::TILE_PYRAMID_FORMAT);
+        let counts = texel(super::TILE_PYRAMID_COUNTS_FORMAT);
+        let gbuffer = texel(ssm_core::GBuffer::POSITION_FORMAT);
+        assert_eq!(gbuffer, texel(ssm_core::GBuffer::NORMAL_FORMAT));
+        let common = LOCAL_SHADERS[0].1;
+        let expected: [(&str, &str, u64); 13] = [
+            (common, "GBUFFER_TEXEL_BYTES", gbuffer),
+            (common, "KERNEL_RECORD_BYTES", super::KERNEL_BYTES),
+            (MIPS_SHADER, "LOW_RES_TEXEL_BYTES", low_res),
+            (KERNEL_SHADER, "LOW_RES_TEXEL_BYTES", low_res),
+            (PYRAMID_SHADER, "SMTG_CELL_BYTES", super::SMTG_CELL_BYTES),
+            (TILE_PYRAMID_SHADER, "TILE_MAP_TEXEL_BYTES", tile_map),
+            (TILE_PYRAMID_SHADER, "TILE_PYRAMID_TEXEL_BYTES", pyramid),
+            (TILE_PYRAMID_SHADER, "TILE_PYRAMID_COUNTS_TEXEL_BYTES", counts),
+            (FILTER_SHADER, "TILE_MAP_TEXEL_BYTES", tile_map),
+            (FILTER_SHADER, "TILE_PYRAMID_TEXEL_BYTES", pyramid),
+            (FILTER_SHADER, "TILE_PYRAMID_COUNTS_TEXEL_BYTES", counts),
+            (FILTER_SHADER, "ACCUMULATED_BYTES", super::ACCUMULATED_BYTES),
+            (FILTER_SHADER, "CAPPED_BYTES", super::CAPPED_BYTES),
+        ];
+        for (shader, name, bytes) in expected {
+            let line = format!("const {name}: u32 = {bytes}u;");
+            assert!(shader.contains(&line), "a shader lacks `{line}`");
         }
     }
 

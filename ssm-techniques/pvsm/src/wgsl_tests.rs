@@ -58,6 +58,17 @@ fn test_integrate(@builtin(global_invocation_id) id: vec3<u32>) {
     let sums = integrate(a.xy, a.zw, b.x, b.y, position, normal, vec2<f32>(0.0));
     test_out[id.x] = vec4<f32>(sums.visible, sums.covered, select(0.0, 1.0, sums.capped), f32(sums.reads));
 }
+
+// test_integrate's inputs -> (texels read, the bytes they fetched, 0, 0)
+@compute @workgroup_size(1)
+fn test_integrate_bytes(@builtin(global_invocation_id) id: vec3<u32>) {
+    let a = test_in[4u * id.x];
+    let b = test_in[4u * id.x + 1u];
+    let position = test_in[4u * id.x + 2u].xyz;
+    let normal = test_in[4u * id.x + 3u].xyz;
+    let sums = integrate(a.xy, a.zw, b.x, b.y, position, normal, vec2<f32>(0.0));
+    test_out[id.x] = vec4<f32>(f32(sums.reads), f32(sums.bytes), 0.0, 0.0);
+}
 ";
 
 /// A tile map, its region and the settings [`evaluate`] binds for `integrate` (the other entry points
@@ -812,4 +823,28 @@ fn a_walk_past_its_cap_stops_and_says_so() {
     assert!(hierarchy[2] == 1.0 && hierarchy[3] <= 32_768.0 + 256.0, "{hierarchy:?}");
     assert!(close(hierarchy[1], uniform[1], F32_TOLERANCE), "a capped walk still covers the whole filter: {hierarchy:?}");
     assert_eq!((uniform[2], uniform[3]), (0.0, 4.0));
+}
+
+/// Each read of a walk counts its texture's texel size, by hand, with the filter of
+/// [`a_decided_block_costs_one_read_and_an_edge_its_boundary`] (texels [2, 62)² of a 64² tile):
+/// over a uniform occluding map the hierarchy decides the four 32² blocks from their pyramid texels
+/// (4 reads of an Rgba32Float texel, 16 bytes each: 64 bytes) and the per-texel walk reads the
+/// 3,600 texels under the filter from the map (R32Float, 4 bytes each: 14,400 bytes); over the bar of
+/// [`a_two_layer_block_on_the_filters_edge_costs_its_near_counts`] the hierarchy's 12 reads are
+/// pyramid depths and near counts (Rgba32Uint), 16 bytes each: 192 bytes.
+#[test]
+fn each_read_of_a_walk_counts_its_texels_bytes() {
+    let gpu = ssm_testing::gpu();
+    let texel = 1.0 / 64.0;
+    let input = filter_input(32.0 * texel, 32.0 * texel, [30.0 * texel, 0.0], 30.0 * texel, 1.0);
+    let bytes = |depths: Vec<f32>, walk: &str| {
+        evaluate(&gpu, "test_integrate_bytes", &input, 1, &Tile::new(64, depths, &[("filter_walk", walk)]))[0]
+    };
+    let uniform = vec![0.5; 64 * 64];
+    let bar: Vec<f32> = (0..64 * 64).map(|i| if (8..12).contains(&(i % 64)) { 0.5 } else { 3.0 }).collect();
+    let (hierarchy, texels, two_layers) = (bytes(uniform.clone(), "hierarchy"), bytes(uniform, "texels"), bytes(bar, "hierarchy"));
+    println!("(reads, bytes): uniform, hierarchy {hierarchy:?}, every texel {texels:?}; bar {two_layers:?}");
+    assert_eq!((hierarchy[0], hierarchy[1]), (4.0, 4.0 * 16.0), "{hierarchy:?}");
+    assert_eq!((texels[0], texels[1]), (3600.0, 3600.0 * 4.0), "{texels:?}");
+    assert_eq!((two_layers[0], two_layers[1]), (12.0, 12.0 * 16.0), "{two_layers:?}");
 }

@@ -72,6 +72,11 @@ const BLOCKER_BLUR_COMPUTE_SHADER: &str = ssm_shaders::sssm::SSSM_BLOCKER_BLUR_C
 const VERTICAL_BLUR_FRAGMENT_SHADER: &str = ssm_shaders::sssm::SSSM_VERTICAL_BLUR_FRAGMENT;
 /// Step 3 as a compute pass sharing each workgroup's screen column.
 const VERTICAL_BLUR_COMPUTE_SHADER: &str = ssm_shaders::sssm::SSSM_VERTICAL_BLUR_COMPUTE;
+/// The format of the four screen-sized targets the passes hand on to each other and read
+/// (`horizontal_blocker`, `blur_source`, `horizontal_blur`, `vertical_tap_source`): a texel read
+/// of one costs 16 bytes (`SCREEN_TARGET_TEXEL_BYTES` in `shaders/sssm/sssm_common.wgsl`). The
+/// reuse share and the penumbra error are `R32Float`, written and read back, never read by a pass.
+pub const SCREEN_TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Pixels per workgroup of the compute passes: along the row in step 2, down the column in step 3
 /// (`SEGMENT_PIXELS` of `sssm_segment.wgsl`; step 3's workgroup grid is (row runs, columns)).
 const SHARED_SEGMENT_PIXELS: u32 = 64;
@@ -274,7 +279,8 @@ enum BlurSteps {
 /// `count_failed_row` in sssm_common.wgsl): each pass's texel reads per pixel of the screen, then,
 /// per computed pixel, the rows of step 2's blocker search and of step 3's blur that failed their
 /// reuse test, by cause (off the screen, no data in the pixel there, a depth difference of α or β
-/// or more).
+/// or more), then each pass's bytes read (its reads, each texel its format's size: 16 for a
+/// G-buffer texel or one of [`SCREEN_TARGET_FORMAT`]'s, 4 for a shadow-map depth).
 const COUNTED: &[(&str, &str)] = &[
     ("sssm_horizontal_blocker", "reads"),
     ("sssm_blocker_and_horizontal_blur", "reads"),
@@ -285,6 +291,9 @@ const COUNTED: &[(&str, &str)] = &[
     ("sssm_blur_rows_failed_off_screen", "rows"),
     ("sssm_blur_rows_failed_no_data", "rows"),
     ("sssm_blur_rows_failed_depth", "rows"),
+    ("sssm_horizontal_blocker", "read_bytes"),
+    ("sssm_blocker_and_horizontal_blur", "read_bytes"),
+    ("sssm_vertical_blur", "read_bytes"),
 ];
 
 /// The intermediate targets between the three passes.
@@ -305,7 +314,7 @@ struct Targets {
 impl Targets {
     fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let target = |label: &str, usage: wgpu::TextureUsages| {
-            let texture = render_texture(device, label, width, height, wgpu::TextureFormat::Rgba32Float, usage);
+            let texture = render_texture(device, label, width, height, SCREEN_TARGET_FORMAT, usage);
             labelled_view(&texture, label)
         };
         // Per-pixel values a pass writes and the CPU reads back.
@@ -368,7 +377,7 @@ impl SeparableSoftShadowMaps {
             "sssm_horizontal_blocker",
             (&shared.module("sssm_horizontal_blocker_shader", HORIZONTAL_BLOCKER_SHADER)?, "sssm_horizontal_blocker"),
             Some(&horizontal_blocker_layout),
-            &[wgpu::TextureFormat::Rgba32Float.into(), wgpu::TextureFormat::Rgba32Float.into()],
+            &[SCREEN_TARGET_FORMAT.into(), SCREEN_TARGET_FORMAT.into()],
             &shared.constants(),
         )?;
         let blur_steps = match settings.blur_passes {
@@ -478,7 +487,7 @@ impl Shared<'_> {
 
     /// Step 2's vertical tap sources in the compute pass (the fragment pass renders them).
     fn vertical_tap_source_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-        write_storage_texture_entry(binding, wgpu::TextureFormat::Rgba32Float)
+        write_storage_texture_entry(binding, SCREEN_TARGET_FORMAT)
     }
 
     /// Step 3's inputs (bindings 4 to 6): step 2's target, step 1's blur sources (for each
@@ -514,7 +523,7 @@ impl Shared<'_> {
             "sssm_blocker_and_horizontal_blur",
             (&self.module("sssm_blocker_blur_fragment_shader", BLOCKER_BLUR_FRAGMENT_SHADER)?, "sssm_blocker_blur"),
             Some(&blocker_blur_layout),
-            &[wgpu::TextureFormat::Rgba32Float.into(), wgpu::TextureFormat::Rgba32Float.into()],
+            &[SCREEN_TARGET_FORMAT.into(), SCREEN_TARGET_FORMAT.into()],
             &self.blocker_blur_constants(),
         )?;
         // The visibility and the reuse share, as two render targets.
@@ -539,7 +548,7 @@ impl Shared<'_> {
             &[
                 texture_entry(4),
                 texture_entry(5),
-                write_storage_texture_entry(6, wgpu::TextureFormat::Rgba32Float),
+                write_storage_texture_entry(6, SCREEN_TARGET_FORMAT),
                 Self::penumbra_error_entry(7),
                 Self::vertical_tap_source_entry(8),
             ],
@@ -668,7 +677,8 @@ impl ShadowTechnique for SeparableSoftShadowMaps {
     /// included), from the counters the shaders keep when built for counting. Reads follow
     /// `ReadCounts`' convention: every `textureLoad` (G-buffer, shadow map, the passes' own
     /// targets) is one texel, at every pixel; a blur tap that reads a shared segment's workgroup
-    /// memory is none, the segment's loads are. The failed-row counters (`rows`) are diagnostics,
+    /// memory is none, the segment's loads are; and the bytes of those reads, each texel its
+    /// format's size (`sssm_common.wgsl`'s `*_TEXEL_BYTES`). The failed-row counters (`rows`) are diagnostics,
     /// not work of a pass of their own: `ReadCounts::work` leaves them out.
     fn counted_work(&mut self, gpu: &GpuContext) -> Result<Option<Vec<ShaderWork>>> {
         self.read_counts.work(gpu)

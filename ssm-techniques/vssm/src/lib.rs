@@ -65,14 +65,17 @@ const FILTER_SHADER: &str = ssm_shaders::vssm::VSSM;
 const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
 
 /// What the shaders count in a counting frame, in the order they index the counters: the table's
-/// two passes their texel reads and bytes stored (vssm_sat.wgsl), the filter its texel reads
-/// (vssm.wgsl). The depth map's pass reads no texel.
+/// two passes their texel reads, the bytes those fetched and the bytes stored (vssm_sat.wgsl), the
+/// filter its texel reads and their bytes (vssm.wgsl). The depth map's pass reads no texel.
 const COUNTERS: &[(&str, &str)] = &[
     ("vssm_sat_rows", "reads"),
+    ("vssm_sat_rows", "read_bytes"),
     ("vssm_sat_rows", "storage_bytes"),
     ("vssm_sat_columns", "reads"),
+    ("vssm_sat_columns", "read_bytes"),
     ("vssm_sat_columns", "storage_bytes"),
     ("vssm_filter", "reads"),
+    ("vssm_filter", "read_bytes"),
 ];
 
 /// The table's texel format: one 128-bit integer of three fixed-point sums (Σz², Σz, the texels with a surface) as four 32-bit words.
@@ -350,5 +353,21 @@ mod tests {
         };
         let line = format!("const MAX_SUBDIVISION: u32 = {max}u;");
         assert!(super::FILTER_SHADER.contains(&line), "vssm.wgsl lacks `{line}`");
+    }
+
+    /// The shaders count each texel they read at its format's size: the depth map's, the table's
+    /// and the G-buffer's.
+    #[test]
+    fn the_shaders_texel_bytes_are_the_formats_sizes() {
+        for (shader, constant, format) in [
+            (super::SAT_SHADER, "DEPTH_TEXEL_BYTES", ssm_core::LightDepthMap::FORMAT),
+            (super::COMMON_SHADER, "TABLE_TEXEL_BYTES", super::TABLE_FORMAT),
+            (super::FILTER_SHADER, "GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::POSITION_FORMAT),
+            (super::FILTER_SHADER, "GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::NORMAL_FORMAT),
+        ] {
+            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
+            let line = format!("const {constant}: u32 = {bytes}u;");
+            assert!(shader.contains(&line), "the VSSM shaders lack `{line}` ({format:?})");
+        }
     }
 }

@@ -103,8 +103,9 @@ fn a_point_light_gives_the_hard_shadow() {
 }
 
 /// The counts of a counting frame (`--count-work`) against the counts by hand (a textureLoad is
-/// one texel; a table texel stored is 16 bytes), on `parallel-square` under a point light with a
-/// 128² map:
+/// one texel, of its format's bytes: the depth map's R32Float 4, the table's Rgba32Uint and the
+/// G-buffer's Rgba32Float 16; a table texel stored is 16 bytes), on `parallel-square` under a point
+/// light with a 128² map:
 /// - the table's rows pass runs one thread per row, which loads the 128 depths of its row and
 ///   stores 128 sums; the columns pass the same per column: 128² texels loaded and 16 · 128²
 ///   bytes stored each;
@@ -143,12 +144,23 @@ fn counted_work_is_the_tables_texels_and_16_entries_per_region() {
     let pixels = u64::from(width * height);
     assert!(found > 0 && not_found > 0, "{found} pixels in shadow, {not_found} lit: the case must have both");
     let pass = |name: &str| work.passes.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name} in {}", work.passes_column()));
-    for name in ["vssm_sat_rows", "vssm_sat_columns"] {
+    // The bytes those reads fetched: an R32Float depth is 4 bytes, an Rgba32Uint table texel and an
+    // Rgba32Float G-buffer texel 16.
+    for (name, texel_bytes) in [("vssm_sat_rows", 4), ("vssm_sat_columns", 16)] {
         let sat = pass(name);
-        assert_eq!((sat.counted_invocations, sat.texel_reads, sat.storage_bytes), (size, size * size, 16 * size * size), "{name}");
+        assert_eq!(
+            (sat.counted_invocations, sat.texel_reads, sat.read_bytes, sat.storage_bytes),
+            (size, size * size, texel_bytes * size * size, 16 * size * size),
+            "{name}"
+        );
     }
     let filter = pass("vssm_filter");
-    assert_eq!((filter.counted_invocations, filter.texel_reads), (pixels, 2 * pixels + 16 * not_found + 64 * found));
+    let filter_reads = 2 * pixels + 16 * not_found + 64 * found;
+    assert_eq!((filter.counted_invocations, filter.texel_reads, filter.read_bytes), (pixels, filter_reads, 16 * filter_reads));
     assert_eq!(work.total(|p| p.atomics), 0);
     assert_eq!(pass("vssm_shadow_map").texel_reads, 0);
+    // Every pass that reads counts its bytes, so the frame's bytes read are known.
+    for pass in work.passes.iter().filter(|p| p.texel_reads > 0) {
+        assert!(pass.read_bytes > 0, "{} reads {} texels but counts no bytes", pass.name, pass.texel_reads);
+    }
 }

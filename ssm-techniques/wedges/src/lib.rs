@@ -107,18 +107,23 @@ const WEDGES_COUNTED_SHADER: &str = ssm_shaders::wedges::WEDGES_WEDGES_COUNTED;
 /// The counters of `--count-work` (issue #40; [`TechniqueSetup::count_work`]), in the order of
 /// `wedges_counts.wgsl`'s `COUNTER_*` indices: (pass, unit). The passes that run without a
 /// casting mesh come first, so that without one the rest are left out (a counter of a pass that
-/// did not run would be work that was not done).
+/// did not run would be work that was not done). Every pass that reads counts the bytes its reads
+/// fetched beside them.
 const COUNTERS: &[(&str, &str)] = &[
     ("wedges_depth_copy", "reads"),
+    ("wedges_depth_copy", "read_bytes"),
     ("wedges_resolve", "reads"),
+    ("wedges_resolve", "read_bytes"),
     ("wedges_wedges", "reads"),
+    ("wedges_wedges", "read_bytes"),
     ("wedges_blend", "reads"),
+    ("wedges_blend", "read_bytes"),
     ("wedges_blend", "storage_bytes"),
     ("wedges_silhouettes", "atomics"),
     ("wedges_silhouettes", "storage_bytes"),
 ];
 /// The counters of the passes that run without a casting mesh.
-const COUNTERS_WITHOUT_MESH: usize = 2;
+const COUNTERS_WITHOUT_MESH: usize = 4;
 
 /// Most silhouette buffers (`MAX_SILHOUETTE_BUFFERS` in the WGSL).
 pub const MAX_SILHOUETTE_BUFFERS: u32 = 64;
@@ -1209,6 +1214,53 @@ mod tests {
         let uniform = WedgesSettingsUniform::from(&WedgesSettings::from_params(&params).unwrap());
         assert_eq!((uniform.blending, uniform.silhouette_buffers), (0, 3));
         assert!(params.set("blending", "probabilistic").is_err());
+    }
+
+    /// The shaders count each texel they read at its format's size, and each storage element at
+    /// its type's (`wedges_counts.wgsl`'s `*_BYTES`), and index the counters in [`COUNTERS`]'s order.
+    #[test]
+    fn the_shaders_count_bytes_read_at_the_formats_sizes() {
+        let gbuffer = [
+            ("GBUFFER_DEPTH_BYTES", ssm_core::GBuffer::DEPTH_FORMAT),
+            ("GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::POSITION_FORMAT),
+            ("GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::NORMAL_FORMAT),
+        ];
+        let own = [
+            ("SILHOUETTE_TEXEL_BYTES", SILHOUETTE_FORMAT),
+            ("SHADED_COUNT_TEXEL_BYTES", SHADED_COUNT_FORMAT),
+            ("UMBRA_MASK_TEXEL_BYTES", UMBRA_MASK_FORMAT),
+        ];
+        for (constant, format) in gbuffer.into_iter().chain(own) {
+            let bytes = format.block_copy_size(None).unwrap();
+            let line = format!("const {constant}: u32 = {bytes}u;");
+            assert!(ssm_shaders::wedges::WEDGES_COUNTS.contains(&line), "wedges_counts.wgsl lacks `{line}` ({format:?})");
+        }
+        // The final buffer's elements are vec4<f32>, the fragment counts u32.
+        let elements = [("FINAL_ELEMENT_BYTES", size_of::<[f32; 4]>()), ("FRAGMENT_COUNT_BYTES", size_of::<u32>())];
+        for (constant, bytes) in elements {
+            let line = format!("const {constant}: u32 = {bytes}u;");
+            assert!(ssm_shaders::wedges::WEDGES_COUNTS.contains(&line), "wedges_counts.wgsl lacks `{line}`");
+        }
+        let counters = [
+            ("COUNTER_DEPTH_COPY_READS", ("wedges_depth_copy", "reads")),
+            ("COUNTER_RESOLVE_READS", ("wedges_resolve", "reads")),
+            ("COUNTER_WEDGE_READS", ("wedges_wedges", "reads")),
+            ("COUNTER_BLEND_READS", ("wedges_blend", "reads")),
+            ("COUNTER_BLEND_STORAGE_BYTES", ("wedges_blend", "storage_bytes")),
+            ("COUNTER_SILHOUETTE_ATOMICS", ("wedges_silhouettes", "atomics")),
+            ("COUNTER_SILHOUETTE_STORAGE_BYTES", ("wedges_silhouettes", "storage_bytes")),
+        ];
+        for (constant, counter) in counters {
+            let index = COUNTERS.iter().position(|c| *c == counter).unwrap();
+            let line = format!("const {constant}: u32 = {index}u;");
+            assert!(ssm_shaders::wedges::WEDGES_COUNTS.contains(&line), "wedges_counts.wgsl lacks `{line}`");
+            // `record_reads` counts a pass's read bytes in the counter after its reads.
+            if counter.1 == "reads" {
+                assert_eq!(COUNTERS[index + 1], (counter.0, "read_bytes"));
+            }
+        }
+        assert!(COUNTERS[..COUNTERS_WITHOUT_MESH].iter().all(|(pass, _)| ["wedges_depth_copy", "wedges_resolve"].contains(pass)));
+        assert!(COUNTERS[COUNTERS_WITHOUT_MESH..].iter().all(|(pass, _)| !["wedges_depth_copy", "wedges_resolve"].contains(pass)));
     }
 
     #[test]

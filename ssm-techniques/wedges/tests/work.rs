@@ -1,8 +1,8 @@
 //! The wedges' counted work (`--count-work`, issue #40) against counts made by hand on
 //! `parallel-square`, whose casting mesh is one open quad, so that every step of the silhouette
 //! pass can be followed by hand. Conventions (`shaders/wedges/wedges_counts.wgsl`): a textureLoad or one
-//! element of a per-pixel storage array read is one texel read, every atomic built-in one atomic,
-//! a plain store its type's bytes.
+//! element of a per-pixel storage array read is one texel read, of its format's or type's bytes,
+//! every atomic built-in one atomic, a plain store its type's bytes.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -63,7 +63,10 @@ const SILHOUETTE_THREADS: u64 = 256 * (2 + 4 + 3 + 2 + 2) + 1 + 16 + 1;
 /// the blend runs one thread per pixel for the one buffer and reads at least the shaded count,
 /// the umbra mask, the areas and the two pairs of inner maxima; each wedge fragment reads the
 /// position, and the normal where a surface covers it; the silhouette pass as
-/// [`SILHOUETTE_ATOMICS`] says.
+/// [`SILHOUETTE_ATOMICS`] says. The bytes those reads fetched: the G-buffer's depth
+/// (Depth32Float) 4, its position and normal (Rgba32Float) 16 each, a final-buffer element
+/// (vec4<f32>) 16; the blend's shaded count (R32Float) 4, umbra mask (R8Unorm) 1, parameter
+/// targets (Rgba32Float) 16 each and fragment count (u32) 4.
 #[test]
 fn every_pass_counts_what_the_case_says_by_hand() {
     let (rendered, work) = counted(&[("blending", "none"), ("silhouette_buffers", "1")]);
@@ -71,13 +74,29 @@ fn every_pass_counts_what_the_case_says_by_hand() {
     let covered = rendered.coverage().iter().filter(|c| **c).count() as u64;
     assert!(covered > 0 && covered < pixels, "{covered} of {pixels}");
     let depth_copy = pass(&work, "wedges_depth_copy");
-    assert_eq!((depth_copy.counted_invocations, depth_copy.texel_reads), (pixels, 2 * pixels + covered));
+    assert_eq!(
+        (depth_copy.counted_invocations, depth_copy.texel_reads, depth_copy.read_bytes),
+        (pixels, 2 * pixels + covered, (4 + 16) * pixels + 16 * covered)
+    );
     let resolve = pass(&work, "wedges_resolve");
-    assert_eq!((resolve.counted_invocations, resolve.texel_reads), (pixels, 2 * pixels + covered));
+    assert_eq!(
+        (resolve.counted_invocations, resolve.texel_reads, resolve.read_bytes),
+        (pixels, 2 * pixels + covered, 2 * 16 * pixels + 16 * covered)
+    );
     assert_eq!((resolve.atomics, resolve.storage_bytes), (0, 0));
     let blend = pass(&work, "wedges_blend");
     assert_eq!(blend.counted_invocations, pixels, "one thread per pixel, one buffer");
     assert!(blend.texel_reads >= 5 * pixels, "{}", blend.texel_reads);
+    // Per thread the shaded count and the umbra mask (4 + 1 bytes), and 16 bytes for every other
+    // read but the fragment count's (4) at the s pixels that shaded a wedge fragment: the bytes
+    // are 16 r - 27 n - 12 s for r reads over n threads, with 0 < s <= n (the wedges shade some).
+    let (reads, threads) = (blend.texel_reads, blend.counted_invocations);
+    let shortfall = (16 * reads - 27 * threads).checked_sub(blend.read_bytes).unwrap();
+    assert!(
+        shortfall % 12 == 0 && (1..=threads).contains(&(shortfall / 12)),
+        "blend: {} bytes for {reads} reads over {threads} threads",
+        blend.read_bytes
+    );
     let wedges = pass(&work, "wedges_wedges");
     assert!(wedges.counted_invocations > 0, "the wedges shade fragments");
     assert!(
@@ -86,10 +105,16 @@ fn every_pass_counts_what_the_case_says_by_hand() {
         wedges.texel_reads,
         wedges.counted_invocations
     );
+    assert_eq!(wedges.read_bytes, 16 * wedges.texel_reads, "the G-buffer's position and normal, Rgba32Float");
     let silhouettes = pass(&work, "wedges_silhouettes");
     assert_eq!(silhouettes.counted_invocations, SILHOUETTE_THREADS, "every thread records once");
     assert_eq!((silhouettes.atomics, silhouettes.storage_bytes), (SILHOUETTE_ATOMICS, SILHOUETTE_STORAGE_BYTES));
-    assert_eq!(silhouettes.texel_reads, 0, "the mesh is geometry, not texels");
+    assert_eq!((silhouettes.texel_reads, silhouettes.read_bytes), (0, 0), "the mesh is geometry, not texels");
+    // Every pass that reads counts its bytes (the framework's own-surface share after it too), so
+    // the frame's bytes read are known.
+    for pass in work.passes.iter().filter(|p| p.texel_reads > 0) {
+        assert!(pass.read_bytes > 0, "{} reads {} texels but counts no bytes", pass.name, pass.texel_reads);
+    }
 }
 
 /// Forest et al.'s blending against the plain wedges, in work (Sec. 5.2: "more GPU intensive"):
