@@ -308,8 +308,9 @@ CHOOSING = ROOT / "docs" / "choosing.md"
 SUMMARY_WORDS = ROOT / "docs" / "summary.toml"
 RESULTS = ROOT / "docs" / "results.md"
 RANKINGS_COMMAND = "scripts/results.py --rankings-from docs/results.md"
-# FLIP has no noise floor of its own in the tables: two FLIP means within this fraction of the
-# lower are tied (a stand-in tolerance, and the generated text says so).
+# Two FLIP means closer than the sum of their noise floors (the FLIP the ground truth's own noise
+# alone shows, `flip_noise`) are tied; in tables without a floor, two within this fraction of the
+# lower (a stand-in tolerance, and the generated text says so).
 FLIP_TOLERANCE = 0.05
 # The groups a claim may rank within (`**Lowest error among the soft techniques: ...**`).
 RANKING_GROUPS = {
@@ -368,7 +369,8 @@ def cell_number(cell):
 def kind_rows(text):
     """The rows of one kind's tables (a `### <kind>` subsection of results.md's `## kinds`), by
     technique: `mae` and `noise` (the MAE cell and its `± truth`), `ms`, `q1` and `q3` (the `ms IQR`
-    cell), `work` (texel reads plus invocations) and `flip` (a `FLIP (shaded)` table); None where
+    cell), `work` (texel reads plus invocations), `flip` and `flip_noise` (a `FLIP (shaded)` table and its
+    `FLIP noise floor`); None where
     the tables lack it. Only the defaults' rows count."""
     rows = {}
     for table in markdown_tables(text):
@@ -377,7 +379,7 @@ def kind_rows(text):
             if not name or cells.get("point", "defaults") != "defaults":
                 continue
             row = rows.setdefault(name, {"technique": name, "mae": None, "noise": None, "ms": None, "q1": None, "q3": None,
-                                         "work": None, "flip": None})
+                                         "work": None, "flip": None, "flip_noise": None})
             if "MAE (± truth)" in cells:
                 value, _, noise = cells["MAE (± truth)"].partition("±")
                 row["mae"], row["noise"] = cell_number(value), cell_number(noise)
@@ -390,6 +392,8 @@ def kind_rows(text):
                 row["work"] = int(cell_number(cells["texel reads"]) + cell_number(cells["invocations"]))
             if "FLIP (shaded)" in cells:
                 row["flip"] = cell_number(cells["FLIP (shaded)"])
+            if "FLIP noise floor" in cells:
+                row["flip_noise"] = cell_number(cells["FLIP noise floor"])
     return rows
 
 
@@ -408,11 +412,14 @@ def kind_tables(results_text):
 
 def tied(measure, a, b):
     """Whether rows `a` and `b` tie on `measure`: errors closer than the sum of their ground truth's
-    noises; FLIP means within FLIP_TOLERANCE of the lower; times whose interquartile ranges overlap
+    noises; FLIP means closer than the sum of their noise floors (within FLIP_TOLERANCE of the lower
+    where the tables give no floor); times whose interquartile ranges overlap
     (without ranges, only equal times); work only when equal (it is counted exactly)."""
     if measure == "error":
         return a["mae"] == b["mae"] or abs(a["mae"] - b["mae"]) < (a["noise"] or 0.0) + (b["noise"] or 0.0)
     if measure == "flip":
+        if a.get("flip_noise") is not None and b.get("flip_noise") is not None:
+            return a["flip"] == b["flip"] or abs(a["flip"] - b["flip"]) < a["flip_noise"] + b["flip_noise"]
         return abs(a["flip"] - b["flip"]) <= FLIP_TOLERANCE * min(a["flip"], b["flip"])
     if measure == "time":
         if None in (a["q1"], a["q3"], b["q1"], b["q3"]):
@@ -505,7 +512,9 @@ def rankings_how():
             "technique shadows (the tables' `MAE`); two errors closer than the sum of their ground truth's own errors "
             "(the `± truth` beside each) are tied.\n"
             f"- **FLIP**, lowest first: the mean FLIP of the shaded image against the shaded ground truth; two FLIP means "
-            f"within {FLIP_TOLERANCE:.0%} of the lower are tied, a stand-in tolerance: no table carries a noise floor for FLIP.\n"
+            f"closer than the sum of their noise floors are tied (the floor: the larger FLIP of the truth's shaded image against "
+            f"the same shading of its visibility moved down or up by its own noise, the tables' `FLIP noise floor`); in "
+            f"tables without a floor, two within {FLIP_TOLERANCE:.0%} of the lower, a stand-in.\n"
             "- **Work**, least first: texel reads plus shader invocations per frame (the tables' `texel reads` and "
             "`invocations`), counted exactly, so tied only when equal.\n"
             "- **Time**, least first: the median time per frame (lavapipe's, on a CPU); two times are tied when the "
@@ -887,9 +896,10 @@ def flip_table(rows):
     rows = [row for row in rows if row.get("flip_mean") not in (None, "")]
     if not rows:
         return ""
-    lines = [f"| {row['technique']} | {float(row['flip_mean']):.5f} |" for row in rows]
-    return "FLIP of the shaded image against the shaded ground truth (sweep.csv's `flip_mean`):\n\n" \
-           "| technique | FLIP (shaded) |\n|---|---:|\n" + "\n".join(lines)
+    floor = lambda row: f"{float(row['flip_noise']):.5f}" if row.get("flip_noise") not in (None, "") else "-"
+    lines = [f"| {row['technique']} | {float(row['flip_mean']):.5f} | {floor(row)} |" for row in rows]
+    return "FLIP of the shaded image against the shaded ground truth (sweep.csv's `flip_mean`, and `flip_noise`: what the truth's own noise alone shows):\n\n" \
+           "| technique | FLIP (shaded) | FLIP noise floor |\n|---|---:|---:|\n" + "\n".join(lines)
 
 
 def time_cell(row):

@@ -32,6 +32,10 @@ pub struct Measured {
     pub work: Option<FrameWork>,
     /// Why the work was not counted although asked: [`crate::work::GROUND_TRUTH_NOT_COUNTED`].
     pub work_note: Option<&'static str>,
+    /// For the ground truth with its noise images: the noise floor of FLIP, the larger mean FLIP
+    /// of its shaded image against the same shading of its visibility moved down or up by its own
+    /// noise at every pixel (what the truth's uncertainty alone can show); `None` otherwise.
+    pub flip_noise: Option<f64>,
 }
 
 impl Measured {
@@ -287,6 +291,7 @@ impl Running {
         // The counting frame builds an instance of its own: the timed one goes first, so that the
         // two are not held at once.
         drop(self.technique);
+        let flip_noise = flip_noise_floor(renderer, &visibility, &shaded, &extra_images)?;
         let work = if job.count_work { crate::work::count(renderer, info, job.params)? } else { None };
         let work_note = (job.count_work && work.is_none()).then_some(crate::work::GROUND_TRUTH_NOT_COUNTED);
         // The counting build's diagnostics that the timed one cannot give (per-pass counts and
@@ -306,8 +311,40 @@ impl Running {
             extra_images,
             work,
             work_note,
+            flip_noise,
         })
     }
+}
+
+/// [`Measured::flip_noise`]: with the truth's noise images (one per light, `truth_noise` and
+/// `truth_noise-light<k>`), the larger mean FLIP of `shaded` against the shading of `visibility`
+/// moved down, then up, by the noise at each pixel; `None` without them (not the ground truth, or
+/// its noise not asked for). Overwrites the renderer's visibility targets.
+fn flip_noise_floor(
+    renderer: &mut Renderer,
+    visibility: &[Vec<f32>],
+    shaded: &[u8],
+    extra_images: &[ssm_core::ExtraImage],
+) -> Result<Option<f64>> {
+    let noise: Option<Vec<&[f32]>> = (0..visibility.len())
+        .map(|light| {
+            let name = if light == 0 {
+                ssm_core::reference::NOISE_OUTPUT.to_owned()
+            } else {
+                format!("{}-light{light}", ssm_core::reference::NOISE_OUTPUT)
+            };
+            extra_images.iter().find(|image| image.name == name).map(|image| image.values.as_slice())
+        })
+        .collect();
+    let Some(noise) = noise else { return Ok(None) };
+    let mut floor = 0.0f64;
+    for sign in [-1.0f32, 1.0] {
+        let moved: Vec<Vec<f32>> =
+            visibility.iter().zip(&noise).map(|(image, noise)| image.iter().zip(*noise).map(|(v, n)| v + sign * n).collect()).collect();
+        let moved_shaded = renderer.shade_visibility(&moved)?;
+        floor = floor.max(flip_mean(shaded, &moved_shaded, renderer.width(), renderer.height()));
+    }
+    Ok(Some(floor))
 }
 
 /// The stem of light `light`'s image files: `visibility` for light 0, `visibility-light<k>` for the others.
@@ -418,6 +455,9 @@ pub struct Row {
     pub metrics: ErrorMetrics,
     /// Mean FLIP of the shaded image against the shaded reference.
     pub flip: f64,
+    /// FLIP's noise floor on these pixels: what the reference's own noise alone shows
+    /// ([`Measured::flip_noise`]); `None` without the reference's noise.
+    pub flip_noise: Option<f64>,
     /// Adapter description.
     pub adapter: String,
     /// GPU timestamps or CPU wall time only.
@@ -474,6 +514,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "gpu_ms_q3",
     "cpu_step_ms",
     "read_bytes",
+    "flip_noise",
 ];
 
 /// Builds the row of `measured` against `reference` over all lights (same
@@ -505,6 +546,7 @@ pub fn row(scene: &str, renderer: &Renderer, measured: &Measured, reference: &Me
         cpu_ms: measured.cpu_ms_median(),
         metrics: average(&per_light),
         flip: flip_mean(&reference.shaded, &measured.shaded, width, height),
+        flip_noise: reference.flip_noise,
         adapter: renderer.gpu.describe(),
         timing_source: measured.frames.first().map_or(TimingSource::CpuWallOnly, |f| f.source),
         passes: measured.pass_medians(),
@@ -635,6 +677,7 @@ impl Row {
         .chain([number(self.gpu_ms_quartiles.map(|q| q.0), 4), number(self.gpu_ms_quartiles.map(|q| q.1), 4), number(self.cpu_step_ms, 4)])
         // Derived from `passes_work` (each pass's `read_bytes`), which the CSV reads back.
         .chain([self.work.as_ref().map_or_else(String::new, |work| crate::work::field(crate::work::Totals::of(work).read_bytes))])
+        .chain([number(self.flip_noise, 6)])
         .collect()
     }
 
@@ -686,6 +729,7 @@ pub fn row_json(row: &Row) -> serde_json::Value {
         "gpu_ms_min": row.gpu_ms_min.map(finite),
         "gpu_ms_iqr": row.gpu_ms_quartiles.map(|(q1, q3)| [finite(q1), finite(q3)]),
         "cpu_step_ms": row.cpu_step_ms.map(finite),
+        "flip_noise": row.flip_noise.map(finite),
         "cpu_ms": finite(row.cpu_ms),
         "metrics": {
             "mae": finite(m.mae),
@@ -789,6 +833,7 @@ pub fn parse_csv(text: &str) -> anyhow::Result<Vec<Row>> {
                 gpu_ms_min: optional("gpu_ms_min")?,
                 gpu_ms_quartiles: optional("gpu_ms_q1")?.zip(optional("gpu_ms_q3")?),
                 cpu_step_ms: optional("cpu_step_ms")?,
+                flip_noise: optional("flip_noise")?,
                 cpu_ms: float("cpu_ms")?,
                 metrics: ErrorMetrics {
                     mae: float("mae")?,
@@ -905,7 +950,7 @@ fn table_cells(r: &Row) -> [String; 12] {
         number(Some(m.psnr), 2),
         format!("{:.4}", m.ssim),
         format!("{:.2}%", m.frac_over_0_05 * 100.0),
-        format!("{:.4}", r.flip),
+        with_noise(r.flip, r.flip_noise),
     ]
 }
 
@@ -1362,6 +1407,7 @@ mod tests {
             gpu_ms_min: gpu,
             gpu_ms_quartiles: gpu.map(|ms| (ms * 0.9, ms * 1.1)),
             cpu_step_ms: gpu.map(|ms| ms * 0.25),
+            flip_noise: gpu.map(|_| 0.0012),
             cpu_ms: 12.5,
             metrics: ErrorMetrics {
                 mae: 0.0234567,

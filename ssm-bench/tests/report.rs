@@ -361,3 +361,34 @@ fn three_shards_merged_equal_the_unsharded_sweep() {
         let _ = std::fs::remove_dir_all(dir);
     }
 }
+
+/// FLIP's noise floor: the ground truth's shaded image against the same shading of its visibility
+/// moved by its own noise, the same for every row of a scene, above 0 where the truth samples
+/// (leaves' ground under 2×2 rays a set), below every technique's FLIP there, and printed beside
+/// each FLIP in report.md. Seen red with the truth's visibility left unmoved (a floor of 0).
+#[test]
+fn the_flip_noise_floor_is_what_the_truths_own_noise_shows() {
+    let out = scratch("flip-noise");
+    let dir = out.display().to_string();
+    let cache = out.join("cache");
+    let output = Command::new(env!("CARGO_BIN_EXE_ssm"))
+        .env("SSM_CACHE_DIR", &cache)
+        .args(["compare", "--scene", "leaves", "--technique", "hard,pcss", "--width", "64", "--height", "48"])
+        .args(["--frames", "1", "--set", "reference.samples=2", "--out", &dir])
+        .output()
+        .expect("the ssm binary runs");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    let (technique, flip, floor) = (column(header, "technique"), column(header, "flip_mean"), column(header, "flip_noise"));
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(split_csv).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    let floors: Vec<f64> = rows.iter().map(|row| row[floor].parse().unwrap_or_else(|_| panic!("a floor in {row:?}"))).collect();
+    assert!(floors[0] > 0.0 && floors[0] == floors[1], "one floor per scene, above 0: {floors:?}");
+    for row in &rows {
+        let value: f64 = row[flip].parse().unwrap();
+        assert!(floors[0] < value, "{}: FLIP {value} above the floor {}", row[technique], floors[0]);
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains(&format!(" ± {:.4} |", floors[0])), "report.md prints the floor beside each FLIP:\n{report}");
+}

@@ -78,7 +78,7 @@ impl Renderer {
                     width,
                     height,
                     VISIBILITY_FORMAT,
-                    wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
+                    wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::STORAGE_BINDING,
                 )
             })
             .collect();
@@ -207,6 +207,39 @@ impl Renderer {
         let gbuffer = self.shared.gbuffer("renderer outputs")?;
         let bytes = read_texture(&self.gpu, &gbuffer.normal, 16, "G-buffer normals")?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Shades `visibility` (one row-major image per light, each clamped to `[0, 1]`) as
+    /// [`Renderer::shade`] shades a technique's: what an image of that visibility looks like (the
+    /// ground truth moved by its own noise, for the noise floor of FLIP). It overwrites the
+    /// visibility targets: read a technique's own first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSize`] when an image or the number of images does not match, or as
+    /// [`Renderer::shade`].
+    pub fn shade_visibility(&mut self, visibility: &[Vec<f32>]) -> Result<Vec<u8>> {
+        let (width, height) = (self.scene.width, self.scene.height);
+        if visibility.len() != self.visibility.len() || visibility.iter().any(|image| image.len() != (width * height) as usize) {
+            return Err(Error::InvalidSize {
+                width,
+                height,
+                problem: format!(
+                    "{} visibility images for {} lights, each of width × height values",
+                    visibility.len(),
+                    self.visibility.len()
+                ),
+            });
+        }
+        for (texture, image) in self.visibility.iter().zip(visibility) {
+            let clamped: Vec<f32> = image.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+            self.gpu.queue.write_texture(
+                texture.as_image_copy(),
+                bytemuck::cast_slice(&clamped),
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            );
+        }
+        self.shade()
     }
 
     /// Shades the current visibility (Lambert × visibility + ambient) and reads
