@@ -204,15 +204,13 @@ mod tests {
     /// [`LightDepthMap`]s).
     #[test]
     fn the_shaders_texel_bytes_are_the_formats_sizes() {
-        for (constant, format) in [
+        let constants = [
             ("GBUFFER_TEXEL_BYTES", GBuffer::POSITION_FORMAT),
             ("GBUFFER_TEXEL_BYTES", GBuffer::NORMAL_FORMAT),
             ("SIDE_FACE_TEXEL_BYTES", LightDepthMap::FORMAT),
             ("VISIBILITY_TEXEL_BYTES", VISIBILITY_FORMAT),
-        ] {
-            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
-            let line = format!("const {constant}: u32 = {bytes}u;");
-            assert!(ssm_shaders::core::BEYOND_FRAME.contains(&line), "beyond_frame.wgsl lacks `{line}` ({format:?})");
-        }
+        ];
+        let missing = crate::read_counts::missing_texel_byte_constants(ssm_shaders::core::BEYOND_FRAME, &constants);
+        assert!(missing.is_empty(), "beyond_frame.wgsl lacks {missing:?}");
     }
 }

@@ -130,14 +130,12 @@ mod tests {
     /// The shader counts each texel it reads at its format's size.
     #[test]
     fn the_shaders_texel_bytes_are_the_formats_sizes() {
-        for (constant, format) in [
+        let constants = [
             ("GBUFFER_TEXEL_BYTES", GBuffer::POSITION_FORMAT),
             ("GBUFFER_TEXEL_BYTES", GBuffer::NORMAL_FORMAT),
             ("VISIBILITY_TEXEL_BYTES", VISIBILITY_FORMAT),
-        ] {
-            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
-            let line = format!("const {constant}: u32 = {bytes}u;");
-            assert!(ssm_shaders::core::OWN_SURFACE_SHARE.contains(&line), "own_surface_share.wgsl lacks `{line}` ({format:?})");
-        }
+        ];
+        let missing = crate::read_counts::missing_texel_byte_constants(ssm_shaders::core::OWN_SURFACE_SHARE, &constants);
+        assert!(missing.is_empty(), "own_surface_share.wgsl lacks {missing:?}");
     }
 }

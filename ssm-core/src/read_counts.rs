@@ -155,6 +155,23 @@ impl ReadCounts {
     }
 }
 
+/// The lines `const <NAME>: u32 = <bytes>u;` that `wgsl` lacks, for each `(NAME, format)`: the
+/// byte sizes a shader counts its reads at must be its textures' formats' (a test of each
+/// counting shader asserts none is missing). A format without a single texel size is reported too.
+#[must_use]
+pub fn missing_texel_byte_constants(wgsl: &str, constants: &[(&str, wgpu::TextureFormat)]) -> Vec<String> {
+    constants
+        .iter()
+        .filter_map(|(constant, format)| match format.block_copy_size(None) {
+            Some(bytes) => {
+                let line = format!("const {constant}: u32 = {bytes}u;");
+                (!wgsl.contains(&line)).then(|| format!("`{line}` ({format:?})"))
+            }
+            None => Some(format!("{constant}: {format:?} has no single texel size")),
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     /// The WGSL side spreads the counts over as many buckets as the Rust side sums.
