@@ -365,9 +365,8 @@ mod tests {
             (super::FILTER_SHADER, "GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::POSITION_FORMAT),
             (super::FILTER_SHADER, "GBUFFER_TEXEL_BYTES", ssm_core::GBuffer::NORMAL_FORMAT),
         ] {
-            let Some(bytes) = format.block_copy_size(None) else { panic!("{format:?} has no single texel size") };
-            let line = format!("const {constant}: u32 = {bytes}u;");
-            assert!(shader.contains(&line), "the VSSM shaders lack `{line}` ({format:?})");
+            let missing = ssm_core::read_counts::missing_texel_byte_constants(shader, &[(constant, format)]);
+            assert!(missing.is_empty(), "the VSSM shaders lack {missing:?}");
         }
     }
 }

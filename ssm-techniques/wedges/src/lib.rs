@@ -1230,11 +1230,9 @@ mod tests {
             ("SHADED_COUNT_TEXEL_BYTES", SHADED_COUNT_FORMAT),
             ("UMBRA_MASK_TEXEL_BYTES", UMBRA_MASK_FORMAT),
         ];
-        for (constant, format) in gbuffer.into_iter().chain(own) {
-            let bytes = format.block_copy_size(None).unwrap();
-            let line = format!("const {constant}: u32 = {bytes}u;");
-            assert!(ssm_shaders::wedges::WEDGES_COUNTS.contains(&line), "wedges_counts.wgsl lacks `{line}` ({format:?})");
-        }
+        let constants: Vec<(&str, wgpu::TextureFormat)> = gbuffer.into_iter().chain(own).collect();
+        let missing = ssm_core::read_counts::missing_texel_byte_constants(ssm_shaders::wedges::WEDGES_COUNTS, &constants);
+        assert!(missing.is_empty(), "wedges_counts.wgsl lacks {missing:?}");
         // The final buffer's elements are vec4<f32>, the fragment counts u32.
         let elements = [("FINAL_ELEMENT_BYTES", size_of::<[f32; 4]>()), ("FRAGMENT_COUNT_BYTES", size_of::<u32>())];
         for (constant, bytes) in elements {
