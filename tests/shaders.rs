@@ -31,7 +31,18 @@ fn every_wgsl_file_parses_and_validates() {
     wgsl_files(&root, &mut files);
     files.sort();
     assert!(files.len() >= 9, "found only {files:?}");
-    let lookup = |import: &str| std::fs::read_to_string(root.join(import)).ok();
+    // `rust/<Struct>`: a uniform's WGSL declaration, written by its Rust struct's derive
+    // (`UniformStruct::WGSL`) and listed among its technique's importable files.
+    let generated: Vec<(&str, &str)> = ssm_integration_tests::registry()
+        .iter()
+        .flat_map(|info| info.uniforms.iter().flat_map(|check| check.imports.iter().copied()))
+        .filter(|(path, _)| path.starts_with("rust/"))
+        .collect();
+    let lookup = |import: &str| {
+        std::fs::read_to_string(root.join(import))
+            .ok()
+            .or_else(|| generated.iter().find(|(path, _)| *path == import).map(|(_, text)| (*text).to_owned()))
+    };
     // A file another imports is validated inside each importer's composed module (naga validates
     // every function of a module, used or not), so it may call what its importers define (sssm's
     // blur cores call the `*_source` of their fragment or compute entry file).

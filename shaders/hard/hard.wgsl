@@ -5,13 +5,9 @@
 // #import common/shadow_map.wgsl
 // #import common/read_counts.wgsl
 
-struct HardSettings {
-    // Normal offset of the lookup point, in shadow-map texels.
-    normal_offset: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-};
+// The settings, declared once in Rust (`HardSettingsUniform`, ssm-techniques/hard/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/HardSettings
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: HardSettings;
 // Counters 0 and 1: hard_lookup's (pixels, texel reads) and (pixels, bytes those reads fetched)

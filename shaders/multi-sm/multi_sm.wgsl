@@ -8,19 +8,9 @@
 // #import common/read_counts.wgsl
 // #import common/side_faces.wgsl
 
-struct MultiSmSettings {
-    // 1 / K.
-    weight: f32,
-    // Normal offset of the lookup point, in shadow-map texels.
-    normal_offset: f32,
-    // Half the sides of one stratum of the light, world units, along the light's two axes.
-    stratum_half_size: vec2<f32>,
-    // The texels of the receiver's own depth change the side faces' bias allows.
-    side_face_bias_texels: f32,
-    padding_0: f32,
-    padding_1: f32,
-    padding_2: f32,
-};
+// The settings, declared once in Rust (`MultiSmSettingsUniform`, ssm-techniques/multi-sm/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/MultiSmSettings
 
 // Group 0 (`frame`) holds this sample's frame: a point light at the sample, with the light's axes.
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;

@@ -23,16 +23,9 @@
 // #import common/shadow_map.wgsl
 // #import common/read_counts.wgsl
 
-struct PcssSettings {
-    // Samples per axis of the blocker search (n).
-    blocker_kernel: u32,
-    // Samples per axis of the filter (m).
-    pcf_kernel: u32,
-    // 1: compare taps with the receiver's tangent plane; 0: with its depth.
-    receiver_plane: u32,
-    // Normal offset of the lookup point, in shadow-map texels.
-    normal_offset: f32,
-};
+// The settings, declared once in Rust (`PcssSettingsUniform`, ssm-techniques/pcss/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/PcssSettings
 
 @group(2) @binding(0) var shadow_map: texture_2d<f32>;
 @group(2) @binding(1) var<uniform> settings: PcssSettings;

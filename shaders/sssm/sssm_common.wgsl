@@ -5,31 +5,9 @@
 // #import common/camera.wgsl
 // #import common/read_counts.wgsl
 
-struct SssmSettings {
-    // Samples per axis of the blocker search (n) and of the blur (m).
-    blocker_kernel: u32,
-    blur_kernel: u32,
-    // 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
-    receiver_plane: u32,
-    // Reuse thresholds as fractions of the scene's diagonal (scene_length): light-depth
-    // difference (α) and normal-adjusted camera-depth difference (β).
-    alpha: f32,
-    beta: f32,
-    // Normal offset of shadow-map lookups, texels.
-    normal_offset: f32,
-    // Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
-    bilateral_depth: f32,
-    // a in a blur tap's weight exp(-a x²) at its offset x in [-1, 1] (Sec. 4.4): 1 / (2σ²) for the
-    // Gaussian of σ kernel half-widths, 0 for the mean filter.
-    blur_weight_exponent: f32,
-    // BLUR_ALONG_SCREEN (the paper's rows and columns), BLUR_ALONG_LIGHT (the light's two sides as
-    // the screen sees them on the receiver's tangent plane), or BLUR_AXES_AUTO (the light's sides
-    // for a light ELONGATED_LIGHT_RATIO times longer than wide or more, else the screen's).
-    blur_axes: u32,
-    // 1 (the settings' filter = auto): blurs along the light's sides weigh their taps equally
-    // (blur_weight_exponent 0), whatever blur_weight_exponent says.
-    box_along_light: u32,
-};
+// The settings, declared once in Rust (`SssmSettingsUniform`, ssm-techniques/sssm/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/SssmSettings
 
 // The settings' blur_axes.
 const BLUR_ALONG_SCREEN: u32 = 0u;

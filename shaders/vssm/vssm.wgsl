@@ -24,17 +24,9 @@
 // #import common/read_counts.wgsl
 // #import vssm/vssm_common.wgsl
 
-struct VssmSettings {
-    // Side of the shadow map and its summed-area table, texels.
-    size: f32,
-    // Sub-regions per axis of each region (1: plain VSM).
-    subdivision: u32,
-    // Smallest variance the bound uses, in z² units (z = depth / far): keeps it finite on a flat
-    // region, where it is 0, and absorbs the rounding of the table's sums to f32.
-    min_variance: f32,
-    // Normal offset of the lookup point, in shadow-map texels.
-    normal_offset: f32,
-};
+// The settings, declared once in Rust (`VssmSettingsUniform`, ssm-techniques/vssm/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/VssmSettings
 
 @group(2) @binding(0) var moment_table: texture_2d<u32>;
 @group(2) @binding(1) var<uniform> settings: VssmSettings;

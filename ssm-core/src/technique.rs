@@ -287,10 +287,18 @@ pub struct RustLayout {
     pub fields: &'static [(&'static str, usize)],
 }
 
-/// A Rust struct uploaded as a uniform, whose layout can be checked against WGSL.
+/// A Rust struct uploaded as a uniform: its layout, and the WGSL struct the shaders read it as,
+/// written from the Rust one (`#[derive(UniformStruct)]`), so that the struct is declared once.
 pub trait UniformStruct {
     /// Its layout.
     const LAYOUT: RustLayout;
+    /// The WGSL struct's name.
+    const WGSL_NAME: &'static str;
+    /// The path a shader imports the declaration by: `rust/<WGSL_NAME>` (`// #import rust/...`).
+    const WGSL_IMPORT: &'static str;
+    /// The WGSL declaration (`struct <WGSL_NAME> { ... }`), each field's doc comment its comment:
+    /// a technique lists it among its importable files, and its shaders `// #import` it.
+    const WGSL: &'static str;
 }
 
 /// A uniform a technique uploads, paired with the WGSL struct its shaders read

@@ -347,10 +347,19 @@ fn choice(input: &DeriveInput) -> syn::Result<Tokens> {
 
 /// Derives `ssm_core::UniformStruct` for a `#[repr(C)]` struct uploaded as a
 /// uniform: its size and the offset of every field, so that a test can check
-/// them against the WGSL struct the shaders declare (naga reflection).
-/// Fields whose names start with `pad` or `_pad` are padding and need no
-/// WGSL counterpart.
-#[proc_macro_derive(UniformStruct)]
+/// them against the WGSL struct the shaders declare (naga reflection), and the
+/// WGSL declaration itself (`UniformStruct::WGSL`), so that the struct is
+/// written once: a technique hands it to its shaders as an importable file.
+///
+/// The WGSL struct is named by `#[wgsl(name = "...")]`, else by the Rust name
+/// without a trailing `Uniform`; each field's doc comment becomes its WGSL
+/// comment; shaders import it as `// #import rust/<WGSL name>`
+/// (`UniformStruct::WGSL_IMPORT`). Field types: `u32`, `i32`, `f32`, arrays of 2 to 4 of them
+/// (`vecN`), `[[f32; R]; C]` (`matCxR<f32>`), and glam's `Vec2`–`Vec4`,
+/// `UVec2`–`UVec4`, `IVec2`–`IVec4` and `Mat4`. Fields whose names start with
+/// `pad` or `_pad` are padding (they keep their WGSL member, so that both
+/// sides have one size).
+#[proc_macro_derive(UniformStruct, attributes(wgsl))]
 pub fn derive_uniform(input: TokenStream) -> TokenStream {
     let input = syn::parse_macro_input!(input as DeriveInput);
     uniform(&input).unwrap_or_else(syn::Error::into_compile_error).into()
@@ -367,6 +376,21 @@ fn uniform(input: &DeriveInput) -> syn::Result<Tokens> {
     let names: Vec<String> = fields.named.iter().filter_map(|f| f.ident.as_ref().map(ToString::to_string)).collect();
     let idents: Vec<&Ident> = fields.named.iter().filter_map(|f| f.ident.as_ref()).collect();
     let rust_name = name.to_string();
+    let wgsl_name = wgsl_struct_name(input)?;
+    let mut wgsl = format!("struct {wgsl_name} {{\n");
+    for field in &fields.named {
+        let doc = doc_lines(&field.attrs);
+        for line in doc {
+            wgsl.push_str(&format!("    //{}{line}\n", if line.is_empty() { "" } else { " " }));
+        }
+        let ty = wgsl_type(&field.ty).ok_or_else(|| {
+            syn::Error::new(field.ty.span(), "UniformStruct: no WGSL type for this field (u32, i32, f32, arrays of 2 to 4 of them, [[f32; R]; C], glam vectors and Mat4)")
+        })?;
+        let field_name = field.ident.as_ref().map(ToString::to_string).unwrap_or_default();
+        wgsl.push_str(&format!("    {field_name}: {ty},\n"));
+    }
+    wgsl.push_str("}\n");
+    let wgsl_import = format!("{}{wgsl_name}", "rust/");
     Ok(quote! {
         impl ::ssm_core::UniformStruct for #name {
             const LAYOUT: ::ssm_core::RustLayout = ::ssm_core::RustLayout {
@@ -374,6 +398,84 @@ fn uniform(input: &DeriveInput) -> syn::Result<Tokens> {
                 size: ::core::mem::size_of::<Self>(),
                 fields: &[#((#names, ::core::mem::offset_of!(Self, #idents))),*],
             };
+            const WGSL_NAME: &'static str = #wgsl_name;
+            const WGSL_IMPORT: &'static str = #wgsl_import;
+            const WGSL: &'static str = #wgsl;
         }
     })
+}
+
+/// The WGSL struct's name: `#[wgsl(name = "...")]`, else the Rust name less a trailing `Uniform`.
+fn wgsl_struct_name(input: &DeriveInput) -> syn::Result<String> {
+    let mut name = None;
+    for attribute in input.attrs.iter().filter(|a| a.path().is_ident("wgsl")) {
+        attribute.parse_nested_meta(|meta| {
+            if meta.path.is_ident("name") {
+                let value: LitStr = meta.value()?.parse()?;
+                name = Some(value.value());
+                Ok(())
+            } else {
+                Err(meta.error("expected name"))
+            }
+        })?;
+    }
+    let rust = input.ident.to_string();
+    Ok(name.unwrap_or_else(|| rust.strip_suffix("Uniform").filter(|s| !s.is_empty()).unwrap_or(&rust).to_owned()))
+}
+
+/// The lines of a doc comment as written (a blank line kept, leading space trimmed).
+fn doc_lines(attrs: &[syn::Attribute]) -> Vec<String> {
+    attrs
+        .iter()
+        .filter(|a| a.path().is_ident("doc"))
+        .filter_map(|a| match &a.meta {
+            syn::Meta::NameValue(nv) => match &nv.value {
+                Expr::Lit(syn::ExprLit { lit: Lit::Str(text), .. }) => {
+                    let text = text.value();
+                    Some(text.strip_prefix(' ').unwrap_or(&text).trim_end().to_owned())
+                }
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect()
+}
+
+/// The WGSL type of a uniform field's Rust type, where there is one.
+fn wgsl_type(ty: &Type) -> Option<String> {
+    let scalar = |ty: &Type| match type_name(ty).as_deref() {
+        Some(name @ ("u32" | "i32" | "f32")) if matches!(ty, Type::Path(_)) => Some(name.to_owned()),
+        _ => None,
+    };
+    let length = |array: &syn::TypeArray| match &array.len {
+        Expr::Lit(syn::ExprLit { lit: Lit::Int(n), .. }) => n.base10_parse::<u32>().ok(),
+        _ => None,
+    };
+    match ty {
+        Type::Path(_) => scalar(ty).or_else(|| {
+            let name = type_name(ty)?;
+            let (element, size) = match name.as_str() {
+                "Vec2" | "Vec3" | "Vec4" => ("f32", &name[3..]),
+                "UVec2" | "UVec3" | "UVec4" => ("u32", &name[4..]),
+                "IVec2" | "IVec3" | "IVec4" => ("i32", &name[4..]),
+                "Mat4" => return Some("mat4x4<f32>".to_owned()),
+                _ => return None,
+            };
+            Some(format!("vec{size}<{element}>"))
+        }),
+        Type::Array(array) => {
+            let n = length(array).filter(|n| (2..=4).contains(n))?;
+            if let Some(element) = scalar(&array.elem) {
+                return Some(format!("vec{n}<{element}>"));
+            }
+            match array.elem.as_ref() {
+                Type::Array(column) if scalar(&column.elem).as_deref() == Some("f32") => {
+                    let rows = length(column).filter(|r| (2..=4).contains(r))?;
+                    Some(format!("mat{n}x{rows}<f32>"))
+                }
+                _ => None,
+            }
+        }
+        _ => None,
+    }
 }

@@ -37,7 +37,7 @@
 use bytemuck::{Pod, Zeroable};
 use ssm_core::passes::{bind_group, bind_group_layout, texture_entry, uniform_buffer, uniform_entry};
 use ssm_core::read_counts::ReadCounts;
-use ssm_core::shader::create_shader;
+use ssm_core::shader::create_shader_with_imports;
 use ssm_core::{
     Frame, GpuContext, LightDepthMap, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE, SHADOW_MAP_MIN_SIZE, ScreenPass, Settings,
     ShadowMapBias, ShadowTechnique, TechniqueInfo, TechniqueKind, TechniqueSetup, UniformCheck, UniformStruct, VISIBILITY_FORMAT,
@@ -49,6 +49,8 @@ pub const NAME: &str = "hard";
 
 /// The lookup shader.
 const SHADER: &str = ssm_shaders::hard::HARD;
+/// What the shader imports besides `common/`: its settings struct, written from the Rust one.
+const LOCAL_SHADERS: &[(&str, &str)] = &[(HardSettingsUniform::WGSL_IMPORT, HardSettingsUniform::WGSL)];
 /// The lookup pass's label, and its read counters'.
 const LOOKUP_PASS: &str = "hard_lookup";
 /// What the lookup counts in a counting frame, in the order its shader indexes them: its texel
@@ -66,10 +68,12 @@ pub struct HardSettings {
     pub bias: ShadowMapBias,
 }
 
-/// The lookup settings, as `shaders/hard/hard.wgsl` reads them (`HardSettings`).
+/// The lookup settings as `shaders/hard/hard.wgsl` reads them: the WGSL struct `HardSettings`, which
+/// the derive writes and the shader imports (`// #import rust/HardSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct HardSettingsUniform {
+    /// Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
     _pad0: f32,
     _pad1: f32,
@@ -115,7 +119,7 @@ impl HardShadowMapping {
                 read_counts.buffer().as_entire_binding(),
             ],
         );
-        let module = create_shader(setup.gpu, "hard_lookup_shader", SHADER)?;
+        let module = create_shader_with_imports(setup.gpu, "hard_lookup_shader", SHADER, LOCAL_SHADERS)?;
         let lookup = ScreenPass::new(
             setup,
             NAME,
@@ -165,7 +169,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     presets: &[],
     trade: Some("shadow_map_size=512,1024,2048,4096"),
     debug_outputs: &[],
-    uniforms: &[UniformCheck { wgsl_struct: "HardSettings", wgsl_source: SHADER, imports: &[], rust: HardSettingsUniform::LAYOUT }],
+    uniforms: &[UniformCheck {
+        wgsl_struct: HardSettingsUniform::WGSL_NAME,
+        wgsl_source: SHADER,
+        imports: LOCAL_SHADERS,
+        rust: HardSettingsUniform::LAYOUT,
+    }],
     limits: &[],
     paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };

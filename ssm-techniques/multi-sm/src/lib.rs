@@ -39,7 +39,7 @@ use ssm_core::passes::{
     uniform_entry, visibility_storage_entry,
 };
 use ssm_core::read_counts::ReadCounts;
-use ssm_core::shader::create_shader;
+use ssm_core::shader::create_shader_with_imports;
 use ssm_core::ssm_scene::RectLight;
 use ssm_core::{
     Error, Frame, GpuContext, LightDepthMap, LightFrame, LightFrameUniform, ParamValues, Requirements, Result, SHADOW_MAP_MAX_SIZE,
@@ -52,6 +52,8 @@ pub const NAME: &str = "multi-sm";
 
 /// The accumulation shader.
 const SHADER: &str = ssm_shaders::multi_sm::MULTI_SM;
+/// What the shader imports besides `common/`: its settings struct, written from the Rust one.
+const LOCAL_SHADERS: &[(&str, &str)] = &[(MultiSmSettingsUniform::WGSL_IMPORT, MultiSmSettingsUniform::WGSL)];
 /// The accumulation pass's label.
 const ACCUMULATE_PASS: &str = "multi_sm_accumulate";
 /// What the accumulation counts in a counting frame, in the order its shader indexes them: texel
@@ -73,11 +75,14 @@ pub struct MultiSmSettings {
     pub bias: ShadowMapBias,
 }
 
-/// The accumulation settings, as `shaders/multi-sm/multi_sm.wgsl` reads them (`MultiSmSettings`).
+/// The accumulation settings as `shaders/multi-sm/multi_sm.wgsl` reads them: the WGSL struct
+/// `MultiSmSettings`, which the derive writes and the shader imports (`// #import rust/MultiSmSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct MultiSmSettingsUniform {
+    /// 1 / K.
     weight: f32,
+    /// Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
     /// Half the sides of one stratum of the light, world units (along its first and second axes).
     stratum_half_size: [f32; 2],
@@ -206,7 +211,7 @@ impl MultiShadowMaps {
                 )
             })
             .collect();
-        let module = create_shader(setup.gpu, "multi_sm_shader", SHADER)?;
+        let module = create_shader_with_imports(setup.gpu, "multi_sm_shader", SHADER, LOCAL_SHADERS)?;
         let accumulate = compute_pipeline(
             device,
             "multi_sm_accumulate_pipeline",
@@ -348,7 +353,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     presets: PRESETS,
     trade: Some("samples=1,4,16,64"),
     debug_outputs: &[],
-    uniforms: &[UniformCheck { wgsl_struct: "MultiSmSettings", wgsl_source: SHADER, imports: &[], rust: MultiSmSettingsUniform::LAYOUT }],
+    uniforms: &[UniformCheck {
+        wgsl_struct: MultiSmSettingsUniform::WGSL_NAME,
+        wgsl_source: SHADER,
+        imports: LOCAL_SHADERS,
+        rust: MultiSmSettingsUniform::LAYOUT,
+    }],
     limits: &[],
     paper_configuration: ssm_core::PaperConfiguration::DEFAULTS,
 };

@@ -63,7 +63,8 @@ const SHADER: &str = ssm_shaders::pcss::PCSS;
 /// The compute pass whose workgroups share the texels they read.
 const TILED_SHADER: &str = ssm_shaders::pcss::PCSS_TILED;
 /// WGSL files the PCSS shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("pcss/pcss_common.wgsl", COMMON_SHADER)];
+const LOCAL_SHADERS: &[(&str, &str)] =
+    &[(PcssSettingsUniform::WGSL_IMPORT, PcssSettingsUniform::WGSL), ("pcss/pcss_common.wgsl", COMMON_SHADER)];
 /// The label of the pass (both implementations), and of its read counts.
 const PASS: &str = "pcss_blocker_search_and_filter";
 /// What the pass counts, in the order its shaders index them (`record_pcss_reads_of` in
@@ -109,13 +110,18 @@ pub struct PcssSettings {
     pub bias: ShadowMapBias,
 }
 
-/// The kernel sizes, as `shaders/pcss/pcss_common.wgsl` reads them (`PcssSettings`) for both tap sources.
+/// The kernel sizes as `shaders/pcss/pcss_common.wgsl` reads them for both tap sources: the WGSL struct
+/// `PcssSettings`, which the derive writes and the shader imports (`// #import rust/PcssSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct PcssSettingsUniform {
+    /// Samples per axis of the blocker search (n).
     blocker_kernel: u32,
+    /// Samples per axis of the filter (m).
     pcf_kernel: u32,
+    /// 1: compare taps with the receiver's tangent plane; 0: with its depth.
     receiver_plane: u32,
+    /// Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
 }
 
@@ -347,7 +353,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: Some("blocker_kernel:pcf_kernel=3:5,7:15,11:21,29:41"),
     debug_outputs: &[],
     uniforms: &[
-        UniformCheck { wgsl_struct: "PcssSettings", wgsl_source: SHADER, imports: LOCAL_SHADERS, rust: PcssSettingsUniform::LAYOUT },
+        UniformCheck {
+            wgsl_struct: PcssSettingsUniform::WGSL_NAME,
+            wgsl_source: SHADER,
+            imports: LOCAL_SHADERS,
+            rust: PcssSettingsUniform::LAYOUT,
+        },
         UniformCheck {
             wgsl_struct: "PcssSideFaceSettings",
             wgsl_source: ssm_shaders::pcss::PCSS_SIDE_FACES,

@@ -57,6 +57,7 @@ pub const NAME: &str = "sssm";
 
 /// WGSL files the SSSM passes import besides `common/`.
 const LOCAL_SHADERS: &[(&str, &str)] = &[
+    (SssmSettingsUniform::WGSL_IMPORT, SssmSettingsUniform::WGSL),
     ("sssm/sssm_common.wgsl", ssm_shaders::sssm::SSSM_COMMON),
     ("sssm/sssm_blocker_blur.wgsl", ssm_shaders::sssm::SSSM_BLOCKER_BLUR),
     ("sssm/sssm_vertical_blur.wgsl", ssm_shaders::sssm::SSSM_VERTICAL_BLUR),
@@ -192,19 +193,34 @@ pub struct SssmSettings {
     pub bias: ShadowMapBias,
 }
 
-/// `SssmSettings` of `shaders/sssm/sssm_common.wgsl`.
+/// The settings as the shaders read them: the WGSL struct `SssmSettings`, which the derive writes
+/// and `shaders/sssm/sssm_common.wgsl` imports (`// #import rust/SssmSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct SssmSettingsUniform {
+    /// Samples per axis of the blocker search (n).
     blocker_kernel: u32,
+    /// Samples per axis of the blur (m).
     blur_kernel: u32,
+    /// 1: blocker taps compare with the receiver's tangent plane (as pcss's receiver_plane); 0: with its depth.
     receiver_plane: u32,
+    /// Reuse threshold α, a fraction of the scene's diagonal (scene_length): light-depth difference.
     alpha: f32,
+    /// Reuse threshold β, a fraction of the scene's diagonal: normal-adjusted camera-depth difference.
     beta: f32,
+    /// Normal offset of shadow-map lookups, texels.
     normal_offset: f32,
+    /// Depth tolerance of the blurs' bilateral weights, a fraction of the scene's diagonal; 0: no bilateral weighting.
     bilateral_depth: f32,
+    /// a in a blur tap's weight exp(-a x²) at its offset x in [-1, 1] (Sec. 4.4): 1 / (2σ²) for the
+    /// Gaussian of σ kernel half-widths, 0 for the mean filter.
     blur_weight_exponent: f32,
+    /// BLUR_ALONG_SCREEN (the paper's rows and columns), BLUR_ALONG_LIGHT (the light's two sides as
+    /// the screen sees them on the receiver's tangent plane), or BLUR_AXES_AUTO (the light's sides
+    /// for a light ELONGATED_LIGHT_RATIO times longer than wide or more, else the screen's).
     blur_axes: u32,
+    /// 1 (the settings' filter = auto): blurs along the light's sides weigh their taps equally
+    /// (blur_weight_exponent 0), whatever blur_weight_exponent says.
     box_along_light: u32,
 }
 
@@ -868,7 +884,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         },
     ],
     uniforms: &[UniformCheck {
-        wgsl_struct: "SssmSettings",
+        wgsl_struct: SssmSettingsUniform::WGSL_NAME,
         wgsl_source: HORIZONTAL_BLOCKER_SHADER,
         imports: LOCAL_SHADERS,
         rust: SssmSettingsUniform::LAYOUT,

@@ -62,7 +62,8 @@ const SAT_SHADER: &str = ssm_shaders::vssm::VSSM_SAT;
 /// The blocker search, penumbra estimate and filter.
 const FILTER_SHADER: &str = ssm_shaders::vssm::VSSM;
 /// WGSL files the VSSM shaders import besides `common/`.
-const LOCAL_SHADERS: &[(&str, &str)] = &[("vssm/vssm_common.wgsl", COMMON_SHADER)];
+const LOCAL_SHADERS: &[(&str, &str)] =
+    &[(VssmSettingsUniform::WGSL_IMPORT, VssmSettingsUniform::WGSL), ("vssm/vssm_common.wgsl", COMMON_SHADER)];
 
 /// What the shaders count in a counting frame, in the order they index the counters: the table's
 /// two passes their texel reads, the bytes those fetched and the bytes stored (vssm_sat.wgsl), the
@@ -113,13 +114,19 @@ impl VssmSettings {
     }
 }
 
-/// `VssmSettings` of `shaders/vssm/vssm.wgsl`.
+/// The filter's settings as `shaders/vssm/vssm.wgsl` reads them: the WGSL struct `VssmSettings`, which the
+/// derive writes and the shader imports (`// #import rust/VssmSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct VssmSettingsUniform {
+    /// Side of the shadow map and its summed-area table, texels.
     size: f32,
+    /// Sub-regions per axis of each region (1: plain VSM).
     subdivision: u32,
+    /// Smallest variance the bound uses, in z² units (z = depth / far): keeps it finite on a flat
+    /// region, where it is 0, and absorbs the rounding of the table's sums to f32.
     min_variance: f32,
+    /// Normal offset of the lookup point, in shadow-map texels.
     normal_offset: f32,
 }
 
@@ -319,7 +326,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: Some("subdivision=1,2,4"),
     debug_outputs: &[],
     uniforms: &[UniformCheck {
-        wgsl_struct: "VssmSettings",
+        wgsl_struct: VssmSettingsUniform::WGSL_NAME,
         wgsl_source: FILTER_SHADER,
         imports: LOCAL_SHADERS,
         rust: VssmSettingsUniform::LAYOUT,
