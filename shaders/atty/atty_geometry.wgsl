@@ -1,5 +1,5 @@
 // Atty et al. 2006, the micro-patch geometry (Sec. 3.3, 3.4, 4.2) that the list pass
-// (atty_patches.wgsl) and the accumulation (atty_accumulate.wgsl) evaluate. Its twin is
+// (atty_micro_patches.wgsl) and the accumulation (atty_accumulation.wgsl) evaluate. Its twin is
 // ssm-techniques/atty/src/geometry.rs, which also states the paper's own forms; the crate's tests
 // check that module against hand-computed cases and run these functions on the GPU against it.
 // Coordinates: the light's view space (x along u, y along v, depth along its normal from its
@@ -49,7 +49,7 @@ fn hidden_fraction(light_half: vec2<f32>, patch_centre: vec2<f32>, patch_half: v
 
 // Depth, along the ray through ndc `q`, of the tangent plane of the receiver at ndc `receiver_ndc`,
 // depth `receiver_depth`, whose 1/depth has gradient `slope` / receiver_depth per ndc unit (a
-// plane's 1/depth is affine in ndc: 1/z(q) = (1 + slope·(q − q_R)) / z_R; atty_receiver_planes.wgsl
+// plane's 1/depth is affine in ndc: 1/z(q) = (1 + slope·(q − q_R)) / z_R; atty_receiver_map.wgsl
 // measures `slope`). NO_SURFACE where the ray meets the plane behind the light or runs along it.
 fn patch_ray_plane_depth(receiver_ndc: vec2<f32>, receiver_depth: f32, slope: vec2<f32>, q: vec2<f32>) -> f32 {
     let denominator = 1.0 + dot(slope, q - receiver_ndc);

@@ -2,7 +2,7 @@
 // (depth, depth), NO_SURFACE where the texel is empty; texel t of level L the smallest and
 // largest depth over texels t·2^L to (t + 1)·2^L − 1 of level 0 (sizes halve rounding down, so
 // a block never runs past the map). The accumulation merges a block whose depths agree into one
-// micro-patch (atty_accumulate.wgsl).
+// micro-patch (atty_accumulation.wgsl).
 
 // #import common/shadow_map.wgsl
 // #import atty/atty_counts.wgsl

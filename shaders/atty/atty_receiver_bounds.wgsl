@@ -1,7 +1,7 @@
 // The receiver map's depth bounds (max-pyramid): level 0 holds each texel's receiver depth (0
 // where there is no receiver), each further level the largest of the 2×2 texels below it. The
 // accumulation reads it to bound each micro-patch's penumbra rectangle by the deepest receiver
-// under it instead of the frame's far plane (atty_accumulate.wgsl, `penumbra_bound`).
+// under it instead of the frame's far plane (atty_accumulation.wgsl, `penumbra_bound`).
 
 // #import common/shadow_map.wgsl
 // #import atty/atty_counts.wgsl

@@ -1,9 +1,10 @@
 //! The micro-patch geometry of Atty et al. 2006 (Sec. 3.3, 3.4 and 4.2) on the CPU: the paper's
 //! formulas as written, and the forms the shaders evaluate.
 //!
-//! `shaders/atty/atty_geometry.wgsl` is this module's twin: the list pass (`atty_patches.wgsl`)
-//! bounds every penumbra rectangle with its `penumbra_half_ndc`, and the accumulation
-//! (`atty_accumulate.wgsl`) adds `hidden_fraction` and applies `on_or_behind_receiver_plane`.
+//! `shaders/atty/atty_geometry.wgsl` is this module's twin: the list pass
+//! (`atty_micro_patches.wgsl`) bounds every penumbra rectangle with its `penumbra_half_ndc`, and
+//! the accumulation (`atty_accumulation.wgsl`) adds `hidden_fraction` and applies
+//! `on_or_behind_receiver_plane`.
 //! The crate's tests check these functions against hand-computed cases and the paper's own form,
 //! then run the WGSL functions on the GPU against them.
 //!
@@ -123,7 +124,7 @@ pub fn hidden_fraction(light_half: Vec2, patch: &MicroPatch, receiver: Vec2, rec
 /// A receiver's tangent plane as the soft shadow map sees it: along the ray from the light's
 /// centre through ndc `q`, a plane's `1/depth` is affine in `q` (perspective), so the plane through
 /// the receiver at ndc `q_R`, depth `z_R` is `1/z(q) = (1 + slope·(q − q_R))/z_R`, with
-/// `slope = z_R · ∇_q(1/z)`. `atty_receiver_planes.wgsl` measures `slope` from the receiver map.
+/// `slope = z_R · ∇_q(1/z)`. `atty_receiver_map.wgsl` measures `slope` from the receiver map.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReceiverPlane {
     /// The receiver's ndc position `q_R` in the soft shadow map.

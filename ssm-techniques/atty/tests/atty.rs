@@ -380,7 +380,7 @@ impl SquareCase {
     }
 
     /// The f32 rounding of one point's sum of hidden fractions (`hidden_fraction` in
-    /// atty_geometry.wgsl, its inputs as atty_accumulate.wgsl forms them). Every lateral value is
+    /// atty_geometry.wgsl, its inputs as atty_accumulation.wgsl forms them). Every lateral value is
     /// at most L = z_R·tan in magnitude; the receiver and the patch centre carry up to 5 roundings
     /// each (ndc from the texel, times depth, times tan), the scale s = z_R/(z_R − z_P) two, and
     /// the edge `low = R + (c − h − R)·s` four more, those before the scaling magnified by s. For

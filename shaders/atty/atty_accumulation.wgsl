@@ -1,7 +1,7 @@
 // Atty et al. 2006, Soft Shadow Maps: the soft shadow map (SSM) accumulation,
 // entirely on the GPU (the paper's own next step, Sec. 4.3 and 7: no readback
 // of the occluder map). One instanced quad per micro-patch of the list that
-// atty_patches.wgsl builds: the vertex stage emits the patch's penumbra
+// atty_micro_patches.wgsl builds: the vertex stage emits the patch's penumbra
 // rectangle on the SSM; the fragment stage reads the receiver depth and adds
 // the fraction of the light the patch hides there. Additive blending sums the
 // patches.
@@ -13,10 +13,10 @@
 // #import atty/atty_counts.wgsl
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
-// The micro-patches that can hide anything (atty_patches.wgsl), one instance each.
+// The micro-patches that can hide anything (atty_micro_patches.wgsl), one instance each.
 @group(1) @binding(0) var<storage, read> patches: array<MicroPatchRecord>;
 // Per SSM texel, x: the receiver's depth (NO_SURFACE where none). With `receiver_plane`, the
-// receiver planes (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the
+// receiver planes (atty_receiver_map.wgsl), whose y, z hold the plane's slope; without, the
 // receiver map itself.
 @group(1) @binding(1) var receivers: texture_2d<f32>;
 @group(1) @binding(2) var<uniform> settings: AttySettings;

@@ -12,7 +12,7 @@
 @group(2) @binding(0) var soft_shadow_front: texture_2d<f32>;
 @group(2) @binding(1) var soft_shadow_back: texture_2d<f32>;
 // Per texel, x: the nearest receiver's depth; with `receiver_plane`, the receiver planes
-// (atty_receiver_planes.wgsl), whose y, z hold the plane's slope; without, the receiver map.
+// (atty_receiver_map.wgsl), whose y, z hold the plane's slope; without, the receiver map.
 @group(2) @binding(2) var receiver_map: texture_2d<f32>;
 @group(2) @binding(3) var<uniform> settings: AttySettings;
 // The projection's counters (atty_counts.wgsl): 0, texel reads; 1, the bytes they fetched.

@@ -170,7 +170,7 @@ fn list_patch(texel: vec2<u32>) -> bool {
     let self_shadow_depth = settings.self_shadow_tolerance * 2.0 * max(half_size.x, half_size.y) / span;
     // The patch stands for the occluder's surface across its texels, whose depth runs this far on
     // either side of the patch's (its slope across half the patch): the receiver-plane test
-    // (atty_accumulate.wgsl) counts a patch whose surface reaches the receiver's plane as lying on it.
+    // (atty_accumulation.wgsl) counts a patch whose surface reaches the receiver's plane as lying on it.
     var depth_spread = 0.0;
     if (settings.receiver_plane != 0.0) {
         let slope = vec2<f32>(depth_step(vec2<i32>(texel), depth, vec2<i32>(1, 0)), depth_step(vec2<i32>(texel), depth, vec2<i32>(0, 1)));

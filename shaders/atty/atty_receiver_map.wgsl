@@ -1,5 +1,5 @@
 // The receiver map with each receiver's tangent plane, for the receiver-plane test
-// (`receiver_plane`; atty_accumulate.wgsl and atty_project.wgsl): per texel of the light frame,
+// (`receiver_plane`; atty_accumulation.wgsl and atty_projection.wgsl): per texel of the light frame,
 // the nearest receiver's linear depth z_R (as the plain receiver map, ssm-core's light_depth.wgsl,
 // without bias) and the slope of its triangle's plane. A plane's 1/depth is affine in the frame's
 // ndc q, 1/z(q) = (1 + slope·(q − q_R)) / z_R (atty_geometry.wgsl), and so in framebuffer
