@@ -80,6 +80,7 @@ pub const NAME: &str = "atty";
 pub const GEOMETRY_SHADER: &str = ssm_shaders::atty::ATTY_GEOMETRY;
 /// WGSL files the Atty shaders import besides `common/`, as `(path under shaders/, text)`.
 pub const LOCAL_SHADERS: &[(&str, &str)] = &[
+    (AttySettingsUniform::WGSL_IMPORT, AttySettingsUniform::WGSL),
     ("atty/atty_settings.wgsl", ssm_shaders::atty::ATTY_SETTINGS),
     ("atty/atty_geometry.wgsl", GEOMETRY_SHADER),
     ("atty/atty_counts.wgsl", ssm_shaders::atty::ATTY_COUNTS),
@@ -123,19 +124,36 @@ pub struct AttySettings {
     pub receiver_plane_tolerance: f32,
 }
 
-/// The settings uniform both Atty shaders read (`AttySettings` in `shaders/atty/atty_settings.wgsl`).
+/// The settings uniform every Atty shader reads: the WGSL struct `AttySettings`, which the derive writes
+/// and `shaders/atty/atty_settings.wgsl` imports (`// #import rust/AttySettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct AttySettingsUniform {
+    /// Side of the occluder map (N), texels.
     occluder_map_size: f32,
+    /// Side of the soft shadow map (and of the receiver map), texels.
     soft_shadow_map_size: f32,
+    /// Normal offset of the projection's lookup point, in receiver-map texels.
     normal_offset: f32,
+    /// Depth tolerance, in receiver-map texel footprints, within which a receiver-map depth counts
+    /// as the looked-up receiver (the hidden-receiver test and the SSM's depth-aware bilinear lookup).
     receiver_tolerance: f32,
+    /// A micro-patch less than this many of its own widths in front of a receiver counts as the
+    /// receiver's own surface and hides nothing (objects with the role `both` are in both maps).
     self_shadow_tolerance: f32,
+    /// Constant depth tolerance of the hidden-receiver test, a fraction of the scene's diagonal (as the baselines' constant bias).
     receiver_bias: f32,
+    /// 1: each micro-patch's penumbra rectangle is bounded by the deepest receiver under it (the
+    /// receiver_bounds pyramid); 0: by the frame's far plane.
     receiver_bounded: f32,
+    /// Neighbouring occluder texels whose depths differ by at most this many micro-patch widths
+    /// are drawn as one micro-patch (0: never).
     merge_tolerance: f32,
+    /// 1: a micro-patch on or behind a receiver's tangent plane hides nothing from it (the
+    /// accumulation reads the receiver planes); 0: the receiver's depth alone decides.
     receiver_plane: f32,
+    /// How far in front of a receiver's tangent plane, in widths of one texel's micro-patch, a patch
+    /// still counts as lying on it.
     receiver_plane_tolerance: f32,
     _pad: [f32; 2],
 }
@@ -247,7 +265,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     trade: Some("occluder_map_size=64,128,256,512"),
     debug_outputs: &[],
     uniforms: &[UniformCheck {
-        wgsl_struct: "AttySettings",
+        wgsl_struct: AttySettingsUniform::WGSL_NAME,
         wgsl_source: projection::PROJECT_SHADER,
         imports: LOCAL_SHADERS,
         rust: AttySettingsUniform::LAYOUT,
