@@ -1,3 +1,8 @@
+//! Each ray's traversal: a shadow ray runs along the segment from its origin to its light sample
+//! (`segment_ray`), through obvhs's own traversal (the definition, `GroundTruth::unoccluded`),
+//! or through the decoded nodes below after the triangles that blocked the pixel's last rays
+//! (`RecentBlockers`), or against the few triangles a shortcut gathered.
+//!
 //! The ground truth's CWBVH as the shortcuts read it: obvhs 0.4's nodes with each child's
 //! quantised bounds converted to floats once, when the BVH is built, rather than at every visit
 //! (by obvhs's own comment, that conversion is the costliest part of its node test). A node's
@@ -14,6 +19,8 @@ use glam::{UVec2, Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::ray::Ray;
+
+use super::GroundTruth;
 
 /// The least distance at which obvhs's node test lets a ray enter a child box (its private
 /// `cwbvh::node::EPSILON`, used where the ray's own `tmin` would be).
@@ -254,10 +261,86 @@ impl DecodedBvh {
     }
 }
 
+/// The last few triangles that blocked a pixel's rays (their BVH slots), newest first, and the
+/// stack its rays traverse the BVH with (kept, so that a traversal allocates nothing).
+#[derive(Default)]
+pub(super) struct RecentBlockers {
+    slots: [u32; 4],
+    count: usize,
+    traversal_stack: Vec<UVec2>,
+}
+
+impl RecentBlockers {
+    fn triangles(&self) -> &[u32] {
+        &self.slots[..self.count]
+    }
+
+    fn push(&mut self, triangle: u32) {
+        let len = self.slots.len();
+        self.slots.copy_within(0..len - 1, 1);
+        self.slots[0] = triangle;
+        self.count = (self.count + 1).min(len);
+    }
+}
+
+/// The ray along the segment from `origin` to `target`, stopping just short of `target` so that
+/// geometry lying in the light's plane does not count; `None` for a segment of no length.
+pub(super) fn segment_ray(origin: Vec3, target: Vec3) -> Option<Ray> {
+    let offset = target - origin;
+    let distance = offset.length();
+    (distance > 0.0).then(|| Ray::new(Vec3A::from(origin), Vec3A::from(offset / distance), 0.0, distance * (1.0 - 1e-6)))
+}
+
+impl GroundTruth {
+    /// True when the segment from `origin` to `target` crosses no triangle.
+    pub(super) fn unoccluded(&self, origin: Vec3, target: Vec3) -> bool {
+        segment_ray(origin, target).is_none_or(|ray| {
+            self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
+        })
+    }
+
+    /// The BVH slot of the triangle the BVH finds first on `ray` (a [`segment_ray`], with the
+    /// test of [`GroundTruth::unoccluded`] and its traversal, node for node), if any.
+    fn first_blocker(&self, ray: &Ray, stack: &mut Vec<UVec2>) -> Option<u32> {
+        let mut found = None;
+        self.decoded.traverse(ray, stack, |slot| {
+            let blocks = self.crosses(ray, slot as u32);
+            if blocks {
+                found = Some(slot as u32);
+            }
+            blocks
+        });
+        found
+    }
+
+    /// True when `ray` crosses the triangle in BVH slot `slot` before its `tmax`.
+    #[inline(always)]
+    fn crosses(&self, ray: &Ray, slot: u32) -> bool {
+        self.prepared[slot as usize].intersect(ray) < ray.tmax
+    }
+
+    /// True when the ray from `origin` to `target` crosses one of `candidates` (BVH slots; the same
+    /// segment and intersection test as [`GroundTruth::unoccluded`]).
+    pub(super) fn blocked_by(&self, origin: Vec3, target: Vec3, candidates: &[u32]) -> bool {
+        segment_ray(origin, target).is_some_and(|ray| candidates.iter().any(|slot| self.crosses(&ray, *slot)))
+    }
+
+    /// True when the ray from `origin` to `target` is blocked: by one of the triangles in
+    /// `recent` (tried first: a pixel's neighbouring rays mostly hit the same ones), else by the
+    /// triangle the BVH finds, which `recent` then remembers. The same answer as
+    /// `!unoccluded`: a ray a remembered triangle blocks is blocked.
+    pub(super) fn blocked_remembering(&self, origin: Vec3, target: Vec3, recent: &mut RecentBlockers) -> bool {
+        let Some(ray) = segment_ray(origin, target) else { return false };
+        recent.triangles().iter().any(|slot| self.crosses(&ray, *slot))
+            || self.first_blocker(&ray, &mut recent.traversal_stack).map(|blocker| recent.push(blocker)).is_some()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reference::{Pyramid, SplitMix64};
+    use crate::reference::SplitMix64;
+    use crate::reference::pyramid::Pyramid;
     use glam::Vec2;
     use obvhs::cwbvh::builder::build_cwbvh_from_tris;
     use obvhs::triangle::Triangle;
