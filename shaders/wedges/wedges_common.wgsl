@@ -1,7 +1,8 @@
 // Penumbra wedges (Akenine-Möller and Assarsson 2002, Assarsson and
 // Akenine-Möller 2003) with Forest, Barthe and Paulin's blending of
 // overlapping penumbrae (Graphics Hardware 2006): what every wedges shader
-// shares. The buffers' layouts are those of ssm-techniques/wedges/src/lib.rs.
+// shares. The buffers' layouts are those of ssm-techniques/wedges/src/ (lib.rs,
+// mesh.rs, silhouettes.rs).
 
 // #import common/light_frame.wgsl
 

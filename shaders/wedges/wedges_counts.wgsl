@@ -6,7 +6,7 @@
 // counted; every atomic built-in (load, store, add, min) is one atomic; a plain store to storage
 // writes its type's bytes. Every pass that counts reads also counts the bytes they fetched: a
 // texel at its format's size (the *_BYTES constants below, which a test in
-// ssm-techniques/wedges's lib.rs checks against the formats), a storage element at its type's.
+// ssm-techniques/wedges's gpu.rs checks against the formats), a storage element at its type's.
 // The counting code is compiled out unless COUNT_READS.
 
 // #import common/read_counts.wgsl

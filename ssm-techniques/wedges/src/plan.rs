@@ -11,7 +11,9 @@
 
 use ssm_core::{Error, Result};
 
-use crate::{CastingMesh, NAME, SILHOUETTE_BYTES, SILHOUETTE_TARGETS, WEDGE_RECORD_BYTES, WORKGROUP};
+use crate::blend::SILHOUETTE_BYTES;
+use crate::gpu::WORKGROUP;
+use crate::{CastingMesh, NAME, SILHOUETTE_TARGETS, WEDGE_RECORD_BYTES};
 
 /// Bytes per pixel of each final-buffer binding (one `vec4<f32>`).
 pub const FINAL_BINDING_BYTES_PER_PIXEL: u64 = 16;

@@ -3,7 +3,7 @@
 //! spheres 0.3 apart above the ground (Sec. 5, Figs. 1 and 12: "a collection
 //! of spheres", 762 triangles each, their number increased to measure how the
 //! cost grows with the geometry), and the scene names of the `wedges-fig12`
-//! preset.
+//! and `wedges-atty-fig25` presets.
 
 use ssm_scene::Scene;
 
@@ -37,6 +37,28 @@ pub fn sphere_cube(side: u32, segments: u32, rings: u32) -> Scene {
         None => panic!("`sphere-cube` is not a built-in scene"),
     }
 }
+
+/// Fig. 12's scenes: cubes of 1 to 7 spheres a side (1 to 343 spheres) of the paper's 760
+/// triangles, the built-in `sphere-cube` with parameters ([`scenes::sphere_cube_name`](crate::scenes::sphere_cube_name)).
+pub const FIG12_SCENES: &[&str] = &[
+    "sphere-cube:spheres=1,segments=20,rings=20",
+    "sphere-cube:spheres=2,segments=20,rings=20",
+    "sphere-cube:spheres=3,segments=20,rings=20",
+    "sphere-cube:spheres=4,segments=20,rings=20",
+    "sphere-cube:spheres=5,segments=20,rings=20",
+    "sphere-cube:spheres=6,segments=20,rings=20",
+    "sphere-cube:spheres=7,segments=20,rings=20",
+];
+
+/// Atty et al.'s Fig. 25: the same cubes from 8 spheres.
+pub const FIG25_SCENES: &[&str] = &[
+    "sphere-cube:spheres=2,segments=20,rings=20",
+    "sphere-cube:spheres=3,segments=20,rings=20",
+    "sphere-cube:spheres=4,segments=20,rings=20",
+    "sphere-cube:spheres=5,segments=20,rings=20",
+    "sphere-cube:spheres=6,segments=20,rings=20",
+    "sphere-cube:spheres=7,segments=20,rings=20",
+];
 
 #[cfg(test)]
 mod tests {
