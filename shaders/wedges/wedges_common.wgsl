@@ -42,38 +42,12 @@ const WEDGE_FALLBACK: u32 = 2u;
 const WEDGE_PYRAMID: u32 = 4u;
 const WEDGE_APEX_B: u32 = 8u;
 
-// The technique's parameters (WedgesSettingsUniform).
-struct WedgesSettings {
-    // 0: none, the silhouettes' occlusions summed (Akenine-Möller and Assarsson); 1: Forest et al.'s blending.
-    blending: u32,
-    // Silhouette buffers K: silhouette regions are blended in K groups.
-    silhouette_buffers: u32,
-    _pad0: u32,
-    _pad1: u32,
-    // Depth in front of the light's plane below which silhouette edges are clipped (the
-    // geometric near plane), and the local near plane's offset, as fractions of the scene's diagonal.
-    near_fraction: f32,
-    // Slack of Lengyel's bounding-plane rejection, a fraction of the scene's diagonal.
-    plane_tolerance: f32,
-    // Camera depth the G-buffer's is moved by, to the surface's side facing the light, when it is copied for the volumes (NDC units).
-    depth_bias: f32,
-    _pad2: f32,
-};
-
-// The casting mesh's sizes and the scene's bounds (WedgesMeshUniform).
-struct WedgesMesh {
-    face_count: u32,
-    record_count: u32,
-    half_edge_capacity: u32,
-    rank_blocks: u32,
-    width: u32,
-    height: u32,
-    _pad0: u32,
-    _pad1: u32,
-    // The scene's bounding box, enlarged by a margin (w unused): wedges are cut at its faces.
-    bounds_min: vec4<f32>,
-    bounds_max: vec4<f32>,
-};
+// The technique's parameters (`WedgesSettings`) and the casting mesh's sizes and the scene's
+// bounds (`WedgesMesh`), declared once in Rust (`WedgesSettingsUniform` in
+// ssm-techniques/wedges/src/lib.rs, `WedgesMeshUniform` in src/silhouettes.rs), whose derive
+// writes these structs.
+// #import rust/WedgesSettings
+// #import rust/WedgesMesh
 
 // One triangle of the welded casting mesh (Requirements::adjacency).
 struct Face {

@@ -10,14 +10,16 @@
 use bytemuck::Pod;
 use ssm_core::passes::{bind_group, bind_group_layout, uniform_buffer, uniform_entry};
 use ssm_core::read_counts::ReadCounts;
-use ssm_core::{Result, TechniqueSetup};
+use ssm_core::{Result, TechniqueSetup, UniformStruct};
 use wgpu::util::DeviceExt;
 
 use crate::silhouettes::{COUNTER_WORDS, SilhouettePasses, WEDGE_RECORD_BYTES, WedgesMeshUniform};
-use crate::{CastingMesh, MAX_SILHOUETTE_BUFFERS, MeshReport, volumes, wedges};
+use crate::{CastingMesh, MAX_SILHOUETTE_BUFFERS, MeshReport, WedgesSettingsUniform, volumes, wedges};
 
 /// WGSL files the wedges shaders import besides `common/`.
 pub(crate) const LOCAL_SHADERS: &[(&str, &str)] = &[
+    (WedgesSettingsUniform::WGSL_IMPORT, WedgesSettingsUniform::WGSL),
+    (WedgesMeshUniform::WGSL_IMPORT, WedgesMeshUniform::WGSL),
     ("wedges/wedges_common.wgsl", ssm_shaders::wedges::WEDGES_COMMON),
     ("wedges/wedges_counts.wgsl", ssm_shaders::wedges::WEDGES_COUNTS),
     ("wedges/wedges_wedges.wgsl", wedges::WEDGES_SHADER),

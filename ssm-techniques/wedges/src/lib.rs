@@ -122,16 +122,23 @@ pub struct WedgesSettings {
     pub silhouette_buffers: u32,
 }
 
-/// The technique's parameters as the shaders read them (`WedgesSettings` in `shaders/wedges/wedges_common.wgsl`).
+/// The technique's parameters as the shaders read them: the WGSL struct `WedgesSettings`, which the
+/// derive writes and `shaders/wedges/wedges_common.wgsl` imports (`// #import rust/WedgesSettings`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct WedgesSettingsUniform {
+    /// 0: none, the silhouettes' occlusions summed (Akenine-Möller and Assarsson); 1: Forest et al.'s blending.
     blending: u32,
+    /// Silhouette buffers K: silhouette regions are blended in K groups.
     silhouette_buffers: u32,
     _pad0: u32,
     _pad1: u32,
+    /// Depth in front of the light's plane below which silhouette edges are clipped (the
+    /// geometric near plane), and the local near plane's offset, as fractions of the scene's diagonal.
     near_fraction: f32,
+    /// Slack of Lengyel's bounding-plane rejection, a fraction of the scene's diagonal.
     plane_tolerance: f32,
+    /// Camera depth the G-buffer's is moved by, to the surface's side facing the light, when it is copied for the volumes (NDC units).
     depth_bias: f32,
     _pad2: f32,
 }
@@ -359,13 +366,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     debug_outputs: &[],
     uniforms: &[
         UniformCheck {
-            wgsl_struct: "WedgesSettings",
+            wgsl_struct: WedgesSettingsUniform::WGSL_NAME,
             wgsl_source: SILHOUETTES_SHADER,
             imports: LOCAL_SHADERS,
             rust: WedgesSettingsUniform::LAYOUT,
         },
         UniformCheck {
-            wgsl_struct: "WedgesMesh",
+            wgsl_struct: WedgesMeshUniform::WGSL_NAME,
             wgsl_source: SILHOUETTES_SHADER,
             imports: LOCAL_SHADERS,
             rust: WedgesMeshUniform::LAYOUT,

@@ -29,18 +29,26 @@ const STENCIL_LEVELS_WORD: usize = 8 + 6 * MAX_SILHOUETTE_BUFFERS as usize;
 /// Stencil levels: the count is 8 bits, wrapping (a point in 256 volumes of one buffer reads 0).
 const STENCIL_LEVELS: u32 = 256;
 
-/// The casting mesh's sizes as the shaders read them (`WedgesMesh`).
+/// The casting mesh's sizes as the shaders read them: the WGSL struct `WedgesMesh`, which the derive
+/// writes and `shaders/wedges/wedges_common.wgsl` imports (`// #import rust/WedgesMesh`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct WedgesMeshUniform {
+    /// Faces of the casting mesh.
     pub(crate) face_count: u32,
+    /// Edge records of the casting mesh (`CastingMesh::records`).
     pub(crate) record_count: u32,
+    /// Slots of the half-edge table (`CastingMesh::half_edge_capacity`).
     half_edge_capacity: u32,
+    /// Workgroups of the face-ranking pass: faces ÷ `WORKGROUP`, rounded up.
     pub(crate) rank_blocks: u32,
+    /// The frame's width, pixels.
     width: u32,
+    /// The frame's height, pixels.
     height: u32,
     _pad0: u32,
     _pad1: u32,
+    /// The scene's bounding box, enlarged by a margin (w unused): wedges are cut at its faces.
     bounds_min: [f32; 4],
     bounds_max: [f32; 4],
 }
