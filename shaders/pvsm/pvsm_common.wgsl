@@ -68,7 +68,7 @@ struct Kernel {
 };
 
 // Bytes of one Kernel record, an element of the kernels array (a read of a pixel's record fetches
-// them all; src/lib.rs's KernelRecord, checked by a test of the crate).
+// them all; src/kernel.rs's KernelRecord, checked by a test of the crate).
 const KERNEL_RECORD_BYTES: u32 = 48u;
 
 // Bytes of one G-buffer texel read: the position and the normal are Rgba32Float (ssm-core's

@@ -6,7 +6,7 @@
 // and the covered area Σ c, so that tiles sharing a filter merge exactly (Sec. 5.2's V·A and A).
 //
 // Eq. 2's sum is walked top-down over the tile's two-layer min/max depth pyramid
-// (pvsm_tile_pyramid.wgsl): a block whose depths are all at or behind the receiver's (every texel
+// (pvsm_filter_pyramid.wgsl): a block whose depths are all at or behind the receiver's (every texel
 // lit) or all in front of it (every texel occluding) adds its exact covered area in one step; a
 // block of two layers (a bar over a floor) lying entirely inside the filter, with the receiver
 // between its layers, adds its far layer's texel count as its lit area (inside the filter every
@@ -42,14 +42,14 @@ struct TileSettings {
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 @group(3) @binding(0) var<uniform> tile: TileSettings;
 @group(3) @binding(1) var tile_map: texture_2d<f32>;
-// The tile map's two-layer min/max depth pyramid (pvsm_tile_pyramid.wgsl): mip m holds level m + 1
+// The tile map's two-layer min/max depth pyramid (pvsm_filter_pyramid.wgsl): mip m holds level m + 1
 // (blocks of 2^(m+1) texels a side) as (nearest, farthest, near_max, far_min), and in
 // tile_near_counts its near cluster's texels in each child (x, y, z, w: children (0, 0), (1, 0),
 // (0, 1), (1, 1)); only the tile's region, from the top-left corner, is written.
 @group(3) @binding(3) var tile_pyramid: texture_2d<f32>;
 @group(3) @binding(4) var tile_near_counts: texture_2d<u32>;
 
-// The ReadCounts counters of this pass and the resolve (READ_COUNTERS in src/lib.rs): every read of
+// The ReadCounts counters of this pass and the resolve (READ_COUNTERS in src/gpu.rs): every read of
 // every invocation of pvsm_tile_filter, and the bytes they fetched; the walk's reads per filter
 // evaluation (the texels filtered, a diagnostic, not a pass); every read of pvsm_resolve, and its
 // bytes.
@@ -59,7 +59,7 @@ const READ_COUNTER_TILE_FILTER_WALK: u32 = 12u;
 const READ_COUNTER_RESOLVE: u32 = 13u;
 const READ_COUNTER_RESOLVE_READ_BYTES: u32 = 14u;
 
-// Bytes of one read (src/lib.rs's formats and buffers, checked by a test of the crate): a texel of
+// Bytes of one read (src/filter.rs's formats and buffers, checked by a test of the crate): a texel of
 // the tile map, R32Float (ssm-core's LightDepthMap::FORMAT); of its pyramid, Rgba32Float
 // (TILE_PYRAMID_FORMAT); of its near counts, Rgba32Uint (TILE_PYRAMID_COUNTS_FORMAT); a pixel's
 // accumulated sums, a vec2<f32>; its capped flag, a u32. (A kernel record is KERNEL_RECORD_BYTES, a

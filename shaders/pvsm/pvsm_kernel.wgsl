@@ -26,7 +26,7 @@
 // predicted resolution puts under its filter).
 @group(2) @binding(6) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+// The ReadCounts counters of this pass (READ_COUNTERS in src/gpu.rs).
 const READ_COUNTER_KERNEL_SHAPE: u32 = 2u;
 const READ_COUNTER_KERNEL_SHAPE_READ_BYTES: u32 = 3u;
 const READ_COUNTER_KERNEL_SHAPE_ATOMICS: u32 = 4u;

@@ -258,6 +258,26 @@ pub fn tile(pyramid: &Pyramid, max_tile: u32, max_tiles: usize, split_excess: f3
     tiling
 }
 
+/// Step 6's outcome over the last frame's lights, for the diagnostics: the tiles, the texels
+/// rendered into them, the largest tile, whether the cap was reached, the tiles clamped to the
+/// device's limit, the finest tile's resolution, and the first 16 tiles' sizes.
+pub(crate) fn tiling_diagnostics(tilings: &[Tiling]) -> Vec<(String, f64)> {
+    let tiles: Vec<&Tile> = tilings.iter().flat_map(|t| &t.tiles).collect();
+    let texels: f64 = tiles.iter().map(|t| f64::from(t.size.x) * f64::from(t.size.y)).sum();
+    let mut out = vec![
+        ("pvsm_tiles".to_owned(), tiles.len() as f64),
+        ("pvsm_texels_rendered".to_owned(), texels),
+        ("pvsm_largest_tile".to_owned(), tiles.iter().map(|t| f64::from(t.size.max_element())).fold(0.0, f64::max)),
+        ("pvsm_tile_cap_reached".to_owned(), f64::from(u8::from(tilings.iter().any(|t| t.cap_reached)))),
+        ("pvsm_clamped_tiles".to_owned(), tiles.iter().filter(|t| t.clamped).count() as f64),
+        ("pvsm_finest_resolution".to_owned(), tiles.iter().map(|t| f64::from(t.resolution())).fold(0.0, f64::max)),
+    ];
+    for (index, tile) in tiles.iter().enumerate().take(16) {
+        out.push((format!("pvsm_tile{index}_size"), f64::from(tile.size.x.max(tile.size.y))));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

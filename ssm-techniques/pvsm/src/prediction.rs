@@ -1,4 +1,5 @@
-//! The perceptual resolution prediction of Sec. 5.1: how many shadow-map
+//! Step 4 of Sec. 5.2 (on the GPU in step 3's pass, [`crate::kernel`]): the
+//! perceptual resolution prediction of Sec. 5.1: how many shadow-map
 //! texels a filter `n` pixels wide on screen needs for its penumbra to look
 //! like the reference (the user study's ρ), and the predicted texel size of
 //! Eq. 5. The WGSL twin is `shaders/pvsm/pvsm_common.wgsl` (`texels_needed`);

@@ -3,7 +3,7 @@
 //! the GPU for given inputs; the tests compare them with values worked out by hand from the paper
 //! (the appendix's convolution, Eqs. 4 and 5, Eq. 2's texels as quads), with the CPU twins in
 //! [`crate::prediction`] (ρ), and the hierarchical walk of Eq. 2 (over the min/max pyramid that the
-//! real `pvsm_tile_pyramid.wgsl` builds) with the per-texel sum.
+//! real `pvsm_filter_pyramid.wgsl` builds) with the per-texel sum.
 
 // Test helpers unwrap too: a failure should stop the test where it happens.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -11,11 +11,12 @@
 use ssm_core::passes::{bind_group_layout, storage_entry, texture_entry, uniform_entry, write_storage_texture_entry};
 use ssm_core::{GpuContext, LightFrameUniform, Settings};
 
-use crate::prediction::{self, DYNAMIC_PEAK, Prediction};
-use crate::{
-    FILTER_SHADER, LOCAL_SHADERS, PvsmSettings, PvsmSettingsUniform, TILE_PYRAMID_COUNTS_FORMAT, TILE_PYRAMID_FORMAT, TILE_PYRAMID_SHADER,
-    TilePyramidLevelUniform, TileSettingsUniform, uint_texture_entry,
+use crate::filter::{
+    FILTER_PYRAMID_SHADER, FILTER_SHADER, TILE_PYRAMID_COUNTS_FORMAT, TILE_PYRAMID_FORMAT, TilePyramidLevelUniform, TileSettingsUniform,
 };
+use crate::gpu::{LOCAL_SHADERS, uint_texture_entry};
+use crate::prediction::{self, DYNAMIC_PEAK, Prediction};
+use crate::{PvsmSettings, PvsmSettingsUniform};
 
 /// The test entry points. Inputs and outputs are `vec4<f32>`s; group 3's bindings 5 and 6 are free in
 /// the filter module (0, 1, 3 and 4 hold the tile, its map and its pyramid, 2 the resolve pass's target).
@@ -116,11 +117,12 @@ impl Tile {
     }
 }
 
-/// Builds `tile`'s two-layer min/max pyramid (depths and near counts) with `pvsm_tile_pyramid.wgsl`,
+/// Builds `tile`'s two-layer min/max pyramid (depths and near counts) with `pvsm_filter_pyramid.wgsl`,
 /// as the technique does before each tile's filter: levels 1 to ceil(log2 of the region's longer side).
 fn build_pyramid(gpu: &GpuContext, tile: &Tile, map: &wgpu::TextureView, pyramid: &wgpu::Texture, counts: &wgpu::Texture) {
     let device = &gpu.device;
-    let module = ssm_core::shader::create_shader_with_imports(gpu, "pvsm_test_pyramid_module", TILE_PYRAMID_SHADER, LOCAL_SHADERS).unwrap();
+    let module =
+        ssm_core::shader::create_shader_with_imports(gpu, "pvsm_test_pyramid_module", FILTER_PYRAMID_SHADER, LOCAL_SHADERS).unwrap();
     let tile_layout = bind_group_layout(device, "pvsm_test_pyramid_tile_layout", &[uniform_entry(0)]);
     let level_layout = bind_group_layout(
         device,

@@ -21,12 +21,12 @@ struct PyramidSettings {
 // READ_COUNTER_SMTG_PYRAMID_READ_BYTES (the bytes they fetched).
 @group(0) @binding(3) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+// The ReadCounts counters of this pass (READ_COUNTERS in src/gpu.rs).
 const READ_COUNTER_SMTG_PYRAMID: u32 = 5u;
 const READ_COUNTER_SMTG_PYRAMID_READ_BYTES: u32 = 6u;
 
 // Bytes of one cell read: a grid cell's two u32 (its resolutions along u and v) or a pyramid cell's
-// vec2<f32> (src/lib.rs sizes both buffers at 8 bytes a cell, checked by a test of the crate).
+// vec2<f32> (src/gpu.rs sizes both buffers at 8 bytes a cell, checked by a test of the crate).
 const SMTG_CELL_BYTES: u32 = 8u;
 
 const THREADS: u32 = 256u;

@@ -12,7 +12,7 @@
 // READ_COUNTER_LOW_RES_MIPS_READ_BYTES (the bytes they fetched).
 @group(0) @binding(2) var<storage, read_write> read_counts: array<atomic<u32>>;
 
-// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+// The ReadCounts counters of this pass (READ_COUNTERS in src/gpu.rs).
 const READ_COUNTER_LOW_RES_MIPS: u32 = 0u;
 const READ_COUNTER_LOW_RES_MIPS_READ_BYTES: u32 = 1u;
 

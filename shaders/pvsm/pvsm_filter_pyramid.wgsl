@@ -55,12 +55,12 @@ struct PyramidLevel {
 @group(1) @binding(4) var finer_counts: texture_2d<u32>;
 @group(1) @binding(5) var coarser_counts: texture_storage_2d<rgba32uint, write>;
 
-// The ReadCounts counters of this pass (READ_COUNTERS in src/lib.rs).
+// The ReadCounts counters of this pass (READ_COUNTERS in src/gpu.rs).
 const READ_COUNTER_TILE_PYRAMID: u32 = 7u;
 const READ_COUNTER_TILE_PYRAMID_READ_BYTES: u32 = 8u;
 const READ_COUNTER_TILE_PYRAMID_STORAGE_BYTES: u32 = 9u;
 
-// Bytes of one texel read (src/lib.rs's formats, checked by a test of the crate): the tile map's
+// Bytes of one texel read (src/filter.rs's formats, checked by a test of the crate): the tile map's
 // R32Float (ssm-core's LightDepthMap::FORMAT), the pyramid's Rgba32Float (TILE_PYRAMID_FORMAT) and
 // its near counts' Rgba32Uint (TILE_PYRAMID_COUNTS_FORMAT).
 const TILE_MAP_TEXEL_BYTES: u32 = 4u;
