@@ -5,67 +5,18 @@
 // #import common/shadow_map.wgsl
 // #import common/camera.wgsl
 
-struct PvsmSettings {
-    // Side of the shadow-map tile grid (SMTG), cells.
-    grid_size: u32,
-    // Samples per axis of the blocker search on the low-resolution map.
-    blocker_kernel: u32,
-    // ρ model: 0 dynamic, 1 static, 2 linear, 3 fixed (no prediction).
-    prediction: u32,
-    // 1: the filter is convolved with the pixel's footprint (Sec. 4.2).
-    antialiasing: u32,
-    // k: k×k screen-space sub-samples per pixel (the supersampling of Fig. 11); 1: none.
-    supersampling: u32,
-    // 1: texels compare with the receiver's tangent plane along their ray; 0: with its depth.
-    receiver_plane: u32,
-    // Normal offset of the lookup point, in texels of the resolution the pixel asked for.
-    normal_offset: f32,
-    // Constant depth bias, a fraction of the scene's diagonal (scene_length).
-    constant_bias: f32,
-    // Side of the shadow map of prediction = fixed, texels.
-    fixed_size: f32,
-    // 1: each texel a point sample, weighted fully when its centre is inside the filter (classic
-    // PCF, Fig. 4(a)); 0: each texel a quad weighted by its exact overlap (Eq. 2, Fig. 4(c)).
-    point_samples: u32,
-    // 1: a tile finer than the pixel's predicted texel is read at every k-th texel (k the ratio);
-    // 0: at every texel (the paper).
-    predicted_stride: u32,
-    // With antialiasing off: texels per pixel, along each axis, for a shadow sharper than a pixel.
-    hard_texels: f32,
-    // 1: the filter reads every texel under it (filter_walk = texels); 0: it walks the tile's min/max
-    // pyramid (filter_walk = hierarchy), the same sum.
-    texel_walk: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
+// The settings, declared once in Rust (`PvsmSettingsUniform`, ssm-techniques/pvsm/src/lib.rs),
+// whose derive writes this struct.
+// #import rust/PvsmSettings
 
 // Every screen-space pass binds the camera and the settings first in its own group.
 @group(2) @binding(0) var<uniform> camera: Camera;
 @group(2) @binding(1) var<uniform> settings: PvsmSettings;
 
 // One pixel's filter, from the kernel-shape pass (step 3), for the tile passes (step 8).
-struct Kernel {
-    // Shadow-map coordinates of the pixel's point (before the normal offset).
-    centre: vec2<f32>,
-    // The filter h as a parallelogram (Sec. 4.2): half-axis u (any direction) and half-axis v,
-    // vertical (only its height), in shadow-map coordinates.
-    u_axis: vec2<f32>,
-    v_height: f32,
-    // Light depth of the pixel's point.
-    depth: f32,
-    // KERNEL_* flags.
-    flags: u32,
-    // The largest normal offset the lookup point may get, world units.
-    offset: f32,
-    // The texel size the prediction asked for along each axis (shadow-map coordinates): tiles finer
-    // than that (a neighbour needed more) are integrated at about this resolution.
-    texel: vec2<f32>,
-    // The average occluder depth z_o the filter's size came from (the receiver's own depth where no
-    // blocker was seen, with prediction = fixed).
-    blocker_depth: f32,
-    _pad: f32,
-};
+// One pixel's filter from step 3, declared once in Rust (`KernelRecord`, ssm-techniques/pvsm/src/kernel.rs),
+// whose derive writes this struct.
+// #import rust/Kernel
 
 // Bytes of one Kernel record, an element of the kernels array (a read of a pixel's record fetches
 // them all; src/kernel.rs's KernelRecord, checked by a test of the crate).

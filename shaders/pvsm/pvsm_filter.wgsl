@@ -20,15 +20,9 @@
 // #import pvsm/pvsm_common.wgsl
 // #import common/read_counts.wgsl
 
-struct TileSettings {
-    // The tile's rectangle of the light frame's shadow-map coordinates.
-    uv_min: vec2<f32>,
-    uv_max: vec2<f32>,
-    // Texels of its map (the top-left part of the tile atlas).
-    size: vec2<f32>,
-    _pad0: f32,
-    _pad1: f32,
-};
+// The settings, declared once in Rust (`TileSettingsUniform`, ssm-techniques/pvsm/src/filter.rs),
+// whose derive writes this struct.
+// #import rust/TileSettings
 
 @group(2) @binding(2) var<storage, read> kernels: array<Kernel>;
 // Per pixel: (Σ c·o, Σ c).

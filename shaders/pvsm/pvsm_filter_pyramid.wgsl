@@ -24,23 +24,13 @@
 // frame, where this pass binds its tile.
 const NO_SURFACE: f32 = 3.40282347e38;
 
-struct TileSettings {
-    uv_min: vec2<f32>,
-    uv_max: vec2<f32>,
-    // Texels of the tile's map region.
-    size: vec2<f32>,
-    _pad0: f32,
-    _pad1: f32,
-};
+// The tile's settings, declared once in Rust (`TileSettingsUniform`, ssm-techniques/pvsm/src/filter.rs),
+// whose derive writes this struct.
+// #import rust/TileSettings
 
-struct PyramidLevel {
-    // The level written (1 or more); its texels are in mip level - 1 of the pyramid.
-    level: u32,
-    // 1: the level below is the tile map (one depth per texel); 0: a pyramid level.
-    from_map: u32,
-    _pad0: u32,
-    _pad1: u32,
-};
+// One level's settings of the tile's min/max pyramid, declared once in Rust (`TilePyramidLevelUniform`, ssm-techniques/pvsm/src/filter.rs),
+// whose derive writes this struct.
+// #import rust/PyramidLevel
 
 @group(0) @binding(0) var<uniform> tile: TileSettings;
 @group(1) @binding(0) var<uniform> pyramid_level: PyramidLevel;

@@ -9,17 +9,9 @@
 
 // #import common/light_frame.wgsl
 
-struct RasterSettings {
-    // Half a texel in NDC (1 / side along each axis).
-    half_texel: vec2<f32>,
-    // Side of the map, texels.
-    size: vec2<f32>,
-    // 1: enlarge triangles (software conservative rasterization); 0: the rasterizer is conservative itself.
-    enlarge: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
+// The settings, declared once in Rust (`RasterSettingsUniform`, ssm-techniques/pvsm/src/low_res_map.rs),
+// whose derive writes this struct.
+// #import rust/RasterSettings
 
 @group(0) @binding(0) var<uniform> frame: LightFrame;
 // ssm-core's SceneVertex as 32-bit words: position (3), normal (3), role (1).

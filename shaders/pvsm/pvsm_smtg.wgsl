@@ -5,13 +5,9 @@
 
 // #import common/read_counts.wgsl
 
-struct PyramidSettings {
-    // Side of level 0, a power of two.
-    grid_size: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
+// The settings, declared once in Rust (`PyramidSettingsUniform`, ssm-techniques/pvsm/src/smtg.rs),
+// whose derive writes this struct.
+// #import rust/PyramidSettings
 
 @group(0) @binding(0) var<uniform> pyramid_settings: PyramidSettings;
 @group(0) @binding(1) var<storage, read> grid: array<u32>;

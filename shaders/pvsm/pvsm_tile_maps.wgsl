@@ -6,14 +6,9 @@
 
 // #import common/light_frame.wgsl
 
-struct CullSettings {
-    // First index of the map's range in the scene's index buffer.
-    first_index: u32,
-    // Triangles in that range.
-    triangle_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-};
+// The settings, declared once in Rust (`CullSettingsUniform`, ssm-techniques/pvsm/src/tile_maps.rs),
+// whose derive writes this struct.
+// #import rust/CullSettings
 
 // The tile's own frame: its view_proj maps the tile's rectangle onto clip space's [-1, 1]².
 @group(0) @binding(0) var<uniform> frame: LightFrame;

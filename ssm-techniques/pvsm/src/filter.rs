@@ -57,8 +57,10 @@ pub enum FilterWalk {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct TileSettingsUniform {
+    /// The tile's rectangle of the light frame's shadow-map coordinates.
     pub(crate) uv_min: [f32; 2],
     pub(crate) uv_max: [f32; 2],
+    /// Texels of its map (the top-left part of the tile atlas).
     pub(crate) size: [f32; 2],
     pub(crate) _pad0: f32,
     pub(crate) _pad1: f32,
@@ -84,8 +86,11 @@ pub(crate) const CAPPED_BYTES: u64 = 4;
 /// `PyramidLevel` of `shaders/pvsm/pvsm_filter_pyramid.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+#[wgsl(name = "PyramidLevel")]
 pub struct TilePyramidLevelUniform {
+    /// The level written (1 or more); its texels are in mip level - 1 of the pyramid.
     pub(crate) level: u32,
+    /// 1: the level below is the tile map (one depth per texel); 0: a pyramid level.
     pub(crate) from_map: u32,
     pub(crate) _pad0: u32,
     pub(crate) _pad1: u32,

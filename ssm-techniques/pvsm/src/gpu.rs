@@ -9,7 +9,9 @@ use ssm_core::passes::{
 };
 use ssm_core::read_counts::ReadCounts;
 use ssm_core::shader::create_shader_with_imports;
-use ssm_core::{DepthBiasUniform, Error, Frame, GpuContext, LightDepthMap, LightFrameUniform, Result, Settings, TechniqueSetup};
+use ssm_core::{
+    DepthBiasUniform, Error, Frame, GpuContext, LightDepthMap, LightFrameUniform, Result, Settings, TechniqueSetup, UniformStruct,
+};
 
 use crate::filter::{
     ACCUMULATED_BYTES, CAPPED_BYTES, FILTER_PYRAMID_SHADER, FILTER_SHADER, TILE_PYRAMID_COUNTS_FORMAT, TILE_PYRAMID_FORMAT, TilePyramid,
@@ -22,7 +24,17 @@ use crate::tile_maps::TILE_MAPS_SHADER;
 use crate::{Conservative, LastFrame, NAME, PredictedVirtualShadowMaps, Prediction, PvsmSettings, PvsmSettingsUniform};
 
 /// WGSL files the PVSM shaders import besides `common/`.
-pub(crate) const LOCAL_SHADERS: &[(&str, &str)] = &[("pvsm/pvsm_common.wgsl", ssm_shaders::pvsm::PVSM_COMMON)];
+pub(crate) const LOCAL_SHADERS: &[(&str, &str)] = &[
+    ("pvsm/pvsm_common.wgsl", ssm_shaders::pvsm::PVSM_COMMON),
+    // The uniforms and records, declared once in Rust: their derives write the WGSL structs.
+    (crate::PvsmSettingsUniform::WGSL_IMPORT, crate::PvsmSettingsUniform::WGSL),
+    (crate::KernelRecord::WGSL_IMPORT, crate::KernelRecord::WGSL),
+    (crate::RasterSettingsUniform::WGSL_IMPORT, crate::RasterSettingsUniform::WGSL),
+    (crate::PyramidSettingsUniform::WGSL_IMPORT, crate::PyramidSettingsUniform::WGSL),
+    (crate::CullSettingsUniform::WGSL_IMPORT, crate::CullSettingsUniform::WGSL),
+    (crate::TileSettingsUniform::WGSL_IMPORT, crate::TileSettingsUniform::WGSL),
+    (crate::TilePyramidLevelUniform::WGSL_IMPORT, crate::TilePyramidLevelUniform::WGSL),
+];
 
 /// The work the passes count with `count_reads` ([`ReadCounts`]), in the order the shaders index
 /// them: `(WGSL constant, shader, pass, unit)`. A texel read is one texel fetched (a `textureLoad`,

@@ -20,14 +20,25 @@ pub(crate) const KERNEL_SHADER: &str = ssm_shaders::pvsm::PVSM_KERNEL;
 /// debug outputs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
+#[wgsl(name = "Kernel")]
 pub struct KernelRecord {
+    /// Shadow-map coordinates of the pixel's point (before the normal offset).
     centre: [f32; 2],
+    /// The filter h as a parallelogram (Sec. 4.2): half-axis u (any direction) and half-axis v,
+    /// vertical (only its height), in shadow-map coordinates.
     u_axis: [f32; 2],
     v_height: f32,
+    /// Light depth of the pixel's point.
     depth: f32,
+    /// KERNEL_* flags.
     flags: u32,
+    /// The largest normal offset the lookup point may get, world units.
     offset: f32,
+    /// The texel size the prediction asked for along each axis (shadow-map coordinates): tiles finer
+    /// than that (a neighbour needed more) are integrated at about this resolution.
     texel: [f32; 2],
+    /// The average occluder depth z_o the filter's size came from (the receiver's own depth where no
+    /// blocker was seen, with prediction = fixed).
     blocker_depth: f32,
     _pad: f32,
 }

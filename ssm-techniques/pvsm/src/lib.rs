@@ -157,18 +157,34 @@ pub struct PvsmSettings {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct PvsmSettingsUniform {
+    /// Side of the shadow-map tile grid (SMTG), cells.
     grid_size: u32,
+    /// Samples per axis of the blocker search on the low-resolution map.
     blocker_kernel: u32,
+    /// ρ model: 0 dynamic, 1 static, 2 linear, 3 fixed (no prediction).
     prediction: u32,
+    /// 1: the filter is convolved with the pixel's footprint (Sec. 4.2).
     antialiasing: u32,
+    /// k: k×k screen-space sub-samples per pixel (the supersampling of Fig. 11); 1: none.
     supersampling: u32,
+    /// 1: texels compare with the receiver's tangent plane along their ray; 0: with its depth.
     receiver_plane: u32,
+    /// Normal offset of the lookup point, in texels of the resolution the pixel asked for.
     normal_offset: f32,
+    /// Constant depth bias, a fraction of the scene's diagonal (scene_length).
     constant_bias: f32,
+    /// Side of the shadow map of prediction = fixed, texels.
     fixed_size: f32,
+    /// 1: each texel a point sample, weighted fully when its centre is inside the filter (classic
+    /// PCF, Fig. 4(a)); 0: each texel a quad weighted by its exact overlap (Eq. 2, Fig. 4(c)).
     point_samples: u32,
+    /// 1: a tile finer than the pixel's predicted texel is read at every k-th texel (k the ratio);
+    /// 0: at every texel (the paper).
     predicted_stride: u32,
+    /// With antialiasing off: texels per pixel, along each axis, for a shadow sharper than a pixel.
     hard_texels: f32,
+    /// 1: the filter reads every texel under it (filter_walk = texels); 0: it walks the tile's min/max
+    /// pyramid (filter_walk = hierarchy), the same sum.
     texel_walk: u32,
     _pad0: u32,
     _pad1: u32,
@@ -441,19 +457,54 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         },
     ],
     uniforms: &[
-        UniformCheck { wgsl_struct: "PvsmSettings", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: PvsmSettingsUniform::LAYOUT },
-        UniformCheck { wgsl_struct: "RasterSettings", wgsl_source: LOW_RES_MAP_SHADER, imports: &[], rust: RasterSettingsUniform::LAYOUT },
-        UniformCheck { wgsl_struct: "PyramidSettings", wgsl_source: SMTG_SHADER, imports: &[], rust: PyramidSettingsUniform::LAYOUT },
-        UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_SHADER, imports: LOCAL_SHADERS, rust: TileSettingsUniform::LAYOUT },
-        UniformCheck { wgsl_struct: "CullSettings", wgsl_source: TILE_MAPS_SHADER, imports: &[], rust: CullSettingsUniform::LAYOUT },
         UniformCheck {
-            wgsl_struct: "PyramidLevel",
+            wgsl_struct: PvsmSettingsUniform::WGSL_NAME,
+            wgsl_source: KERNEL_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: PvsmSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: RasterSettingsUniform::WGSL_NAME,
+            wgsl_source: LOW_RES_MAP_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: RasterSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: PyramidSettingsUniform::WGSL_NAME,
+            wgsl_source: SMTG_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: PyramidSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: TileSettingsUniform::WGSL_NAME,
+            wgsl_source: FILTER_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: TileSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: CullSettingsUniform::WGSL_NAME,
+            wgsl_source: TILE_MAPS_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: CullSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: TilePyramidLevelUniform::WGSL_NAME,
             wgsl_source: FILTER_PYRAMID_SHADER,
-            imports: &[],
+            imports: LOCAL_SHADERS,
             rust: TilePyramidLevelUniform::LAYOUT,
         },
-        UniformCheck { wgsl_struct: "TileSettings", wgsl_source: FILTER_PYRAMID_SHADER, imports: &[], rust: TileSettingsUniform::LAYOUT },
-        UniformCheck { wgsl_struct: "Kernel", wgsl_source: KERNEL_SHADER, imports: LOCAL_SHADERS, rust: KernelRecord::LAYOUT },
+        UniformCheck {
+            wgsl_struct: TileSettingsUniform::WGSL_NAME,
+            wgsl_source: FILTER_PYRAMID_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: TileSettingsUniform::LAYOUT,
+        },
+        UniformCheck {
+            wgsl_struct: KernelRecord::WGSL_NAME,
+            wgsl_source: KERNEL_SHADER,
+            imports: LOCAL_SHADERS,
+            rust: KernelRecord::LAYOUT,
+        },
     ],
     limits: &[
         ssm_core::KnownLimit {

@@ -34,8 +34,11 @@ pub enum Conservative {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct RasterSettingsUniform {
+    /// Half a texel in NDC (1 / side along each axis).
     pub(crate) half_texel: [f32; 2],
+    /// Side of the map, texels.
     pub(crate) size: [f32; 2],
+    /// 1: enlarge triangles (software conservative rasterization); 0: the rasterizer is conservative itself.
     pub(crate) enlarge: u32,
     pub(crate) _pad0: u32,
     pub(crate) _pad1: u32,

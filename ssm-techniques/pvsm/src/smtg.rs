@@ -18,6 +18,7 @@ pub(crate) const SMTG_SHADER: &str = ssm_shaders::pvsm::PVSM_SMTG;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct PyramidSettingsUniform {
+    /// Side of level 0, a power of two.
     pub(crate) grid_size: u32,
     pub(crate) _pad0: u32,
     pub(crate) _pad1: u32,

@@ -20,7 +20,9 @@ pub(crate) const TILE_MAPS_SHADER: &str = ssm_shaders::pvsm::PVSM_TILE_MAPS;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, UniformStruct)]
 pub struct CullSettingsUniform {
+    /// First index of the map's range in the scene's index buffer.
     first_index: u32,
+    /// Triangles in that range.
     triangle_count: u32,
     _pad0: u32,
     _pad1: u32,
