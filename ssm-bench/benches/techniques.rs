@@ -12,7 +12,9 @@
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ssm_bench::{bench_size, output_requirements, registry};
+use ssm_bench::bench::bench_size;
+use ssm_bench::measure::needs::output_requirements;
+use ssm_bench::registry;
 use ssm_core::{GpuContext, Renderer, TechniqueKind};
 use ssm_scene::BUILTIN_SCENES;
 

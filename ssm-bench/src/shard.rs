@@ -14,7 +14,8 @@ use std::str::FromStr;
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
-use crate::report;
+use crate::data::Row;
+use crate::data::csv::parse_csv;
 
 /// A grid point's varied values, `(qualified parameter, value)`, scene ones first.
 pub type Varied = Vec<(String, String)>;
@@ -249,7 +250,7 @@ pub struct Merged {
     /// The adapters that ran the shards, each once, in shard order.
     pub adapters: Vec<String>,
     /// The rows, in the unsharded order.
-    pub rows: Vec<report::Row>,
+    pub rows: Vec<Row>,
     /// Each row's varied values.
     pub varied: Vec<Varied>,
 }
@@ -269,7 +270,7 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged> {
         let record = ShardRecord::read(dir)?;
         let csv_file = dir.join("sweep.csv");
         let text = std::fs::read_to_string(&csv_file).with_context(|| format!("reading {}", csv_file.display()))?;
-        let rows = report::parse_csv(&text).with_context(|| format!("reading {}", csv_file.display()))?;
+        let rows = parse_csv(&text).with_context(|| format!("reading {}", csv_file.display()))?;
         if rows.len() != record.rows.len() {
             bail!("{}: {} rows, but its shard.json records {}", csv_file.display(), rows.len(), record.rows.len());
         }
@@ -306,7 +307,7 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged> {
     if let Some(missing) = seen.iter().position(Option::is_none) {
         bail!("shard {}/{count} is missing", missing + 1);
     }
-    let mut runs: Vec<Option<(report::Row, Varied)>> = vec![None; identity.runs];
+    let mut runs: Vec<Option<(Row, Varied)>> = vec![None; identity.runs];
     for (dir, record, rows) in shards.iter().cloned() {
         let expected = record.shard.runs(identity.runs);
         for ((run, varied), row) in record.rows.into_iter().zip(rows) {

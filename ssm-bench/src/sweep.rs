@@ -1,12 +1,16 @@
-//! `ssm sweep`: a grid over techniques' quality knobs, each point measured
-//! like a row of `ssm compare`, and the plot of time against error with the
-//! Pareto front marked (drawn by [`crate::charts`]): the speed/accuracy trade.
+//! `ssm sweep`'s plan: a grid over techniques' quality knobs (and the scene's), each point
+//! measured like a row of `ssm compare` ([`crate::measure`]): the `--vary` axes ([`Vary`]), the
+//! presets ([`presets`]), the grid resolved before the GPU is touched ([`SweepPlan`]) and the
+//! scene's overrides ([`SceneOverrides`]). The plot of time against error with the Pareto front
+//! marked, the speed/accuracy trade, is [`crate::present::sweep`]'s (drawn by
+//! [`crate::present::charts`]).
 
 use anyhow::{Context, Result, bail};
 
 use ssm_core::{ParamValues, Registry, TechniqueInfo, TechniqueKind};
 
-use crate::report::{PixelSet, Row};
+use crate::measure::pixels::PixelSet;
+use crate::present::sweep::ErrorAxis;
 
 /// One axis of a sweep: parameters of one technique that vary together.
 /// `mine.kernel=7,15,21` varies one; `mine.search:kernel=7:15,11:21`
@@ -403,140 +407,6 @@ pub fn grid(varies: &[&Vary]) -> Vec<Vec<(String, String)>> {
     points
 }
 
-/// Which measure is plotted against time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum ErrorAxis {
-    /// The headline error: mean absolute error over the pixels the reference or the technique
-    /// shadows (`ErrorMetrics::mae`).
-    Mae,
-    /// Mean absolute error over the reference's umbra and penumbra.
-    MaePenumbra,
-    /// Root-mean-square error.
-    Rmse,
-    /// 1 − SSIM.
-    OneMinusSsim,
-    /// Mean FLIP of the shaded images.
-    Flip,
-    /// GPU time per frame (or CPU wall time without timestamps), for the paper's timing figures.
-    Time,
-}
-
-impl ErrorAxis {
-    /// The value of this measure in `row`.
-    #[must_use]
-    pub fn of(self, row: &Row) -> f64 {
-        match self {
-            Self::Mae => row.metrics.mae,
-            Self::MaePenumbra => row.metrics.mae_penumbra,
-            Self::Rmse => row.metrics.rmse,
-            Self::OneMinusSsim => 1.0 - row.metrics.ssim,
-            Self::Flip => row.flip,
-            Self::Time => time_of(row),
-        }
-    }
-
-    /// Axis label.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Mae => "mean absolute error where either image is shadowed",
-            Self::MaePenumbra => "mean absolute error over umbra and penumbra",
-            Self::Rmse => "RMSE",
-            Self::OneMinusSsim => "1 - SSIM",
-            Self::Flip => "mean FLIP (shaded)",
-            Self::Time => "time per frame, ms",
-        }
-    }
-}
-
-/// The time a row is plotted at: GPU median, else CPU wall median.
-#[must_use]
-pub fn time_of(row: &Row) -> f64 {
-    row.gpu_ms_median.unwrap_or(row.cpu_ms)
-}
-
-/// One line of `sweep.md`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MarkdownRow {
-    /// The scene, with its varied values (`sphere-cube[lights=2]`).
-    pub scene: String,
-    /// The technique.
-    pub technique: String,
-    /// Its own varied values as `param=value`, space-separated; empty at its defaults.
-    pub point: String,
-    /// Median time per frame, ms.
-    pub ms: f64,
-    /// First and third quartiles of the time per frame, ms (GPU timestamps only).
-    pub ms_quartiles: Option<(f64, f64)>,
-    /// Median ms per frame of the CPU work inside the frame (a paper's CPU step), part of `ms`.
-    pub cpu_step_ms: Option<f64>,
-    /// The headline error against the ground truth ([`ErrorAxis::Mae`]).
-    pub mae: f64,
-    /// The ground truth's own error over the same pixels, when known.
-    pub truth_noise: Option<f64>,
-    /// Penumbra MAE against the ground truth.
-    pub mae_penumbra: f64,
-    /// PSNR against the ground truth, dB.
-    pub psnr: f64,
-    /// Counted texel reads per frame (`--count-work`); `None` when not counted.
-    pub texel_reads: Option<u64>,
-    /// The bytes those reads fetched; `None` when not counted.
-    pub read_bytes: Option<u64>,
-    /// Counted vertex, fragment and compute invocations per frame; `None` when not counted.
-    pub invocations: Option<u64>,
-}
-
-/// `sweep.md`: the sweep's rows as one Markdown table whose first column names the sweep (a
-/// preset's name), under a line naming the adapter, the image size and the frames timed; the
-/// last two columns are the counted work (`--count-work`), `-` where not counted. The
-/// table's lines from the fifth on are rows only, so that tables of several sweeps on one machine
-/// concatenate into one (`scripts/gpu-bench.sh`).
-#[must_use]
-pub fn markdown(sweep: &str, adapter: &str, size: (u32, u32), frames: u32, rows: &[MarkdownRow]) -> String {
-    let mut text = format!("Adapter: {adapter}; {}×{} pixels; median of {frames} frames.\n\n", size.0, size.1);
-    text.push_str(
-        "| sweep | scene | technique | point | ms | ms IQR | MAE (± truth) | penumbra MAE | PSNR dB | texel reads | invocations | CPU step ms | bytes read |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-    );
-    for row in rows {
-        let point = if row.point.is_empty() { "defaults" } else { &row.point };
-        text.push_str(&format!(
-            "| {sweep} | {} | {} | {point} | {:.2} | {} | {} | {:.4} | {:.1} | {} | {} | {} | {} |\n",
-            row.scene,
-            row.technique,
-            row.ms,
-            row.ms_quartiles.map_or_else(|| "-".to_owned(), |(q1, q3)| format!("{q1:.2}–{q3:.2}")),
-            crate::report::with_noise(row.mae, row.truth_noise),
-            row.mae_penumbra,
-            row.psnr,
-            crate::work::cell(row.texel_reads),
-            crate::work::cell(row.invocations),
-            row.cpu_step_ms.map_or_else(|| "-".to_owned(), |ms| format!("{ms:.2}")),
-            crate::work::cell(row.read_bytes)
-        ));
-    }
-    text
-}
-
-/// Indices of the rows on the Pareto front of (time, error): no other row is
-/// at least as fast and at least as accurate, and better in one. Sorted by time.
-#[must_use]
-pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
-    let dominated = |i: usize| {
-        let (t, e) = points[i];
-        points.iter().enumerate().any(|(j, &(u, f))| j != i && u <= t && f <= e && (u < t || f < e))
-    };
-    let mut front: Vec<usize> =
-        (0..points.len()).filter(|&i| points[i].0.is_finite() && points[i].1.is_finite() && !dominated(i)).collect();
-    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
-    front
-}
-
-/// The short label of a point: its varied values.
-#[must_use]
-pub fn point_label(varied: &[(String, String)]) -> String {
-    varied.iter().map(|(_, v)| v.as_str()).collect::<Vec<_>>().join("/")
-}
-
 /// `name=value;name=value` of a grid point (the parameter names without their technique), or
 /// `defaults` for the empty point.
 #[must_use]
@@ -567,17 +437,10 @@ pub fn in_step_with(specs: &[String], x_axis: &str) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// Whether positive values span more than a decade (so that a logarithmic axis reads better).
-#[must_use]
-pub fn spans_decades(values: &[f64]) -> bool {
-    let positive: Vec<f64> = values.iter().copied().filter(|v| v.is_finite() && *v > 0.0).collect();
-    let (low, high) = positive.iter().fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
-    positive.len() == values.len() && !positive.is_empty() && high > 10.0 * low
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::present::sweep::{point_label, spans_decades};
 
     #[test]
     fn vary_specifications_parse_and_expand() {
@@ -674,40 +537,5 @@ mod tests {
         assert_eq!(path_component(&assignment_label(&point)), "occluder_map_size=128_two_sided=true");
         assert_eq!(assignment_label(&[]), "defaults");
         assert_eq!(path_component("a/b:c d"), "a_b_c_d");
-    }
-
-    #[test]
-    fn markdown_tables_of_several_sweeps_concatenate() {
-        let row = |technique: &str| MarkdownRow {
-            scene: "sphere-cube[lights=2]".into(),
-            technique: technique.into(),
-            point: String::new(),
-            ms: 12.345,
-            ms_quartiles: Some((12.0, 12.5)),
-            cpu_step_ms: None,
-            mae: 0.02345,
-            truth_noise: Some(0.00123),
-            mae_penumbra: 0.01234,
-            psnr: 31.25,
-            texel_reads: None,
-            read_bytes: None,
-            invocations: Some(3456),
-        };
-        let first = markdown("lights", "llvmpipe", (320, 240), 3, &[row("hard"), row("pcss")]);
-        let lines: Vec<&str> = first.lines().collect();
-        assert_eq!(lines[0], "Adapter: llvmpipe; 320×240 pixels; median of 3 frames.");
-        assert_eq!(
-            lines[4],
-            "| lights | sphere-cube[lights=2] | hard | defaults | 12.35 | 12.00–12.50 | 0.0234 ± 0.0012 | 0.0123 | 31.2 | - | 3456 | - | - |"
-        );
-        assert_eq!(lines.len(), 6, "a title, a blank line, the header, its rule, then one line per row");
-    }
-
-    #[test]
-    fn pareto_front_keeps_the_undominated_points_in_time_order() {
-        let points = [(1.0, 0.5), (2.0, 0.2), (3.0, 0.3), (4.0, 0.1), (2.0, 0.6), (f64::NAN, 0.0)];
-        assert_eq!(pareto_front(&points), vec![0, 1, 3]);
-        // Ties are not domination.
-        assert_eq!(pareto_front(&[(1.0, 1.0), (1.0, 1.0)]), vec![0, 1]);
     }
 }

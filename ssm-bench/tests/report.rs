@@ -233,8 +233,8 @@ fn the_memory_a_technique_holds_is_reported() {
     let mut memory = |size: &str| {
         let mut params = defaults.clone();
         params.set("shadow_map_size", size).unwrap();
-        let measured = ssm_bench::report::measure(&mut renderer, hard, &params, 1, &[]).unwrap();
-        measured.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).map(|(_, v)| *v).unwrap()
+        let measured = ssm_bench::measure::measure(&mut renderer, hard, &params, 1, &[]).unwrap();
+        measured.diagnostics.iter().find(|(k, _)| k == ssm_bench::measure::MEMORY_DIAGNOSTIC).map(|(_, v)| *v).unwrap()
     };
     let (small, large) = (memory("512"), memory("1024"));
     println!("hard: {small} MiB at 512², {large} MiB at 1024²");
@@ -247,7 +247,7 @@ fn the_memory_a_technique_holds_is_reported() {
 /// 1024² holding four times what it holds at 512² though both exist at once.
 #[test]
 fn techniques_measured_in_turns_keep_their_own_images_and_memory() {
-    use ssm_bench::report::{FrameOrder, MeasureJob, measure_all};
+    use ssm_bench::measure::{FrameOrder, MeasureJob, measure_all};
     let gpu = ssm_core::GpuContext::new().unwrap();
     let registry = ssm_bench::registry().unwrap();
     let (hard, pcss) = (registry.get("hard").unwrap(), registry.get("pcss").unwrap());
@@ -258,7 +258,7 @@ fn techniques_measured_in_turns_keep_their_own_images_and_memory() {
         params
     };
     let (small, large, soft) = (hard_params("512"), hard_params("1024"), ssm_core::ParamValues::defaults(pcss.name, pcss.params));
-    let needs = ssm_bench::requirements_of([(hard, &small), (pcss, &soft)]).unwrap();
+    let needs = ssm_bench::measure::needs::requirements_of([(hard, &small), (pcss, &soft)]).unwrap();
     let mut renderer = ssm_core::Renderer::new(&gpu, &scene, 64, 48, &needs).unwrap();
     let jobs = [
         MeasureJob { info: hard, params: &small, debug: &[], count_work: false },
@@ -269,7 +269,8 @@ fn techniques_measured_in_turns_keep_their_own_images_and_memory() {
     let in_turns = measure_all(&mut renderer, &jobs, 3, FrameOrder::Interleaved, || timed += 1).unwrap();
     let one_by_one = measure_all(&mut renderer, &jobs, 3, FrameOrder::Sequential, || {}).unwrap();
     assert_eq!(timed, 9, "one call per timed frame");
-    let memory = |m: &ssm_bench::report::Measured| m.diagnostics.iter().find(|(k, _)| k == ssm_bench::report::MEMORY_DIAGNOSTIC).unwrap().1;
+    let memory =
+        |m: &ssm_bench::measure::Measured| m.diagnostics.iter().find(|(k, _)| k == ssm_bench::measure::MEMORY_DIAGNOSTIC).unwrap().1;
     for (index, (turns, alone)) in in_turns.iter().zip(&one_by_one).enumerate() {
         assert_eq!(turns.frames.len(), 3, "job {index}");
         assert!(turns.visibility == alone.visibility, "job {index}: its visibility measured in turns differs from measured alone");

@@ -17,7 +17,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use common::{column, knob_vary, pass_prefix, split_csv, two_techniques};
-use ssm_bench::report::{FrameOrder, MeasureJob, measure_all, parse_csv};
+use ssm_bench::data::csv::parse_csv;
+use ssm_bench::measure::{FrameOrder, MeasureJob, measure_all};
 use ssm_core::{GpuContext, Renderer, TechniqueKind};
 
 fn ssm(args: &[&str], cache: &Path) -> Output {
@@ -114,15 +115,15 @@ fn only_a_measurement_that_counts_renders_a_counting_frame() {
     let reference = registry.iter().find(|i| i.kind == TechniqueKind::GroundTruth).unwrap();
     let params = info.default_params();
     let reference_params = reference.params_from([("samples", "4"), ("cache", "false")]).unwrap();
-    let needs = ssm_bench::requirements_of([(info, &params), (reference, &reference_params)]).unwrap();
+    let needs = ssm_bench::measure::needs::requirements_of([(info, &params), (reference, &reference_params)]).unwrap();
     let mut renderer = Renderer::new(&gpu, &scene, 48, 36, &needs).unwrap();
     let job = |count_work| MeasureJob { info, params: &params, debug: &[], count_work };
-    let before = ssm_bench::work::counting_frames();
+    let before = ssm_bench::measure::work::counting_frames();
     let plain = measure_all(&mut renderer, &[job(false), job(false)], 1, FrameOrder::Interleaved, || {}).unwrap();
-    assert_eq!(ssm_bench::work::counting_frames(), before, "no counting frame without --count-work");
+    assert_eq!(ssm_bench::measure::work::counting_frames(), before, "no counting frame without --count-work");
     assert!(plain.iter().all(|m| m.work.is_none() && m.work_note.is_none()));
     let counted = measure_all(&mut renderer, &[job(true), job(false)], 1, FrameOrder::Interleaved, || {}).unwrap();
-    assert_eq!(ssm_bench::work::counting_frames(), before + 1, "one counting frame, for the job that asked");
+    assert_eq!(ssm_bench::measure::work::counting_frames(), before + 1, "one counting frame, for the job that asked");
     assert!(counted[0].work.as_ref().is_some_and(|w| !w.passes.is_empty()) && counted[1].work.is_none());
     // Counting changes no result, up to the f32 rounding of additive blends whose order atomics
     // decide (atty, wedges): tests/multi_light.rs's re-render tolerance.
@@ -131,8 +132,8 @@ fn only_a_measurement_that_counts_renders_a_counting_frame() {
     assert!(largest <= 1e-5, "counting after the timed frames changed a pixel by {largest}");
     let truth = MeasureJob { info: reference, params: &reference_params, debug: &[], count_work: true };
     let traced = measure_all(&mut renderer, &[truth], 1, FrameOrder::Sequential, || {}).unwrap();
-    assert_eq!(ssm_bench::work::counting_frames(), before + 1, "the ground truth has no GPU frame to count");
-    assert_eq!((traced[0].work.as_ref(), traced[0].work_note), (None, Some(ssm_bench::work::GROUND_TRUTH_NOT_COUNTED)));
+    assert_eq!(ssm_bench::measure::work::counting_frames(), before + 1, "the ground truth has no GPU frame to count");
+    assert_eq!((traced[0].work.as_ref(), traced[0].work_note), (None, Some(ssm_bench::data::work::GROUND_TRUTH_NOT_COUNTED)));
 }
 
 /// `render --count-work` writes each technique's passes into timings.json, and says why the

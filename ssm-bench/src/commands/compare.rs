@@ -7,8 +7,20 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer, TechniqueKind};
 
-use super::{CountWorkArg, Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
-use crate::{charts, check_debug_outputs, debug_outputs_for, registry, report, requirements_of, write_positions};
+use super::{CountWorkArg, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
+use crate::data::Row;
+use crate::data::csv::csv;
+use crate::data::json::row_json;
+use crate::data::work::Totals;
+use crate::measure::files::{write_images, write_positions};
+use crate::measure::needs::{check_debug_outputs, debug_outputs_for, requirements_of};
+use crate::measure::pixels::{PixelSet, pixel_mask};
+use crate::measure::truth::rows_per_light;
+use crate::measure::{MeasureJob, measure, measure_all};
+use crate::present::markdown::markdown_report;
+use crate::present::page::{VIEWER_SCRIPT, ViewerImages, html_report, viewer_data};
+use crate::present::{Format, ReportContext, charts, reference_cost, say};
+use crate::registry;
 
 /// `ssm compare`'s arguments.
 #[derive(clap::Args)]
@@ -31,7 +43,7 @@ pub(super) struct CompareArgs {
     frames: u32,
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1).
     #[arg(long, value_enum, default_value = "all")]
-    pixels: report::PixelSet,
+    pixels: PixelSet,
     /// Debug outputs to write beside each technique's visibility, comma-separated (`ssm list`
     /// shows what each technique offers; `all`: every one).
     #[arg(long = "debug-output", value_delimiter = ',', value_name = "NAME")]
@@ -92,11 +104,11 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
 
     let progress = progress_bar(runs.len() as u64 * u64::from(args.frames.max(1)) + 1);
     progress.set_message(format!("{} (ground truth)", reference_info.name));
-    let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
-    let coverage = report::pixel_mask(&renderer, report::PixelSet::All)?;
+    let reference = measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
+    let coverage = pixel_mask(&renderer, PixelSet::All)?;
     let size = (args.size.width, args.size.height);
-    report::write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;
-    let covered = report::pixel_mask(&renderer, args.pixels)?;
+    write_images(&args.out.join(reference_info.name), &reference, size, &coverage, None)?;
+    let covered = pixel_mask(&renderer, args.pixels)?;
     progress.inc(1);
     let mut rows = Vec::new();
     // Every technique's visibility, kept for the interactive viewer's data.
@@ -104,21 +116,21 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
     // The overlays always: the HTML report draws them over the visibility.
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, true)).collect();
     let count_work = args.work.count_work;
-    let jobs: Vec<report::MeasureJob<'_>> =
-        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug, count_work }).collect();
+    let jobs: Vec<MeasureJob<'_>> =
+        runs.iter().zip(&debug).map(|((info, params), debug)| MeasureJob { info, params, debug, count_work }).collect();
     progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
-    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
+    let measured = measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     for measured in measured {
         let info = measured.info;
-        report::write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
-        rows.extend(report::rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
+        write_images(&args.out.join(info.name), &measured, size, &coverage, Some((&reference, &covered)))?;
+        rows.extend(rows_per_light(&args.scene, &renderer, &measured, &reference, &covered));
         visibilities.push((info.name, measured.visibility));
     }
     progress.finish_and_clear();
 
     let adapter = gpu.describe();
     let reference_text = reference_params.to_string();
-    let reference_cost = report::reference_cost(&reference.diagnostics);
+    let reference_cost = reference_cost(&reference.diagnostics);
     // Where each technique's time goes, passes named without the technique's prefix.
     let bars: Vec<(String, Vec<(String, f64)>)> = rows
         .iter()
@@ -145,7 +157,7 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
         }
     };
     let work_charts = if count_work { work_charts(args, &rows) } else { Vec::new() };
-    let context = report::ReportContext {
+    let context = ReportContext {
         scene: &args.scene,
         adapter: &adapter,
         size: (args.size.width, args.size.height),
@@ -160,19 +172,14 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
     let write = |name: &str, text: String| {
         std::fs::write(args.out.join(name), text).with_context(|| format!("writing {}", args.out.join(name).display()))
     };
-    write("results.csv", report::csv(&rows))?;
-    let markdown = report::markdown_report(&context, &rows);
+    write("results.csv", csv(&rows))?;
+    let markdown = markdown_report(&context, &rows);
     write("report.md", markdown.clone())?;
-    let mut viewer_images =
-        vec![report::ViewerImages { technique: reference_info.name, visibility: &reference.visibility, has_flip: false }];
-    viewer_images.extend(visibilities.iter().map(|(name, visibility)| report::ViewerImages {
-        technique: name,
-        visibility,
-        has_flip: true,
-    }));
-    write("viewer-data.js", report::viewer_data(reference_info.name, size, &coverage, &viewer_images, &rows))?;
-    write("viewer.js", report::VIEWER_SCRIPT.to_owned())?;
-    write("index.html", report::html_report(&context, &rows, reference_info.name))?;
+    let mut viewer_images = vec![ViewerImages { technique: reference_info.name, visibility: &reference.visibility, has_flip: false }];
+    viewer_images.extend(visibilities.iter().map(|(name, visibility)| ViewerImages { technique: name, visibility, has_flip: true }));
+    write("viewer-data.js", viewer_data(reference_info.name, size, &coverage, &viewer_images, &rows))?;
+    write("viewer.js", VIEWER_SCRIPT.to_owned())?;
+    write("index.html", html_report(&context, &rows, reference_info.name))?;
     let index = args.out.join("index.html");
     match args.format {
         Format::Text => {
@@ -180,7 +187,7 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
             say!("wrote results.csv, report.md and the images under {}", args.out.display());
             say!("report: {} (open it in a browser, or run with --open)", index.display());
         }
-        Format::Json => say!("{}", serde_json::to_string_pretty(&rows.iter().map(report::row_json).collect::<Vec<_>>())?),
+        Format::Json => say!("{}", serde_json::to_string_pretty(&rows.iter().map(row_json).collect::<Vec<_>>())?),
     }
     if args.open {
         // Not a failure when there is no browser: the report is written.
@@ -194,8 +201,7 @@ pub(super) fn run(args: &CompareArgs) -> Result<()> {
 /// The per-pass work charts (`passes-reads.*`: texel reads, `passes-invocations.*`: vertex,
 /// fragment and compute invocations), each of the techniques that counted it, as
 /// (the viewer's name for it, the SVG's file name).
-fn work_charts(args: &CompareArgs, rows: &[report::Row]) -> Vec<(&'static str, &'static str)> {
-    use crate::work::Totals;
+fn work_charts(args: &CompareArgs, rows: &[Row]) -> Vec<(&'static str, &'static str)> {
     type Count = fn(&Totals) -> Option<u64>;
     let kinds: [(&str, &str, &str, charts::PassMeasure, Count); 2] = [
         ("reads", "passes-reads.png", "passes-reads.svg", charts::PassMeasure::TEXEL_READS, |t| t.texel_reads),

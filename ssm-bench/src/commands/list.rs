@@ -6,8 +6,9 @@ use anyhow::{Context, Result};
 use ssm_core::GpuContext;
 use ssm_scene::BUILTIN_SCENES;
 
-use super::Format;
-use crate::{registry, support_on};
+use crate::measure::needs::support_on;
+use crate::present::{Format, say};
+use crate::registry;
 
 /// `ssm list`: every registered technique, its paper, needs, parameters and debug outputs, and
 /// whether this adapter runs it.

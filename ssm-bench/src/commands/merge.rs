@@ -5,10 +5,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use super::Format;
-use super::sweep::{SweepOutput, write_sweep};
-use crate::shard;
-use crate::sweep::ErrorAxis;
+use crate::present::Format;
+use crate::present::sweep::{Cost, ErrorAxis, SweepOutput, WorkUnit, write_sweep};
+use crate::{shard, sweep};
 
 /// `ssm merge`'s arguments.
 #[derive(clap::Args)]
@@ -40,6 +39,7 @@ pub(super) fn run(args: &MergeArgs) -> Result<()> {
         );
     }
     let adapter = merged.adapters.join(" + ");
+    let along_x = sweep::in_step_with(&identity.varies, &identity.x_axis);
     let output = SweepOutput {
         out: &args.out,
         name: identity.preset.as_deref().unwrap_or("custom"),
@@ -48,11 +48,11 @@ pub(super) fn run(args: &MergeArgs) -> Result<()> {
         frames: identity.frames,
         scene_spec: &identity.scene,
         x_axis: &identity.x_axis,
-        specs: &identity.varies,
+        along_x: &along_x,
         error,
-        cost: <crate::work::Cost as clap::ValueEnum>::from_str(&identity.cost, true)
+        cost: <Cost as clap::ValueEnum>::from_str(&identity.cost, true)
             .map_err(|e| anyhow::anyhow!("the shards' cost `{}`: {e}", identity.cost))?,
-        work_unit: <crate::work::WorkUnit as clap::ValueEnum>::from_str(&identity.work_unit, true)
+        work_unit: <WorkUnit as clap::ValueEnum>::from_str(&identity.work_unit, true)
             .map_err(|e| anyhow::anyhow!("the shards' work unit `{}`: {e}", identity.work_unit))?,
         format: args.format,
     };

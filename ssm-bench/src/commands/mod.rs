@@ -1,6 +1,8 @@
 //! The `ssm` command line: the clap definitions of every command, what several commands share
 //! (output format, image size, frame order, `--set`, scene loading, the progress bar), and one
-//! module per command, each readable on its own.
+//! module per command, each readable on its own: its arguments parsed (and a sweep planned:
+//! [`crate::sweep`]), then measured ([`crate::measure`]), then reported ([`crate::data`],
+//! [`crate::present`]).
 
 use std::io::Write;
 
@@ -10,14 +12,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ssm_core::{ParamValues, TechniqueInfo};
 use ssm_scene::{Scene, SceneSource};
 
-use crate::report;
-
-/// Writes a line to stdout, failing (rather than panicking like `println!`) when stdout is closed.
-macro_rules! say {
-    ($($arg:tt)*) => {
-        writeln!(std::io::stdout().lock(), $($arg)*).context("writing to stdout")?
-    };
-}
+use crate::measure::FrameOrder;
+use crate::present::{Format, say};
 
 mod compare;
 mod list;
@@ -74,15 +70,6 @@ enum Command {
     New(new::NewArgs),
 }
 
-/// How a command prints what it found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum Format {
-    /// Lines for people.
-    Text,
-    /// One JSON document on stdout, for scripts (progress and notes go to stderr).
-    Json,
-}
-
 #[derive(clap::Args)]
 struct ListArgs {
     #[command(flatten)]
@@ -135,8 +122,8 @@ struct FrameOrderArgs {
 
 impl FrameOrderArgs {
     /// The order `--sequential` asks for.
-    fn order(self) -> report::FrameOrder {
-        if self.sequential { report::FrameOrder::Sequential } else { report::FrameOrder::Interleaved }
+    fn order(self) -> FrameOrder {
+        if self.sequential { FrameOrder::Sequential } else { FrameOrder::Interleaved }
     }
 }
 

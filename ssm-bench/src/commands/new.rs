@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use crate::present::say;
 use crate::registry;
 
 /// `ssm new`'s arguments.

@@ -6,8 +6,13 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer};
 
-use super::{CountWorkArg, Format, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
-use crate::{check_debug_outputs, debug_outputs_for, registry, report, requirements_of, work, write_positions, write_run};
+use super::{CountWorkArg, FrameOrderArgs, ImageSize, load_scene, params_for, parse_setting, progress_bar};
+use crate::measure::files::{write_positions, write_run};
+use crate::measure::needs::{check_debug_outputs, debug_outputs_for, requirements_of};
+use crate::measure::{MeasureJob, measure_all};
+use crate::present::work::{FRAME_HEADER, PASS_HEADER, frame_table, notes, pass_table};
+use crate::present::{Format, say};
+use crate::registry;
 
 /// `ssm render`'s arguments.
 #[derive(clap::Args)]
@@ -68,10 +73,10 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
     progress.set_message(runs.iter().map(|(info, _)| info.name).collect::<Vec<_>>().join(","));
     let debug: Vec<Vec<&str>> = runs.iter().map(|(info, _)| debug_outputs_for(info, &args.debug_outputs, false)).collect();
     let count_work = args.work.count_work;
-    let jobs: Vec<report::MeasureJob<'_>> =
-        runs.iter().zip(&debug).map(|((info, params), debug)| report::MeasureJob { info, params, debug, count_work }).collect();
+    let jobs: Vec<MeasureJob<'_>> =
+        runs.iter().zip(&debug).map(|((info, params), debug)| MeasureJob { info, params, debug, count_work }).collect();
     // Technique errors name the technique already.
-    let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
+    let measured = measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
     progress.finish_and_clear();
     for run in &measured {
         let info = run.info;
@@ -103,14 +108,14 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
             std::iter::once(header.join("\t")).chain(rows.iter().map(|row| row.join("\t"))).collect()
         };
         say!("counted work per frame (every light):");
-        for line in lines(&work::FRAME_HEADER, work::frame_table(&counted, pixels)) {
+        for line in lines(&FRAME_HEADER, frame_table(&counted, pixels)) {
             say!("  {line}");
         }
         say!("counted work per pass:");
-        for line in lines(&work::PASS_HEADER, work::pass_table(&counted)) {
+        for line in lines(&PASS_HEADER, pass_table(&counted)) {
             say!("  {line}");
         }
-        for note in work::notes(&counted) {
+        for note in notes(&counted) {
             say!("note: {note}");
         }
     }

@@ -1,19 +1,28 @@
 //! `ssm sweep`: techniques' parameters (and the scene's) varied over a grid, each point measured
 //! against the ground truth; sweep.csv, sweep.md and the time-against-error plot. The writing of
-//! those outputs is shared with `ssm merge`, which rebuilds them from a sharded sweep.
+//! those outputs ([`crate::present::sweep`]) is shared with `ssm merge`, which rebuilds them from a
+//! sharded sweep.
 //!
 //! `sweep::` here is the library's [`crate::sweep`] (the plan, presets and axes); this module is
 //! the command around it.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use ssm_core::{GpuContext, Renderer, TechniqueInfo, TechniqueKind};
 
-use super::{CountWorkArg, Format, FrameOrderArgs, load_scene, params_for, parse_setting, progress_bar};
+use super::{CountWorkArg, FrameOrderArgs, load_scene, params_for, parse_setting, progress_bar};
+use crate::data::Row;
+use crate::measure::files::write_images;
+use crate::measure::needs::{check_debug_outputs, debug_outputs_for, requirements_of};
+use crate::measure::pixels::{PixelSet, pixel_mask};
+use crate::measure::truth::row;
+use crate::measure::{MeasureJob, measure, measure_all};
+use crate::present::sweep::{Cost, ErrorAxis, SweepOutput, WorkUnit, write_sweep};
+use crate::present::{Format, say};
 use crate::shard::{Shard, ShardRecord, SweepIdentity, Varied};
-use crate::{charts, check_debug_outputs, debug_outputs_for, registry, report, requirements_of, sweep, work};
+use crate::{registry, sweep};
 
 /// A sweep's image size: a preset may carry its paper's.
 #[derive(clap::Args, Clone, Copy)]
@@ -48,7 +57,7 @@ pub(super) struct SweepArgs {
     settings: Vec<String>,
     /// The measure on the y axis (`time` for the papers' timing figures); default: the preset's, else mae (the headline error).
     #[arg(long, value_enum)]
-    error: Option<sweep::ErrorAxis>,
+    error: Option<ErrorAxis>,
     /// The x axis: `time`, or a varied parameter as `<technique>.<param>` (`scene.light_scale`); default: the preset's, else time.
     #[arg(long)]
     x: Option<String>,
@@ -66,13 +75,13 @@ pub(super) struct SweepArgs {
     /// Whenever work is counted, sweep-work.png and .svg plot it: error against work where the
     /// plot is against time, else work in place of the plot's time or error.
     #[arg(long, value_enum, default_value = "time")]
-    cost: work::Cost,
+    cost: Cost,
     /// The unit of counted work in the work plot and the `--cost work` front.
     #[arg(long, value_enum, default_value = "reads-and-invocations")]
-    work_unit: work::WorkUnit,
+    work_unit: WorkUnit,
     /// Pixels the error metrics cover: every surface, or only receivers (as Atty et al. measure, Sec. 5.2.1); default: the preset's, else all.
     #[arg(long, value_enum)]
-    pixels: Option<report::PixelSet>,
+    pixels: Option<PixelSet>,
     /// `text`: a line per point on stdout; `json`: the rows and their varied values as one JSON document.
     #[arg(long, value_enum, default_value = "text")]
     format: Format,
@@ -96,12 +105,12 @@ pub(super) struct SweepArgs {
 impl SweepArgs {
     /// Whether every point's work is counted: `--count-work`, or `--cost work`.
     fn counts_work(&self) -> bool {
-        self.work.count_work || self.cost == work::Cost::Work
+        self.work.count_work || self.cost == Cost::Work
     }
 }
 
 /// What a sweep measured: its rows and, per row, its run's number and varied values.
-type SweepRows = (Vec<report::Row>, Vec<(usize, Varied)>);
+type SweepRows = (Vec<Row>, Vec<(usize, Varied)>);
 
 /// A sweep with every default resolved: the scene, the axes, the pixels and the plan.
 struct ResolvedSweep {
@@ -111,8 +120,8 @@ struct ResolvedSweep {
     out: PathBuf,
     plan: sweep::SweepPlan,
     x_axis: String,
-    error: sweep::ErrorAxis,
-    pixels: report::PixelSet,
+    error: ErrorAxis,
+    pixels: PixelSet,
     /// (width, height): the command line's, else the preset's, else 640×480.
     size: (u32, u32),
 }
@@ -137,7 +146,7 @@ fn list_presets(registry: &ssm_core::Registry) -> Result<()> {
 }
 
 /// The error axis as `--error` spells it.
-fn sweep_axis_name(axis: sweep::ErrorAxis) -> String {
+fn sweep_axis_name(axis: ErrorAxis) -> String {
     clap::ValueEnum::to_possible_value(&axis).map_or_else(String::new, |v| v.get_name().to_owned())
 }
 
@@ -147,7 +156,7 @@ pub(super) fn sweep_name(value: impl clap::ValueEnum) -> String {
 }
 
 /// The pixel set as `--pixels` spells it.
-fn sweep_pixels_name(pixels: report::PixelSet) -> String {
+fn sweep_pixels_name(pixels: PixelSet) -> String {
     clap::ValueEnum::to_possible_value(&pixels).map_or_else(String::new, |v| v.get_name().to_owned())
 }
 
@@ -187,8 +196,8 @@ fn resolve_sweep(args: &SweepArgs, registry: &ssm_core::Registry, settings: &[(&
     if x_axis != "time" && !plan.varied.contains(&x_axis) {
         bail!("--x {x_axis}: not a varied parameter (give `time` or one of the --vary parameters as <technique>.<param>)");
     }
-    let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(sweep::ErrorAxis::Mae);
-    let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(report::PixelSet::All);
+    let error = args.error.or_else(|| preset.as_ref().map(|p| p.y_axis)).unwrap_or(ErrorAxis::Mae);
+    let pixels = args.pixels.or_else(|| preset.as_ref().map(|p| p.pixels)).unwrap_or(PixelSet::All);
     let size = sweep::image_size(args.size.width, args.size.height, preset.as_ref());
     Ok(ResolvedSweep { scene_spec, specs, out, plan, x_axis, error, pixels, size })
 }
@@ -234,24 +243,24 @@ fn run_sweep(
         };
         let mut renderer = Renderer::new(gpu, &scene, sweep.size.0, sweep.size.1, &needs)?;
         progress.set_message(format!("reference {scene_name}"));
-        let reference = report::measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
-        let covered = report::pixel_mask(&renderer, sweep.pixels)?;
+        let reference = measure(&mut renderer, reference_info, &reference_params, 1, &[ssm_core::reference::NOISE_OUTPUT])?;
+        let covered = pixel_mask(&renderer, sweep.pixels)?;
         let size = sweep.size;
         // Under <out>/images/<scene point>/ when asked: the ground truth, then each technique's points.
         let images = args.images.then(|| sweep.out.join("images").join(sweep::path_component(&sweep::assignment_label(scene_point))));
-        let coverage = if images.is_some() { report::pixel_mask(&renderer, report::PixelSet::All)? } else { Vec::new() };
+        let coverage = if images.is_some() { pixel_mask(&renderer, PixelSet::All)? } else { Vec::new() };
         if let Some(dir) = &images {
-            report::write_images(&dir.join(reference_info.name), &reference, size, &coverage, None)?;
+            write_images(&dir.join(reference_info.name), &reference, size, &coverage, None)?;
         }
         progress.inc(1);
         // This shard's points of the scene point, measured together (their frames in turns, unless --sequential).
         let points: Vec<usize> = (0..plan.points.len()).filter(|point| runs.contains(&(first_run + point))).collect();
         let debug: Vec<Vec<&str>> =
             points.iter().map(|&point| debug_outputs_for(plan.points[point].0, &args.debug_outputs, false)).collect();
-        let jobs: Vec<report::MeasureJob<'_>> = points
+        let jobs: Vec<MeasureJob<'_>> = points
             .iter()
             .zip(&debug)
-            .map(|(&point, debug)| report::MeasureJob {
+            .map(|(&point, debug)| MeasureJob {
                 info: plan.points[point].0,
                 params: &plan.points[point].1,
                 debug,
@@ -259,15 +268,15 @@ fn run_sweep(
             })
             .collect();
         progress.set_message(format!("{} points of {scene_name}", jobs.len()));
-        let measured = report::measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
+        let measured = measure_all(&mut renderer, &jobs, args.frames, args.frame_order.order(), || progress.inc(1))?;
         for (measured, &point_index) in measured.into_iter().zip(&points) {
             let (info, _, technique_point) = &plan.points[point_index];
             let run = first_run + point_index;
             if let Some(dir) = &images {
                 let point_dir = dir.join(info.name).join(sweep::path_component(&sweep::assignment_label(technique_point)));
-                report::write_images(&point_dir, &measured, size, &coverage, Some((&reference, &covered)))?;
+                write_images(&point_dir, &measured, size, &coverage, Some((&reference, &covered)))?;
             }
-            rows.push(report::row(&scene_name, &renderer, &measured, &reference, &covered));
+            rows.push(row(&scene_name, &renderer, &measured, &reference, &covered));
             let mut all: Vec<(String, String)> = scene_point.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())).collect();
             all.extend(technique_point.iter().cloned());
             varied.push((run, all));
@@ -275,209 +284,6 @@ fn run_sweep(
     }
     progress.finish_and_clear();
     Ok((rows, varied))
-}
-
-/// What a sweep's outputs are written from, whether measured here or merged from shards.
-pub(super) struct SweepOutput<'a> {
-    pub(super) out: &'a Path,
-    /// The preset's name, or `custom`.
-    pub(super) name: &'a str,
-    /// The adapter's name for `sweep.md`'s header (several, joined, for a merge across machines).
-    pub(super) adapter: &'a str,
-    pub(super) size: (u32, u32),
-    pub(super) frames: u32,
-    pub(super) scene_spec: &'a str,
-    pub(super) x_axis: &'a str,
-    /// Every `--vary` specification (to find the parameters that vary in step with the x axis).
-    pub(super) specs: &'a [String],
-    pub(super) error: sweep::ErrorAxis,
-    /// What the printed Pareto front weighs error against.
-    pub(super) cost: work::Cost,
-    /// The unit of the work plot.
-    pub(super) work_unit: work::WorkUnit,
-    pub(super) format: Format,
-}
-
-/// `sweep.csv`, the plot (PNG and SVG) and the table on stdout.
-pub(super) fn write_sweep(output: &SweepOutput<'_>, rows: &[report::Row], varied: &[Vec<(String, String)>]) -> Result<()> {
-    let (out, x_axis, error) = (output.out, output.x_axis, output.error);
-    // Parameters varied in step with the x axis (`scene.segments:rings`) move along it: they are
-    // not what tells one series from another.
-    let along_x = sweep::in_step_with(output.specs, x_axis);
-    std::fs::write(out.join("sweep.csv"), report::csv(rows)).with_context(|| format!("writing {}", out.join("sweep.csv").display()))?;
-    let table: Vec<sweep::MarkdownRow> = rows
-        .iter()
-        .zip(varied)
-        .map(|(row, values)| {
-            let own = format!("{}.", row.technique);
-            let point: Vec<String> = values.iter().filter_map(|(k, v)| k.strip_prefix(&own).map(|k| format!("{k}={v}"))).collect();
-            let totals = row.work.as_ref().map(work::Totals::of);
-            sweep::MarkdownRow {
-                scene: row.scene.clone(),
-                technique: row.technique.clone(),
-                point: point.join(" "),
-                ms: sweep::time_of(row),
-                ms_quartiles: row.gpu_ms_quartiles,
-                cpu_step_ms: row.cpu_step_ms,
-                mae: row.metrics.mae,
-                truth_noise: row.metrics.truth_noise,
-                mae_penumbra: row.metrics.mae_penumbra,
-                psnr: row.metrics.psnr,
-                texel_reads: totals.and_then(|t| t.texel_reads),
-                read_bytes: totals.and_then(|t| t.read_bytes),
-                invocations: totals.and_then(|t| t.invocations()),
-            }
-        })
-        .collect();
-    let markdown = sweep::markdown(output.name, output.adapter, output.size, output.frames, &table);
-    std::fs::write(out.join("sweep.md"), markdown).with_context(|| format!("writing {}", out.join("sweep.md").display()))?;
-    // One series per technique and combination of the varied values that are not on the x axis.
-    let plot_points: Vec<charts::PlotPoint> = rows
-        .iter()
-        .zip(varied)
-        .map(|(row, values)| {
-            let prefix = format!("{}.", row.technique);
-            let others: Vec<String> = values
-                .iter()
-                .filter(|(k, _)| k != x_axis && !along_x.contains(k))
-                .map(|(k, v)| format!("{}={v}", k.strip_prefix(&prefix).unwrap_or(k)))
-                .collect();
-            let x = if x_axis == "time" {
-                sweep::time_of(row)
-            } else {
-                values.iter().find(|(k, _)| k == x_axis).and_then(|(_, v)| v.parse().ok()).unwrap_or(f64::NAN)
-            };
-            let series = if x_axis == "time" {
-                row.technique.clone()
-            } else {
-                std::iter::once(row.technique.clone()).chain(others.iter().cloned()).collect::<Vec<_>>().join(" ")
-            };
-            let label = if x_axis == "time" { sweep::point_label(values) } else { String::new() };
-            charts::PlotPoint { series, x, y: error.of(row), label }
-        })
-        .collect();
-    // A parameter axis spanning more than a decade is logarithmic too (triangle counts, sizes).
-    let log_x = x_axis == "time" || sweep::spans_decades(&plot_points.iter().map(|p| p.x).collect::<Vec<_>>());
-    let axes = charts::PlotAxes {
-        x_label: match (x_axis == "time", log_x) {
-            (true, _) => "time per frame, ms (log)".to_owned(),
-            (false, true) => format!("{x_axis} (log)"),
-            (false, false) => x_axis.to_owned(),
-        },
-        y_label: format!("{} (log)", error.label()),
-        log_x,
-        pareto: x_axis == "time" && error != sweep::ErrorAxis::Time,
-    };
-    let title = format!("{} at {}x{} on {}", output.scene_spec, output.size.0, output.size.1, output.adapter);
-    charts::plot(&plot_points, &axes, &title, &out.join("sweep.png"), &out.join("sweep.svg"))?;
-    let work_plot = if rows.iter().any(|r| r.work.is_some()) { write_work_plot(output, rows, &plot_points, &axes)? } else { None };
-    let front_of = |points: &[charts::PlotPoint]| sweep::pareto_front(&points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>());
-    let front = match (&work_plot, output.cost) {
-        (Some((points, work_axes)), work::Cost::Work) if work_axes.pareto => front_of(points),
-        (_, work::Cost::Time) if axes.pareto => front_of(&plot_points),
-        _ => Vec::new(),
-    };
-    let pareto = !front.is_empty();
-    let work_of = |row: &report::Row| row.work.as_ref().and_then(|w| output.work_unit.of(w));
-    if output.format == Format::Json {
-        let json: Vec<serde_json::Value> = rows
-            .iter()
-            .zip(varied)
-            .enumerate()
-            .map(|(index, (row, values))| {
-                let mut value = report::row_json(row);
-                value["varied"] =
-                    values.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>().into();
-                value["pareto"] = front.contains(&index).into();
-                value["work"] = work_of(row).map_or(serde_json::Value::Null, serde_json::Value::from);
-                value
-            })
-            .collect();
-        say!("{}", serde_json::to_string_pretty(&json)?);
-        eprintln!("wrote {}", written(out, work_plot.is_some()));
-        return Ok(());
-    }
-    for (index, (row, values)) in rows.iter().zip(varied).enumerate() {
-        let mark = if front.contains(&index) { "*" } else { " " };
-        // The work in the plot's unit, `-` where a count it needs was not made.
-        let counted = match (&row.work, work_of(row)) {
-            (None, _) => String::new(),
-            (Some(_), Some(amount)) => format!("  {} work", work::short(amount)),
-            (Some(_), None) => "  - work".to_owned(),
-        };
-        say!(
-            "{mark} {:<10} {:<40} {:>9.3} ms{counted}  {} {:.4}",
-            row.technique,
-            sweep::point_label(values),
-            sweep::time_of(row),
-            error.label(),
-            error.of(row)
-        );
-    }
-    if pareto {
-        say!("(* on the Pareto front of {})", if output.cost == work::Cost::Work { "work" } else { "time" });
-    }
-    if work_plot.is_some() {
-        say!("work: {}", output.work_unit.label());
-    }
-    say!("wrote {}", written(out, work_plot.is_some()));
-    Ok(())
-}
-
-/// The files a sweep wrote, for its last line.
-fn written(out: &Path, work_plot: bool) -> String {
-    let mut files = vec!["sweep.csv", "sweep.md", "sweep.png", "sweep.svg"];
-    if work_plot {
-        files.extend(["sweep-work.png", "sweep-work.svg"]);
-    }
-    let paths: Vec<String> = files.iter().map(|f| out.join(f).display().to_string()).collect();
-    format!("{} and {}", paths[..paths.len() - 1].join(", "), paths[paths.len() - 1])
-}
-
-/// `sweep-work.png` and `.svg`: the sweep's plot with counted work (in `--work-unit`) in place of
-/// time: error against work where the time plot is error against time (its Pareto front marked),
-/// else work on the y axis against the same x axis (the papers' timing figures in work).
-/// Returns the points and axes drawn, or `None` (with a note) when no point has the work counted
-/// in that unit (a technique that does not count texel reads in its shaders has no
-/// reads-and-invocations).
-fn write_work_plot(
-    output: &SweepOutput<'_>,
-    rows: &[report::Row],
-    time_points: &[charts::PlotPoint],
-    time_axes: &charts::PlotAxes,
-) -> Result<Option<(Vec<charts::PlotPoint>, charts::PlotAxes)>> {
-    let unit = output.work_unit;
-    let amounts: Vec<f64> = rows.iter().map(|r| r.work.as_ref().and_then(|w| unit.of(w)).unwrap_or(f64::NAN)).collect();
-    let missing: Vec<&str> = rows.iter().zip(&amounts).filter(|(_, a)| a.is_nan()).map(|(r, _)| r.technique.as_str()).collect();
-    if !missing.is_empty() {
-        let mut names = missing.clone();
-        names.dedup();
-        eprintln!(
-            "note: the work plot leaves out {} points whose {} was not counted ({}): see --work-unit",
-            missing.len(),
-            unit.name(),
-            names.join(", ")
-        );
-    }
-    if amounts.iter().all(|a| a.is_nan()) {
-        return Ok(None);
-    }
-    let against_time = output.x_axis == "time";
-    let points: Vec<charts::PlotPoint> = time_points
-        .iter()
-        .zip(&amounts)
-        .map(|(point, amount)| {
-            if against_time { charts::PlotPoint { x: *amount, ..point.clone() } } else { charts::PlotPoint { y: *amount, ..point.clone() } }
-        })
-        .collect();
-    let axes = if against_time {
-        charts::PlotAxes { x_label: format!("{} (log)", unit.label()), ..time_axes.clone() }
-    } else {
-        charts::PlotAxes { y_label: format!("{} (log)", unit.label()), pareto: false, ..time_axes.clone() }
-    };
-    let title = format!("{} at {}x{}: counted work", output.scene_spec, output.size.0, output.size.1);
-    charts::plot(&points, &axes, &title, &output.out.join("sweep-work.png"), &output.out.join("sweep-work.svg"))?;
-    Ok(Some((points, axes)))
 }
 
 /// Resolves the sweep (preset defaults under the command line's choices), measures its points
@@ -517,6 +323,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
         record.write(&sweep.out)?;
     }
     let varied: Vec<Varied> = runs.into_iter().map(|(_, values)| values).collect();
+    let along_x = sweep::in_step_with(&sweep.specs, &sweep.x_axis);
     let output = SweepOutput {
         out: &sweep.out,
         name: args.preset.as_deref().unwrap_or("custom"),
@@ -525,7 +332,7 @@ pub(super) fn run(args: &SweepArgs) -> Result<()> {
         frames: args.frames,
         scene_spec: &sweep.scene_spec,
         x_axis: &sweep.x_axis,
-        specs: &sweep.specs,
+        along_x: &along_x,
         error: sweep.error,
         cost: args.cost,
         work_unit: args.work_unit,

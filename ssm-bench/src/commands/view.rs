@@ -3,7 +3,8 @@
 use anyhow::{Result, bail};
 use ssm_core::TechniqueKind;
 
-use super::{Format, ImageSize, load_scene, params_for, parse_setting};
+use super::{ImageSize, load_scene, params_for, parse_setting};
+use crate::present::Format;
 use crate::registry;
 
 /// `ssm view`'s arguments.

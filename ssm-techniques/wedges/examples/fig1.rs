@@ -15,7 +15,7 @@
 //! `sphere-cube:spheres=5,segments=20,rings=20`).
 
 use anyhow::{Context, Result, bail};
-use ssm_bench::report::measure;
+use ssm_bench::measure::measure;
 use ssm_core::metrics::{ShadowClass, classify, compare};
 use ssm_core::{GpuContext, Renderer, Requirements};
 

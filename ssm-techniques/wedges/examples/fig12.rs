@@ -23,8 +23,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use ssm_bench::charts::{PlotAxes, PlotPoint, plot};
-use ssm_bench::report::measure;
+use ssm_bench::measure::measure;
+use ssm_bench::present::charts::{PlotAxes, PlotPoint, plot};
 use ssm_core::metrics::{ShadowClass, classify, compare};
 use ssm_core::{GpuContext, Renderer, Requirements};
 use ssm_wedges::scenes::{FIG12_SIDES, PAPER_RINGS, PAPER_SEGMENTS, sphere_cube};
@@ -132,7 +132,7 @@ fn main() -> Result<()> {
             renderer.render(technique.as_mut(), info.name)?;
             let visibility = renderer.read_visibility(0, info.name)?;
             let diagnostics = technique.diagnostics(&gpu);
-            let ms = ssm_bench::median(&frame_times[k]).unwrap_or(f64::NAN);
+            let ms = ssm_bench::stats::median(&frame_times[k]).unwrap_or(f64::NAN);
             let diagnostic = |name: &str| diagnostics.iter().find(|(n, _)| n == name).map_or(String::new(), |(_, v)| v.to_string());
             // Without `--error` the errors are not measured: empty in the CSV, said so when printed.
             let measured = truth.as_ref().map(|t| errors(t, &visibility, &covered, options.size));

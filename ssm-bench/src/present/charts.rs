@@ -5,7 +5,8 @@
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 
-use crate::sweep::pareto_front;
+use super::work::short;
+use crate::stats::pareto_front;
 
 /// One point of a plot.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,10 +70,10 @@ impl PassMeasure {
     pub const MILLISECONDS: Self = Self { share_of: "share of the frame's GPU time, %", total: |ms| format!("{ms:.1} ms") };
     /// Texel reads per pass, as the techniques' shaders count them.
     pub const TEXEL_READS: Self =
-        Self { share_of: "share of the frame's counted texel reads, %", total: |n| format!("{} texel reads", crate::work::short(n)) };
+        Self { share_of: "share of the frame's counted texel reads, %", total: |n| format!("{} texel reads", short(n)) };
     /// Vertex, fragment and compute invocations per pass (pipeline statistics).
     pub const INVOCATIONS: Self =
-        Self { share_of: "share of the frame's counted invocations, %", total: |n| format!("{} invocations", crate::work::short(n)) };
+        Self { share_of: "share of the frame's counted invocations, %", total: |n| format!("{} invocations", short(n)) };
 }
 
 /// Where each technique's frame goes: one bar per technique (`(label, passes)`, each pass
