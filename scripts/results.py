@@ -36,7 +36,7 @@ SUMMARY_SCENES = ["sphere-cube", "contact", "leaves"]
 # The examples whose output a technique README reproduces (crate, example, arguments).
 EXAMPLES = {
     "atty": [("ssm-atty", "atty_work", [])],
-    "wedges": [("ssm-wedges", "wedges_work", []), ("ssm-wedges", "fig1", []), ("ssm-wedges", "fig12", [])],
+    "wedges": [("ssm-wedges", "wedges_work", []), ("ssm-bench", "wedges_fig1", []), ("ssm-bench", "wedges_fig12", [])],
 }
 # The kinds of scene docs/choosing.md discusses: (heading, scene, extra sweep arguments, what it tests).
 SCENE_KINDS = [

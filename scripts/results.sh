@@ -24,6 +24,6 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
 # SSM_BIN (a prebuilt `ssm`, as on a lent GPU machine): no build; the examples run only if built.
 if [ -z "${SSM_BIN:-}" ]; then
     cargo build --release --locked --bin ssm
-    cargo build --release --locked -p ssm-atty -p ssm-wedges --examples
+    cargo build --release --locked -p ssm-atty -p ssm-wedges -p ssm-bench --examples
 fi
 exec python3 scripts/results.py "$@"

@@ -334,7 +334,7 @@ const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "wedges-fig12",
-        summary: "Forest et al., Fig. 12: frame time of the plain penumbra wedges (blending=none, one silhouette buffer) and of the blending (forest, 16 buffers); one scene per sphere count (the crate's fig12 example sweeps them all and plots time against triangles). In counted work (--count-work): the same wedge fragments, and per buffer a blend thread per pixel, a full-screen umbra mask and the silhouette targets written back",
+        summary: "Forest et al., Fig. 12: frame time of the plain penumbra wedges (blending=none, one silhouette buffer) and of the blending (forest, 16 buffers); one scene per sphere count (ssm-bench's wedges_fig12 example sweeps them all and plots time against triangles). In counted work (--count-work): the same wedge fragments, and per buffer a blend thread per pixel, a full-screen umbra mask and the silhouette targets written back",
         scenes: FIG12_SCENES,
         varies: &["wedges.blending:silhouette_buffers=none:1,forest:16"],
         y_axis: "time",
@@ -342,7 +342,7 @@ const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "wedges-atty-fig25",
-        summary: "Atty et al., Fig. 25: soft shadow volumes (wedges, forest) against soft shadow maps (atty two-sided, 210² occluder map) as polygons grow; one scene per sphere count, time against error (the fig12 example sweeps them all)",
+        summary: "Atty et al., Fig. 25: soft shadow volumes (wedges, forest) against soft shadow maps (atty two-sided, 210² occluder map) as polygons grow; one scene per sphere count, time against error (ssm-bench's wedges_fig12 example sweeps them all)",
         scenes: FIG25_SCENES,
         varies: &["wedges.blending=forest", "atty.two_sided=true", "atty.occluder_map_size=210"],
         ..Preset::DEFAULT

@@ -8,7 +8,7 @@
 //! method, shown for what the buffers alone do.
 //!
 //! ```sh
-//! cargo run --release -p ssm-wedges --example fig1 -- [--scene sphere-cube] [--size 320x240] [--buffers 16] [--samples 16]
+//! cargo run --release -p ssm-bench --example wedges_fig1 -- [--scene sphere-cube] [--size 320x240] [--buffers 16] [--samples 16]
 //! ```
 //!
 //! `--scene` takes a built-in name or a manifest (the paper's spheres:

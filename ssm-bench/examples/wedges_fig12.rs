@@ -7,7 +7,7 @@
 //! Fig. 25), on cubes of 1 to 343 spheres of 760 triangles.
 //!
 //! ```sh
-//! cargo run --release -p ssm-wedges --example fig12 -- --out out/fig12 [--size 320x240] [--frames 5] \
+//! cargo run --release -p ssm-bench --example wedges_fig12 -- --out out/fig12 [--size 320x240] [--frames 5] \
 //!     [--sides 1,2,3,4,5,6,7] [--error]
 //! ```
 //!
