@@ -121,20 +121,9 @@ fn param_attributes(field: &syn::Field) -> syn::Result<ParamAttributes> {
     Ok(out)
 }
 
-/// The doc comment of `attrs`, lines joined by spaces.
+/// The doc comment of `attrs`, lines joined by spaces (blank lines dropped).
 fn doc_of(attrs: &[syn::Attribute]) -> String {
-    let lines: Vec<String> = attrs
-        .iter()
-        .filter(|a| a.path().is_ident("doc"))
-        .filter_map(|a| match &a.meta {
-            syn::Meta::NameValue(nv) => match &nv.value {
-                Expr::Lit(syn::ExprLit { lit: Lit::Str(text), .. }) => Some(text.value().trim().to_owned()),
-                _ => None,
-            },
-            _ => None,
-        })
-        .filter(|line| !line.is_empty())
-        .collect();
+    let lines: Vec<String> = doc_lines(attrs).into_iter().map(|line| line.trim().to_owned()).filter(|line| !line.is_empty()).collect();
     lines.join(" ")
 }
 
